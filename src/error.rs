@@ -1,0 +1,142 @@
+//! The crate's one error type.
+
+use core::fmt;
+
+/// Everything that can be wrong with the input of a public entry point.
+///
+/// Every public function validates its input at the boundary and returns one of these instead of
+/// panicking or producing garbage. Locations are given as `(ring, vertex)` indices into the input as
+/// the caller passed it (a planar contour is a ring too), so the message points at the offending
+/// coordinate.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum GeomError {
+    /// A coordinate is NaN or infinite.
+    NonFinite {
+        /// Index of the ring (or contour, or edge list) in the input.
+        ring: usize,
+        /// Index of the vertex within the ring.
+        vertex: usize,
+    },
+    /// A direction vector has zero (or subnormal) length, so it names no direction.
+    ZeroVector {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Index of the vertex within the ring.
+        vertex: usize,
+    },
+    /// A ring has fewer than three distinct vertices, so it bounds no area.
+    TooFewVertices {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Number of distinct vertices found.
+        count: usize,
+    },
+    /// Two consecutive vertices coincide (within the documented tolerance) where the operation
+    /// cannot drop one of them itself.
+    CoincidentVertices {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Index of the first of the two vertices.
+        vertex: usize,
+    },
+    /// Two consecutive vertices of a spherical ring are antipodal (or nearly so), so the great-circle
+    /// arc between them is not unique.
+    AntipodalVertices {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Index of the first of the two vertices.
+        vertex: usize,
+    },
+    /// A contour crosses itself or another contour, so inside and outside are ambiguous.
+    SelfIntersecting {
+        /// Index of the first ring involved.
+        ring: usize,
+        /// Index of the second ring involved (equal to `ring` for a self-crossing contour).
+        other_ring: usize,
+    },
+    /// A value lies outside the range the algorithm supports; the message names the range.
+    OutOfRange {
+        /// Which input is out of range.
+        what: &'static str,
+        /// The offending value.
+        value: f64,
+        /// The largest supported magnitude.
+        limit: f64,
+    },
+    /// Silhouette edges do not close into loops: an endpoint is used by only one edge.
+    OpenChain {
+        /// Index (in the input slice) of an edge whose end has no successor.
+        edge: usize,
+    },
+    /// Silhouette edges branch: an endpoint is shared by more than two edges.
+    Branching {
+        /// Index (in the input slice) of one edge at the branching vertex.
+        edge: usize,
+    },
+    /// The directions are not contained in any open hemisphere, so no gnomonic projection maps them
+    /// all to the plane.
+    NotInOpenHemisphere,
+    /// The input is geometrically degenerate in a way the operation cannot resolve; the string
+    /// says how.
+    Degenerate(&'static str),
+}
+
+impl fmt::Display for GeomError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            GeomError::NonFinite { ring, vertex } => write!(
+                f,
+                "coordinate of vertex {vertex} in ring {ring} is NaN or infinite; \
+                 filter non-finite geometry before calling"
+            ),
+            GeomError::ZeroVector { ring, vertex } => write!(
+                f,
+                "vertex {vertex} in ring {ring} is the zero vector and names no direction; \
+                 a spherical vertex must be a non-zero direction"
+            ),
+            GeomError::TooFewVertices { ring, count } => write!(
+                f,
+                "ring {ring} has only {count} distinct vertices; a ring needs at least 3"
+            ),
+            GeomError::CoincidentVertices { ring, vertex } => write!(
+                f,
+                "vertices {vertex} and {} of ring {ring} coincide; remove repeated vertices",
+                vertex + 1
+            ),
+            GeomError::AntipodalVertices { ring, vertex } => write!(
+                f,
+                "vertices {vertex} and {} of ring {ring} are antipodal, so the edge between \
+                 them is ambiguous; insert a vertex in between",
+                vertex + 1
+            ),
+            GeomError::SelfIntersecting { ring, other_ring } if ring == other_ring => {
+                write!(f, "ring {ring} crosses itself; split it into simple rings")
+            }
+            GeomError::SelfIntersecting { ring, other_ring } => write!(
+                f,
+                "rings {ring} and {other_ring} cross each other; rings must only nest or be disjoint"
+            ),
+            GeomError::OutOfRange { what, value, limit } => write!(
+                f,
+                "{what} is {value:e}, outside the supported range (magnitude at most {limit:e})"
+            ),
+            GeomError::OpenChain { edge } => write!(
+                f,
+                "edge {edge} ends where no other edge starts; silhouette edges must form closed loops"
+            ),
+            GeomError::Branching { edge } => write!(
+                f,
+                "more than two edges meet at an endpoint of edge {edge}; silhouette loops must not branch"
+            ),
+            GeomError::NotInOpenHemisphere => f.write_str(
+                "the directions do not fit in any open hemisphere, so no gnomonic projection \
+                 holds them all; split the input first",
+            ),
+            GeomError::Degenerate(why) => write!(f, "degenerate input: {why}"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for GeomError {}

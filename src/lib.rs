@@ -1,0 +1,36 @@
+//! Exact, noise-free direct lighting from area lights, with analytic soft shadows, built on robust
+//! spherical-polygon geometry.
+//!
+//! The crate is layered; each layer uses only the ones below it (see `ARCHITECTURE.md`):
+//!
+//! - [`planar`]: 2D polygons and their boolean operations.
+//! - [`sphere`]: spherical polygons: solid angle, gnomonic projection, ordering of silhouette edges,
+//!   hemisphere clipping.
+//! - [`ltc`]: linearly transformed cosines and polygon integrals.
+//!
+//! Scalars are `f64` and vectors are glam's `DVec2`/`DVec3`; glam is re-exported so that callers
+//! name the same version. Invalid input (NaN, infinity, degenerate geometry) is reported as a
+//! [`GeomError`], never as a panic.
+//!
+//! # Features
+//!
+//! - `std` (default): `std::error::Error` for [`GeomError`], std's float functions.
+//! - `libm`: float functions from libm, for `no_std` targets (wins over `std` when both are on,
+//!   which makes results bit-identical across platforms).
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+extern crate alloc;
+#[cfg(feature = "std")]
+extern crate std;
+
+pub use glam;
+
+mod error;
+pub mod ltc;
+pub(crate) mod math;
+pub mod planar;
+pub mod sphere;
+
+pub use error::GeomError;

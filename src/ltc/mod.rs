@@ -1,0 +1,1 @@
+//! Linearly transformed cosines and exact polygon integrals.

@@ -1,0 +1,83 @@
+//! The float functions the crate needs, routed to std or to libm.
+//!
+//! `core` has no `sqrt`, `atan2` or `sin_cos` for `f64`, so a `no_std` build takes them from libm.
+//! Only this module names either backend; everything else calls these wrappers, which keeps the
+//! choice in one place and the results identical across the crate. When both features are on,
+//! libm wins, which makes results bit-identical across platforms.
+
+#[cfg(all(not(feature = "std"), not(feature = "libm")))]
+compile_error!("arealight needs a float backend: enable the `std` feature (default) or `libm`");
+
+macro_rules! unary {
+    ($($(#[$doc:meta])* $name:ident => $libm:ident;)*) => {$(
+        $(#[$doc])*
+        #[inline]
+        #[must_use]
+        pub fn $name(x: f64) -> f64 {
+            #[cfg(feature = "libm")]
+            { libm::$libm(x) }
+            #[cfg(all(feature = "std", not(feature = "libm")))]
+            { x.$name() }
+        }
+    )*};
+}
+
+unary! {
+    /// Square root.
+    sqrt => sqrt;
+    /// Sine.
+    sin => sin;
+    /// Cosine.
+    cos => cos;
+    /// Tangent.
+    tan => tan;
+    /// Arc cosine.
+    acos => acos;
+    /// Arc sine.
+    asin => asin;
+    /// Arc tangent.
+    atan => atan;
+    /// Natural exponential.
+    exp => exp;
+    /// Natural logarithm.
+    ln => log;
+    /// Cube root.
+    cbrt => cbrt;
+    /// Largest integer not greater than `x`.
+    floor => floor;
+}
+
+/// Four-quadrant arc tangent of `y / x`.
+#[inline]
+#[must_use]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    #[cfg(feature = "libm")]
+    {
+        libm::atan2(y, x)
+    }
+    #[cfg(all(feature = "std", not(feature = "libm")))]
+    {
+        y.atan2(x)
+    }
+}
+
+/// `x` raised to the power `y`.
+#[inline]
+#[must_use]
+pub fn powf(x: f64, y: f64) -> f64 {
+    #[cfg(feature = "libm")]
+    {
+        libm::pow(x, y)
+    }
+    #[cfg(all(feature = "std", not(feature = "libm")))]
+    {
+        x.powf(y)
+    }
+}
+
+/// Sine and cosine of `x`.
+#[inline]
+#[must_use]
+pub fn sin_cos(x: f64) -> (f64, f64) {
+    (sin(x), cos(x))
+}

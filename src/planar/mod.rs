@@ -1,0 +1,1 @@
+//! Planar polygons and their boolean operations.
