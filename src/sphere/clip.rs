@@ -81,6 +81,9 @@ struct Chain {
     /// Polar angles on the circle of the entry and exit points.
     entry_angle: f64,
     exit_angle: f64,
+    /// Whether the region continues along the circle just counter-clockwise of the exit point.
+    /// True for a transversal exit; at a vertex on the circle it depends on the corner there.
+    exit_open_ccw: bool,
 }
 
 /// Seed paper 000, Alg. 3, generalized from the z-up horizon of one convex ring to any
@@ -154,11 +157,13 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                 }
                 (true, true) => scratch.push(b),
                 (true, false) => {
-                    let p = if sb.abs() <= HORIZON_TOLERANCE {
+                    let on = sb.abs() <= HORIZON_TOLERANCE;
+                    let p = if on {
                         onto_circle(b)
                     } else {
                         onto_circle(b * sa - a * sb)
                     };
+                    let exit_open_ccw = !on || corner_contains(a, b, ring[(j + 1) % m], n.cross(b));
                     scratch.push(p);
                     if let Some((start, entry_angle)) = open.take() {
                         chains.push(Chain {
@@ -166,6 +171,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                             end: scratch.len(),
                             entry_angle,
                             exit_angle: angle(p),
+                            exit_open_ccw,
                         });
                     }
                 }
@@ -193,9 +199,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             if taken[d] {
                 continue;
             }
-            let gap = (other.entry_angle - chain.exit_angle).rem_euclid(2.0 * PI);
-            // An entry a hair behind the exit is the same point, not a full turn away.
-            let gap = if gap > 2.0 * PI - 1e-12 { 0.0 } else { gap };
+            let gap = circle_gap(chain, other);
             if gap < best.0 {
                 best = (gap, d);
             }
@@ -223,8 +227,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             if d == usize::MAX {
                 break;
             }
-            let gap = (chains[d].entry_angle - ch.exit_angle).rem_euclid(2.0 * PI);
-            let gap = if gap > 2.0 * PI - 1e-12 { 0.0 } else { gap };
+            let gap = circle_gap(ch, &chains[d]);
             // Intermediate vertices keep every circle edge a minor arc.
             let steps = crate::math::floor(gap / MAX_CIRCLE_STEP) as usize + 1;
             for t in 1..steps {
@@ -237,6 +240,31 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
         close_ring(&mut out_verts, &mut out_ends, ring_start);
     }
     finish(out_verts, out_ends)
+}
+
+/// Counter-clockwise angle along the circle from the exit of `from` to the entry of `to`.
+///
+/// When the two points coincide (a ring touching the circle at a vertex, or two rings touching
+/// there) the angle is 0 or a full turn, decided by whether the region continues along the circle
+/// past the exit: a convex corner touching the circle from inside leaves the circle outside the
+/// region (join at once), a reflex one has the whole circle inside (go all the way round).
+fn circle_gap(from: &Chain, to: &Chain) -> f64 {
+    let gap = (to.entry_angle - from.exit_angle).rem_euclid(2.0 * PI);
+    if gap < 1e-12 || gap > 2.0 * PI - 1e-12 {
+        if from.exit_open_ccw { 2.0 * PI } else { 0.0 }
+    } else {
+        gap
+    }
+}
+
+/// Whether the tangent direction `t` at the vertex `b` of the path `a -> b -> c` points into the
+/// region, which lies on the left: the corner's interior is swept counter-clockwise (about `b`)
+/// from the direction toward `c` to the direction toward `a`.
+fn corner_contains(a: DVec3, b: DVec3, c: DVec3, t: DVec3) -> bool {
+    let da = a - b * a.dot(b);
+    let dc = c - b * c.dot(b);
+    let sweep = |x: DVec3| crate::math::atan2(dc.cross(x).dot(b), dc.dot(x)).rem_euclid(2.0 * PI);
+    sweep(t) < sweep(da)
 }
 
 /// Whether the clipping circle lies inside the region, when no ring crosses it: the region's side

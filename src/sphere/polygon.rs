@@ -269,47 +269,108 @@ impl SphericalPolygon {
         best.1
     }
 
-    /// Rejects rings that cross or touch themselves or each other.
+    /// Rejects rings that cross or overlap themselves or each other.
+    ///
+    /// Rings may touch at a shared vertex (the same `DVec3` in both places), as the results of
+    /// clipping and set operations do where a hole touches an outer boundary; they may not cross
+    /// there, nor touch anywhere else.
     fn check_simple(&self) -> Result<(), GeomError> {
-        let rings: SmallVec<[&[DVec3]; 4]> = self.rings().collect();
-        for (r, ra) in rings.iter().enumerate() {
-            let n = ra.len();
+        // Every edge as (ring, index in ring, start, end).
+        let mut edges: Vec<(usize, usize, DVec3, DVec3)> = Vec::with_capacity(self.verts.len());
+        for (r, ring) in self.rings().enumerate() {
+            let n = ring.len();
             for i in 0..n {
-                let (a, b) = (ra[i], ra[(i + 1) % n]);
-                // Adjacent edges share the vertex b; they are invalid only if they fold back over
-                // each other: on one great circle, with a and c on the same side of b.
-                let c = ra[(i + 2) % n];
-                if orient(a, b, c) == 0 && (a - b * a.dot(b)).dot(c - b * c.dot(b)) > 0.0 {
-                    return Err(GeomError::SelfIntersecting {
-                        ring: r,
-                        other_ring: r,
-                    });
-                }
-                for j in i + 2..n {
-                    if i == 0 && j == n - 1 {
-                        continue; // adjacent through the closing edge
+                edges.push((r, i, ring[i], ring[(i + 1) % n]));
+            }
+        }
+        let err = |r: usize, s: usize| GeomError::SelfIntersecting {
+            ring: r,
+            other_ring: s,
+        };
+        for (k, &(r, i, a, b)) in edges.iter().enumerate() {
+            for &(s, j, c, d) in &edges[k + 1..] {
+                let n = self.ring_len(r);
+                let consecutive = r == s && (j == (i + 1) % n || i == (j + 1) % n);
+                // A shared endpoint is allowed; the two edges may not leave it along the same
+                // direction (that would be an overlap, or a fold for consecutive edges).
+                let shared = if b == c {
+                    Some((b, a, d))
+                } else if a == d {
+                    Some((a, b, c))
+                } else if a == c {
+                    Some((a, b, d))
+                } else if b == d {
+                    Some((b, a, c))
+                } else {
+                    None
+                };
+                match shared {
+                    Some((x, p, q)) => {
+                        let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
+                        if orient(x, p, q) == 0 && tp.dot(tq) > 0.0 {
+                            return Err(err(r, s));
+                        }
+                        // The far ends may still meet the other edge (two edges sharing both
+                        // ends are caught above, as they leave in the same direction).
                     }
-                    if arcs_intersect(a, b, ra[j], ra[(j + 1) % n]) {
-                        return Err(GeomError::SelfIntersecting {
-                            ring: r,
-                            other_ring: r,
-                        });
-                    }
-                }
-                for (s, rb) in rings.iter().enumerate().skip(r + 1) {
-                    let m = rb.len();
-                    for j in 0..m {
-                        if arcs_intersect(a, b, rb[j], rb[(j + 1) % m]) {
-                            return Err(GeomError::SelfIntersecting {
-                                ring: r,
-                                other_ring: s,
-                            });
+                    None if consecutive => {}
+                    None => {
+                        if arcs_intersect(a, b, c, d) {
+                            return Err(err(r, s));
                         }
                     }
                 }
             }
         }
+        self.check_pinches()
+    }
+
+    /// At a vertex visited more than once (a pinch), each visit's two edges must be adjacent in
+    /// the angular order around the vertex; interleaved visits cross each other there.
+    fn check_pinches(&self) -> Result<(), GeomError> {
+        // (vertex, ring, prev, next) for every vertex occurrence, sorted so equal vertices meet.
+        let mut occ: Vec<(DVec3, usize, DVec3, DVec3)> = Vec::with_capacity(self.verts.len());
+        for (r, ring) in self.rings().enumerate() {
+            let n = ring.len();
+            for i in 0..n {
+                occ.push((ring[i], r, ring[(i + n - 1) % n], ring[(i + 1) % n]));
+            }
+        }
+        let key = |p: &DVec3| (p.x.to_bits(), p.y.to_bits(), p.z.to_bits());
+        occ.sort_by_key(|o| key(&o.0));
+        let mut start = 0;
+        while start < occ.len() {
+            let mut end = start + 1;
+            while end < occ.len() && occ[end].0 == occ[start].0 {
+                end += 1;
+            }
+            let group = &occ[start..end];
+            if group.len() > 1 {
+                let x = group[0].0;
+                let (u, v) = super::predicates::tangent_frame(x);
+                let ang = |p: DVec3| crate::math::atan2(p.dot(v), p.dot(u));
+                let two_pi = 2.0 * PI;
+                for (gi, &(_, ri, pi, ni)) in group.iter().enumerate() {
+                    let (lo, span) = (ang(ni), (ang(pi) - ang(ni)).rem_euclid(two_pi));
+                    let within = |t: f64| (t - lo).rem_euclid(two_pi) < span;
+                    for &(_, rj, pj, nj) in &group[gi + 1..] {
+                        if within(ang(pj)) != within(ang(nj)) {
+                            return Err(GeomError::SelfIntersecting {
+                                ring: ri,
+                                other_ring: rj,
+                            });
+                        }
+                    }
+                }
+            }
+            start = end;
+        }
         Ok(())
+    }
+
+    fn ring_len(&self, r: usize) -> usize {
+        let s = if r == 0 { 0 } else { self.ends[r - 1] as usize };
+        self.ends[r] as usize - s
     }
 
     /// Rejects rings that disagree about which side of a shared face is inside.
@@ -328,7 +389,14 @@ impl SphericalPolygon {
         for i in 0..k {
             for j in 0..k {
                 if i != j {
-                    side[i * k + j] = nearest_feature(core::iter::once(rings[i]), rings[j][0])
+                    // A vertex of ring j that is not a pinch shared with ring i, so that it lies
+                    // strictly on one side of ring i (all shared would mean overlapping edges).
+                    let probe = rings[j]
+                        .iter()
+                        .find(|p| !rings[i].contains(p))
+                        .copied()
+                        .unwrap_or(rings[j][0]);
+                    side[i * k + j] = nearest_feature(core::iter::once(rings[i]), probe)
                         .is_some_and(|(_, inside)| inside);
                 }
             }

@@ -1,0 +1,100 @@
+//! Helpers shared by the integration tests: a small deterministic RNG, polygon generators and an
+//! independent Monte Carlo estimator of solid angles with a stated confidence bound.
+#![allow(dead_code)]
+
+use arealight::glam::DVec3;
+use std::f64::consts::PI;
+
+/// SplitMix64: tiny, deterministic, good enough for test sampling.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.f64()
+    }
+    /// Uniform direction on the sphere.
+    pub fn dir(&mut self) -> DVec3 {
+        let z = self.range(-1.0, 1.0);
+        let phi = self.range(0.0, 2.0 * PI);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}
+
+/// The point at geodesic distance `rho` from unit `c` in azimuth `theta` (about `c`).
+pub fn polar(c: DVec3, rho: f64, theta: f64) -> DVec3 {
+    let (u, v) = c.any_orthonormal_pair();
+    (c * rho.cos() + (u * theta.cos() + v * theta.sin()) * rho.sin()).normalize()
+}
+
+/// A ring star-shaped about `c` (counter-clockwise seen from outside): `n` sorted azimuths with
+/// gaps below 2 pi / 3 and radii in `[rho * shrink, rho]`.
+pub fn star_ring(rng: &mut Rng, c: DVec3, n: usize, rho: f64, shrink: f64) -> Vec<DVec3> {
+    let n = n.max(3);
+    // Evenly spaced azimuths jittered by at most a third of the spacing keep every gap < 2pi/3.
+    let step = 2.0 * PI / n as f64;
+    let start = rng.range(0.0, 2.0 * PI);
+    (0..n)
+        .map(|i| {
+            let th = start + step * (i as f64 + rng.range(-0.3, 0.3));
+            polar(c, rho * rng.range(shrink, 1.0), th)
+        })
+        .collect()
+}
+
+/// Stratified Monte Carlo estimate of the solid angle of `{d : inside(d)}`, with two jittered
+/// samples per cell of an `nz x nphi` equal-area grid in (z, phi), and its estimated standard
+/// deviation (from the within-cell sample variance, which is unbiased for the estimator's
+/// variance). Returns (estimate, sigma, cell area).
+pub fn mc_solid_angle(
+    rng: &mut Rng,
+    nz: usize,
+    nphi: usize,
+    mut inside: impl FnMut(DVec3) -> bool,
+) -> (f64, f64, f64) {
+    let dz = 2.0 / nz as f64;
+    let dphi = 2.0 * PI / nphi as f64;
+    let area = dz * dphi;
+    let (mut est, mut var) = (0.0, 0.0);
+    for i in 0..nz {
+        for j in 0..nphi {
+            let mut f = [0.0; 2];
+            for fk in &mut f {
+                let z = -1.0 + dz * (i as f64 + rng.f64());
+                let phi = dphi * (j as f64 + rng.f64());
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let d = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+                *fk = if inside(d) { 1.0 } else { 0.0 };
+            }
+            est += area * (f[0] + f[1]) / 2.0;
+            var += area * area * (f[0] - f[1]) * (f[0] - f[1]) / 4.0;
+        }
+    }
+    (est, var.sqrt(), area)
+}
+
+/// Asserts that `exact` agrees with a Monte Carlo estimate within 5 estimated standard
+/// deviations plus two cells (the floor covers boundary cells whose two samples happened to
+/// agree, which makes the variance estimate zero there).
+pub fn assert_mc_agrees(exact: f64, mc: (f64, f64, f64), what: &str) {
+    let (est, sigma, cell) = mc;
+    let bound = 5.0 * sigma + 2.0 * cell;
+    assert!(
+        (exact - est).abs() <= bound,
+        "{what}: exact {exact} vs Monte Carlo {est} (bound {bound}, sigma {sigma})"
+    );
+}
