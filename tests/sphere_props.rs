@@ -43,7 +43,7 @@ fn revalidate(p: &SphericalPolygon) -> Result<SphericalPolygon, arealight::GeomE
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
 
     /// project then unproject returns the direction; unproject then project returns the point.
     #[test]

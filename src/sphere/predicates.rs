@@ -79,13 +79,6 @@ pub(crate) fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     2.0 * crate::math::atan2(det, den)
 }
 
-/// Angle between unit vectors `a` and `b` in `[0, pi]`, as `atan2(|a x b|, a . b)`: accurate for
-/// tiny and for near-antipodal pairs, where `acos` of a rounded dot product is not.
-#[inline]
-pub(crate) fn angle_between(a: DVec3, b: DVec3) -> f64 {
-    crate::math::atan2(a.cross(b).length(), a.dot(b))
-}
-
 /// A right-handed orthonormal frame `(u, v)` completing the unit vector `n` (`u x v = n`).
 ///
 /// Branch-free construction of Duff et al. 2017, "Building an orthonormal basis, revisited",

@@ -66,6 +66,17 @@ pub fn mc_solid_angle(
     nphi: usize,
     mut inside: impl FnMut(DVec3) -> bool,
 ) -> (f64, f64, f64) {
+    mc_integral(rng, nz, nphi, |d| if inside(d) { 1.0 } else { 0.0 })
+}
+
+/// As [`mc_solid_angle`], for the integral of a bounded function over the sphere. The floor of
+/// [`assert_mc_agrees`] assumes `|f| <= 1`.
+pub fn mc_integral(
+    rng: &mut Rng,
+    nz: usize,
+    nphi: usize,
+    mut f_of: impl FnMut(DVec3) -> f64,
+) -> (f64, f64, f64) {
     let dz = 2.0 / nz as f64;
     let dphi = 2.0 * PI / nphi as f64;
     let area = dz * dphi;
@@ -78,7 +89,7 @@ pub fn mc_solid_angle(
                 let phi = dphi * (j as f64 + rng.f64());
                 let r = (1.0 - z * z).max(0.0).sqrt();
                 let d = DVec3::new(r * phi.cos(), r * phi.sin(), z);
-                *fk = if inside(d) { 1.0 } else { 0.0 };
+                *fk = f_of(d);
             }
             est += area * (f[0] + f[1]) / 2.0;
             var += area * area * (f[0] - f[1]) * (f[0] - f[1]) / 4.0;
@@ -97,4 +108,66 @@ pub fn assert_mc_agrees(exact: f64, mc: (f64, f64, f64), what: &str) {
         (exact - est).abs() <= bound,
         "{what}: exact {exact} vs Monte Carlo {est} (bound {bound}, sigma {sigma})"
     );
+}
+
+/// Number of proptest cases: `default`, or `PROPTEST_CASES` from the environment for longer
+/// opt-in stress runs (`PROPTEST_CASES=20000 cargo test --release --test sphere_props`).
+pub fn cases(default: u32) -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// Gauss–Legendre nodes and weights on [0, 1], by Newton iteration on P_n.
+pub fn gauss_legendre01(n: usize) -> Vec<(f64, f64)> {
+    (0..n)
+        .map(|i| {
+            let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            let mut dp = 0.0;
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, x);
+                for k in 2..=n {
+                    let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+                    p0 = p1;
+                    p1 = p2;
+                }
+                dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+                let dx = p1 / dp;
+                x -= dx;
+                if dx.abs() < 1e-16 {
+                    break;
+                }
+            }
+            let w = 2.0 / ((1.0 - x * x) * dp * dp);
+            ((x + 1.0) / 2.0, w / 2.0)
+        })
+        .collect()
+}
+
+/// Integral of `f` over the spherical triangle (a, b, c) (all within an open hemisphere about
+/// their sum), by tensor Gauss–Legendre on the planar triangle through them, mapped centrally to
+/// the sphere: d omega = |q . N| / |q|^3 dA.
+pub fn triangle_quadrature(
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+    n: usize,
+    f: impl Fn(DVec3) -> f64,
+) -> f64 {
+    let gl = gauss_legendre01(n);
+    let (e1, e2) = (b - a, c - b);
+    let cross = e1.cross(e2);
+    let area2 = cross.length();
+    let normal = cross / area2;
+    let mut sum = 0.0;
+    for &(s, ws) in &gl {
+        for &(t, wt) in &gl {
+            let q = a + e1 * s + e2 * (s * t);
+            let r = q.length();
+            let jac = area2 * s * q.dot(normal).abs() / (r * r * r);
+            sum += ws * wt * jac * f(q / r);
+        }
+    }
+    sum
 }
