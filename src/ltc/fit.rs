@@ -1,0 +1,647 @@
+//! The LTC table fitter (feature `fit`): fits the GGX tables that `table_data.rs` ships.
+//!
+//! Run it with `cargo run --release --features fit --example fit_ltc`; it rewrites
+//! `src/ltc/table_data.rs`. The procedure follows [HDHN16] §4.2 with the refinements of the public
+//! implementation, and one change of objective:
+//!
+//! 1. For each cell (view cosine, roughness) of the grid, estimate the directional albedo `A`, the
+//!    Fresnel weight and the average direction `Z` of the cosine-weighted BRDF `f cos` with
+//!    stratified visible-normal samples ([Hei18]). `Z` lies in the xz-plane; `X = Y x Z`, `Y = y`.
+//! 2. Parameterise the LTC in the frame of `Z` by three numbers, `M = [X Y Z] S` with
+//!    `S = [[m11, 0, m13], [0, m22, 0], [0, 0, 1]]` (optimised as `ln m11`, `ln m22`, `m13`, so that
+//!    the simplex adapts to lobes of any width down to `alpha = 1e-4`).
+//! 3. Minimise a sampled error between the LTC and `f cos / A` with Nelder–Mead, warm-started from
+//!    the neighbouring cell. The error is estimated by multiple importance sampling (balance
+//!    heuristic) with a fixed stratified set of uniform numbers pushed through both the BRDF
+//!    sampler and the LTC sampler, so that it is a deterministic function of the parameters.
+//!
+//! Two objectives are available ([`FitMode`]):
+//!
+//! - [`FitMode::Arealight`] (the shipped table): the L1 distance `integral |q - p| dw` between the
+//!   normalised BRDF `p = f cos / A` and the LTC *clipped to the upper hemisphere and renormalised*,
+//!   `q = D [z > 0] / h` with `h` its upper-hemisphere mass. Shading only ever sees the clipped
+//!   LTC scaled by `norm = A / h`, and the L1 distance bounds the shading error of every light
+//!   polygon at once: `|integral over P of (q - p)| <= L1 / 2` for any region `P`. The grid is
+//!   uniform in `sqrt(alpha)` from `alpha = 1e-4` and in `sqrt(1 - cos theta)` down to
+//!   `cos theta = 1e-3`.
+//! - [`FitMode::Reference`]: a straightforward reproduction of the public implementation's fit,
+//!    for comparison: the cubed error `integral |f cos - A D|^3 / (pdf_brdf + pdf_ltc)` of the
+//!    unclipped LTC scaled by `norm = A`, on the grid `alpha = max(r^2, 1e-4)` with `r` uniform
+//!    from 0 and `theta = min(acos(1 - x^2), 1.57)`.
+//!
+//! After the warm-started sweep, two refinement passes re-start the optimiser in each cell from
+//! each neighbour's solution when that is better there, so that no cell (in particular at
+//! `alpha -> 0` or at grazing angles) is left in a worse local minimum than its neighbours.
+//!
+//! # References
+//!
+//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//!   linearly transformed cosines.* ACM TOG 35(4), 2016.
+//! - [Hei18] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
+//! - [NM65] J. A. Nelder, R. Mead. *A simplex method for function minimization.* The Computer
+//!   Journal 7(4), 1965.
+
+use std::fmt::Write as _;
+use std::string::String;
+use std::vec;
+use std::vec::Vec;
+
+use glam::{DMat3, DVec2, DVec3};
+
+use super::distribution::Ltc;
+use super::ggx::{ggx_brdf_cos, ggx_sample_vndf, ggx_vndf_pdf};
+use super::table::{CHANNELS, Grid, LtcTable, ViewAxis};
+use crate::GeomError;
+
+/// Which objective and grid to fit; see the [module documentation](self).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FitMode {
+    /// This crate's fit: L1 error of the horizon-clipped, renormalised LTC; the shipped table.
+    Arealight,
+    /// Reproduction of the public reference fit (cubed error, unclipped LTC, reference grid).
+    Reference,
+}
+
+impl FitMode {
+    fn grid(self, n: usize) -> Grid {
+        match self {
+            FitMode::Arealight => Grid {
+                n,
+                view: ViewAxis::SqrtOneMinusCos,
+                cos_min: 1e-3,
+                alpha_min: 1e-4,
+                rough_from_zero: false,
+            },
+            FitMode::Reference => Grid {
+                n,
+                view: ViewAxis::SqrtOneMinusCos,
+                cos_min: 1.57f64.cos(),
+                alpha_min: 1e-4,
+                rough_from_zero: true,
+            },
+        }
+    }
+}
+
+/// Fitter settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FitConfig {
+    /// Objective and grid.
+    pub mode: FitMode,
+    /// Nodes per axis (the shipped table uses 64).
+    pub size: usize,
+    /// Stratified samples per axis for each sampler in the objective (`n^2` BRDF samples plus
+    /// `n^2` LTC samples per evaluation).
+    pub samples: usize,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+impl FitConfig {
+    /// The settings that produced the shipped table (for [`FitMode::Arealight`]) or the
+    /// comparison table (for [`FitMode::Reference`]): 64 x 64 cells, 32 x 32 samples per sampler,
+    /// two threads.
+    #[must_use]
+    pub fn new(mode: FitMode) -> Self {
+        Self {
+            mode,
+            size: 64,
+            samples: 32,
+            threads: 2,
+        }
+    }
+}
+
+/// The result of a fit: the table and per-cell diagnostics.
+#[derive(Debug, Clone)]
+pub struct FittedTable {
+    mode: FitMode,
+    table: LtcTable,
+    /// `(ln m11, ln m22, m13)` per cell, `k * n + j` order.
+    params: Vec<[f64; 3]>,
+    /// Final objective value per cell.
+    errors: Vec<f64>,
+}
+
+impl FittedTable {
+    /// The fitted table, ready for lookups.
+    #[must_use]
+    pub fn table(&self) -> &LtcTable {
+        &self.table
+    }
+
+    /// The final objective value of each cell, indexed `k * n + j` (roughness node `k`, view node
+    /// `j`). For [`FitMode::Arealight`] this is the L1 distance described in the module docs.
+    #[must_use]
+    pub fn cell_errors(&self) -> &[f64] {
+        &self.errors
+    }
+
+    /// The fitted `(ln m11, ln m22, m13)` of each cell, indexed like [`Self::cell_errors`].
+    #[must_use]
+    pub fn cell_params(&self) -> &[[f64; 3]] {
+        &self.params
+    }
+
+    /// Rust source for `table_data.rs`: plain `pub(crate) static` arrays, one per channel.
+    #[must_use]
+    pub fn to_source(&self, command: &str) -> String {
+        let g = self.table.grid();
+        let mut s = String::new();
+        let _ = writeln!(s, "// @generated by `{command}`; do not edit.");
+        let _ = writeln!(
+            s,
+            "// GGX (height-correlated Smith) LTC table, fit mode {:?}: {} x {} cells, index k * SIZE + j",
+            self.mode, g.n, g.n
+        );
+        let _ = writeln!(
+            s,
+            "// (roughness node k, uniform in sqrt(alpha) over [ALPHA_MIN, 1]; view node j, uniform in"
+        );
+        let _ = writeln!(
+            s,
+            "// sqrt(1 - cos theta) over [COS_MIN, 1]). M^-1 is scaled so that M^-1[1][1] = 1."
+        );
+        let _ = writeln!(s, "pub(crate) const SIZE: usize = {};", g.n);
+        let _ = writeln!(s, "pub(crate) const ALPHA_MIN: f64 = {:e};", g.alpha_min);
+        let _ = writeln!(s, "pub(crate) const COS_MIN: f64 = {:e};", g.cos_min);
+        let names = [
+            "M_INV_00", "M_INV_02", "M_INV_20", "M_INV_22", "NORM", "ALBEDO", "FRESNEL",
+        ];
+        for (ch, name) in names.iter().enumerate() {
+            let vals = self.table.channel(ch);
+            let _ = writeln!(s, "pub(crate) static {name}: [f64; {}] = [", vals.len());
+            for row in vals.chunks(8) {
+                s.push_str("    ");
+                for v in row {
+                    let _ = write!(s, "{v:.10e}, ");
+                }
+                s.pop();
+                s.push('\n');
+            }
+            s.push_str("];\n");
+        }
+        s
+    }
+}
+
+/// Per-cell BRDF statistics and the fixed BRDF samples of the objective.
+struct Cell {
+    v: DVec3,
+    alpha: f64,
+    albedo: f64,
+    fresnel: f64,
+    /// Frame of the average direction: columns X, Y, Z.
+    frame: DMat3,
+    /// BRDF samples: direction, `f cos`, VNDF pdf.
+    brdf: Vec<(DVec3, f64, f64)>,
+}
+
+fn stratified(n: usize) -> Vec<DVec2> {
+    let mut u = Vec::with_capacity(n * n);
+    for i in 0..n {
+        for j in 0..n {
+            u.push(DVec2::new(
+                (i as f64 + 0.5) / n as f64,
+                (j as f64 + 0.5) / n as f64,
+            ));
+        }
+    }
+    u
+}
+
+impl Cell {
+    fn new(cos_theta: f64, alpha: f64, us: &[DVec2], stats: &[DVec2]) -> Self {
+        let c = cos_theta.clamp(0.0, 1.0);
+        let v = DVec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c);
+        // Albedo, Fresnel weight and average direction by VNDF sampling: weight f cos / pdf.
+        let (mut a, mut fr, mut dir) = (0.0, 0.0, DVec3::ZERO);
+        for &u in stats {
+            let l = ggx_sample_vndf(v, alpha, u);
+            let pdf = ggx_vndf_pdf(v, l, alpha);
+            if pdf <= 0.0 || l.z <= 0.0 {
+                continue;
+            }
+            let w = ggx_brdf_cos(v, l, alpha) / pdf;
+            let h = (v + l).normalize();
+            a += w;
+            fr += w * (1.0 - v.dot(h).clamp(0.0, 1.0)).powi(5);
+            dir += w * l;
+        }
+        let m = stats.len() as f64;
+        let albedo = a / m;
+        let fresnel = if a > 0.0 { fr / a } else { 0.0 };
+        let z = DVec3::new(dir.x, 0.0, dir.z).normalize_or(DVec3::Z);
+        let x = DVec3::new(z.z, 0.0, -z.x);
+        let frame = DMat3::from_cols(x, DVec3::Y, z);
+        let brdf = us
+            .iter()
+            .map(|&u| {
+                let l = ggx_sample_vndf(v, alpha, u);
+                (l, ggx_brdf_cos(v, l, alpha), ggx_vndf_pdf(v, l, alpha))
+            })
+            .collect();
+        Self {
+            v,
+            alpha,
+            albedo,
+            fresnel,
+            frame,
+            brdf,
+        }
+    }
+
+    fn matrix(&self, p: &[f64; 3]) -> DMat3 {
+        let s = DMat3::from_cols(
+            DVec3::new(p[0].exp(), 0.0, 0.0),
+            DVec3::new(0.0, p[1].exp(), 0.0),
+            DVec3::new(p[2], 0.0, 1.0),
+        );
+        self.frame * s
+    }
+
+    fn objective(&self, p: &[f64; 3], mode: FitMode, us: &[DVec2]) -> f64 {
+        const BAD: f64 = 1e10;
+        if !p.iter().all(|x| x.is_finite()) || p[0].abs() > 30.0 || p[1].abs() > 30.0 {
+            return BAD;
+        }
+        let Ok(ltc) = Ltc::new(self.matrix(p)) else {
+            return BAD;
+        };
+        let a = self.albedo;
+        let n = us.len() as f64;
+        let mut err = 0.0;
+        match mode {
+            FitMode::Arealight => {
+                let h = ltc.upper_hemisphere_mass();
+                if !(h > 1e-6) {
+                    return BAD;
+                }
+                let term = |fc: f64, d: f64, pdf: f64, up: bool| {
+                    let q = if up { d / h } else { 0.0 };
+                    let denom = pdf + d;
+                    if denom > 0.0 {
+                        (q - fc / a).abs() / denom
+                    } else {
+                        0.0
+                    }
+                };
+                for &(l, fc, pdf) in &self.brdf {
+                    err += term(fc, ltc.density(l), pdf, l.z > 0.0);
+                }
+                for &u in us {
+                    let l = ltc.sample(u);
+                    if l.z <= 0.0 {
+                        continue;
+                    }
+                    let fc = ggx_brdf_cos(self.v, l, self.alpha);
+                    err += term(fc, ltc.density(l), ggx_vndf_pdf(self.v, l, self.alpha), true);
+                }
+            }
+            FitMode::Reference => {
+                let term = |fc: f64, d: f64, pdf: f64| {
+                    let e = (fc - a * d).abs();
+                    let denom = pdf + d;
+                    if denom > 0.0 { e * e * e / denom } else { 0.0 }
+                };
+                for &(l, fc, pdf) in &self.brdf {
+                    err += term(fc, ltc.density(l), pdf);
+                }
+                for &u in us {
+                    let l = ltc.sample(u);
+                    let fc = ggx_brdf_cos(self.v, l, self.alpha);
+                    err += term(fc, ltc.density(l), ggx_vndf_pdf(self.v, l, self.alpha));
+                }
+            }
+        }
+        err / n
+    }
+}
+
+/// Nelder–Mead [NM65] on three parameters; returns the best point and value.
+fn nelder_mead(
+    f: &dyn Fn(&[f64; 3]) -> f64,
+    x0: [f64; 3],
+    step: [f64; 3],
+    max_evals: usize,
+) -> ([f64; 3], f64) {
+    let mut pts = [x0; 4];
+    for i in 0..3 {
+        pts[i + 1][i] += step[i];
+    }
+    let mut vals = pts.map(|p| f(&p));
+    let mut evals = 4;
+    let lerp = |a: &[f64; 3], b: &[f64; 3], t: f64| -> [f64; 3] {
+        [
+            a[0] + t * (b[0] - a[0]),
+            a[1] + t * (b[1] - a[1]),
+            a[2] + t * (b[2] - a[2]),
+        ]
+    };
+    while evals < max_evals {
+        // Sort ascending by value.
+        let mut idx = [0usize, 1, 2, 3];
+        idx.sort_by(|&a, &b| vals[a].total_cmp(&vals[b]));
+        pts = idx.map(|i| pts[i]);
+        vals = idx.map(|i| vals[i]);
+        let spread = vals[3] - vals[0];
+        if spread <= 1e-9 * vals[0].abs() + 1e-14 {
+            break;
+        }
+        let c = [
+            (pts[0][0] + pts[1][0] + pts[2][0]) / 3.0,
+            (pts[0][1] + pts[1][1] + pts[2][1]) / 3.0,
+            (pts[0][2] + pts[1][2] + pts[2][2]) / 3.0,
+        ];
+        // Reflection, expansion, contraction, shrink (standard coefficients 1, 2, 1/2, 1/2).
+        let xr = lerp(&c, &pts[3], -1.0);
+        let fr = f(&xr);
+        evals += 1;
+        if fr < vals[0] {
+            let xe = lerp(&c, &pts[3], -2.0);
+            let fe = f(&xe);
+            evals += 1;
+            if fe < fr {
+                pts[3] = xe;
+                vals[3] = fe;
+            } else {
+                pts[3] = xr;
+                vals[3] = fr;
+            }
+        } else if fr < vals[2] {
+            pts[3] = xr;
+            vals[3] = fr;
+        } else {
+            let (xc, fc) = if fr < vals[3] {
+                let xc = lerp(&c, &xr, 0.5);
+                (xc, f(&xc))
+            } else {
+                let xc = lerp(&c, &pts[3], 0.5);
+                (xc, f(&xc))
+            };
+            evals += 1;
+            if fc < vals[3].min(fr) {
+                pts[3] = xc;
+                vals[3] = fc;
+            } else {
+                for i in 1..4 {
+                    pts[i] = lerp(&pts[0], &pts[i], 0.5);
+                    vals[i] = f(&pts[i]);
+                }
+                evals += 3;
+            }
+        }
+    }
+    let mut best = 0;
+    for i in 1..4 {
+        if vals[i] < vals[best] {
+            best = i;
+        }
+    }
+    (pts[best], vals[best])
+}
+
+/// Optimises from `x0`, restarting the simplex at the best point until it stops improving.
+fn minimise(f: &dyn Fn(&[f64; 3]) -> f64, x0: [f64; 3]) -> ([f64; 3], f64) {
+    let mut best = (x0, f(&x0));
+    let mut scale = 0.2;
+    for _ in 0..6 {
+        let p = best.0;
+        let s13 = scale * (0.5 * (p[0] + p[1])).exp();
+        let step = [scale, scale, s13];
+        let r = nelder_mead(f, p, step, 400);
+        let improved = r.1 < best.1 * (1.0 - 1e-6);
+        if r.1 < best.1 {
+            best = r;
+        }
+        if !improved {
+            break;
+        }
+        scale *= 0.5;
+    }
+    best
+}
+
+/// Warm start from a neighbour at roughness `a_from`, for a cell at roughness `a_to`: the lobe
+/// width scales roughly like alpha, so also try the neighbour's matrix scaled by the ratio.
+fn warm_starts(p: [f64; 3], a_from: f64, a_to: f64) -> [[f64; 3]; 2] {
+    let r = a_to / a_from;
+    let lr = r.ln();
+    [p, [p[0] + lr, p[1] + lr, p[2] * r]]
+}
+
+/// Fits a GGX LTC table; `progress` is called with the number of finished cell fits.
+///
+/// # Examples
+///
+/// ```no_run
+/// use arealight::ltc::fit::{FitConfig, FitMode, fit_ggx};
+/// let fitted = fit_ggx(&FitConfig::new(FitMode::Arealight), |_| {});
+/// let source = fitted.to_source("cargo run --release --features fit --example fit_ltc");
+/// assert!(source.contains("pub(crate) static NORM"));
+/// ```
+pub fn fit_ggx(cfg: &FitConfig, progress: impl Fn(usize) + Sync) -> FittedTable {
+    let n = cfg.size.max(2);
+    let mode = cfg.mode;
+    let grid = mode.grid(n);
+    let us = stratified(cfg.samples.max(2));
+    let stats = stratified(128);
+    let threads = cfg.threads.max(1);
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let tick = || progress(done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1);
+
+    // Cells, built in parallel (column j = view node).
+    let make_col = |j: usize| -> Vec<Cell> {
+        (0..n)
+            .map(|k| Cell::new(grid.node_cos(j), grid.node_alpha(k), &us, &stats))
+            .collect()
+    };
+    let cols: Vec<Vec<Cell>> = par_map(n, threads, make_col);
+    let cell = |k: usize, j: usize| &cols[j][k];
+
+    // Roughest row first, sequentially over the view angle.
+    let mut top = Vec::with_capacity(n);
+    let mut prev = [0.0, 0.0, 0.0];
+    for j in 0..n {
+        let c = cell(n - 1, j);
+        let f = |p: &[f64; 3]| c.objective(p, mode, &us);
+        let r = minimise(&f, prev);
+        prev = r.0;
+        top.push(r);
+        tick();
+    }
+
+    // Then each view column downwards in roughness, warm-started from the cell above.
+    let col_fit = |j: usize| -> Vec<([f64; 3], f64)> {
+        let mut out = vec![([0.0; 3], 0.0); n];
+        out[n - 1] = top[j];
+        for k in (0..n - 1).rev() {
+            let c = cell(k, j);
+            let f = |p: &[f64; 3]| c.objective(p, mode, &us);
+            let starts = warm_starts(out[k + 1].0, cell(k + 1, j).alpha, c.alpha);
+            let x0 = if f(&starts[0]) <= f(&starts[1]) {
+                starts[0]
+            } else {
+                starts[1]
+            };
+            out[k] = minimise(&f, x0);
+            tick();
+        }
+        out
+    };
+    let fitted: Vec<Vec<([f64; 3], f64)>> = par_map(n, threads, col_fit);
+    let mut res: Vec<([f64; 3], f64)> = (0..n * n).map(|i| fitted[i % n][i / n]).collect();
+
+    // Refinement: restart each cell from any neighbour's solution that is better there.
+    for _pass in 0..2 {
+        let snap = res.clone();
+        let refine_col = |j: usize| -> Vec<([f64; 3], f64)> {
+            (0..n)
+                .map(|k| {
+                    let c = cell(k, j);
+                    let f = |p: &[f64; 3]| c.objective(p, mode, &us);
+                    let mut best = snap[k * n + j];
+                    let mut cand: Vec<[f64; 3]> = Vec::new();
+                    if j > 0 {
+                        cand.push(snap[k * n + j - 1].0);
+                    }
+                    if j + 1 < n {
+                        cand.push(snap[k * n + j + 1].0);
+                    }
+                    for kk in [k.wrapping_sub(1), k + 1] {
+                        if kk < n {
+                            let ws = warm_starts(snap[kk * n + j].0, cell(kk, j).alpha, c.alpha);
+                            cand.extend_from_slice(&ws);
+                        }
+                    }
+                    for p in cand {
+                        if f(&p) < best.1 {
+                            let r = minimise(&f, p);
+                            if r.1 < best.1 {
+                                best = r;
+                            }
+                        }
+                    }
+                    best
+                })
+                .collect()
+        };
+        let refined: Vec<Vec<([f64; 3], f64)>> = par_map(n, threads, refine_col);
+        res = (0..n * n).map(|i| refined[i % n][i / n]).collect();
+    }
+
+    // Tabulate.
+    let mut data: [Vec<f64>; CHANNELS] = core::array::from_fn(|_| vec![0.0; n * n]);
+    for k in 0..n {
+        for j in 0..n {
+            let c = cell(k, j);
+            let i = k * n + j;
+            let m = c.matrix(&res[i].0);
+            let mi = m.inverse();
+            let s = 1.0 / mi.y_axis.y;
+            data[0][i] = mi.x_axis.x * s;
+            data[1][i] = mi.z_axis.x * s;
+            data[2][i] = mi.x_axis.z * s;
+            data[3][i] = mi.z_axis.z * s;
+            data[4][i] = match mode {
+                FitMode::Arealight => {
+                    let h = Ltc::new(m).map_or(1.0, |l| l.upper_hemisphere_mass());
+                    c.albedo / h
+                }
+                FitMode::Reference => c.albedo,
+            };
+            data[5][i] = c.albedo;
+            data[6][i] = c.fresnel;
+        }
+    }
+    FittedTable {
+        mode,
+        table: LtcTable::from_parts(grid, data),
+        params: res.iter().map(|r| r.0).collect(),
+        errors: res.iter().map(|r| r.1).collect(),
+    }
+}
+
+/// Maps `f` over `0..n` on `threads` scoped threads (interleaved), preserving order.
+fn par_map<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let f = &f;
+    let mut parts: Vec<Vec<(usize, T)>> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..threads)
+            .map(|t| s.spawn(move || (t..n).step_by(threads).map(|i| (i, f(i))).collect()))
+            .collect();
+        hs.into_iter()
+            .map(|h| h.join().unwrap_or_default())
+            .collect()
+    });
+    let mut all: Vec<(usize, T)> = parts.iter_mut().flat_map(core::mem::take).collect();
+    all.sort_by_key(|x| x.0);
+    all.into_iter().map(|x| x.1).collect()
+}
+
+/// SplitMix64, for the jittered samples of [`shading_error`].
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// The shading error of a table at one (view cosine, alpha), relative to the albedo:
+/// `integral over the sphere of |norm D_ltc(l) [l.z > 0] - f(v, l) cos| dl / A`.
+///
+/// This bounds the relative error of LTC shading for every light polygon (the error for a polygon
+/// is at most this integral, and at most half of it when the total albedo is matched). It is
+/// estimated with `samples^2` jittered BRDF samples and as many LTC samples (balance-heuristic
+/// MIS), using the true GGX BRDF, independently of the fitter's fixed sample set.
+///
+/// # Errors
+///
+/// As for [`LtcTable::lookup`].
+pub fn shading_error(
+    table: &LtcTable,
+    cos_theta_v: f64,
+    alpha: f64,
+    samples: usize,
+    seed: u64,
+) -> Result<f64, GeomError> {
+    let look = table.lookup(cos_theta_v, alpha)?;
+    let ltc = look.ltc()?;
+    let c = cos_theta_v.clamp(table.cos_min(), 1.0);
+    let alpha = alpha.clamp(table.alpha_min(), 1.0);
+    let v = DVec3::new((1.0 - c * c).sqrt(), 0.0, c);
+    let mut rng = SplitMix(seed);
+    let n = samples.max(1);
+    let (mut err, mut albedo) = (0.0, 0.0);
+    for i in 0..n {
+        for j in 0..n {
+            let u1 = DVec2::new(
+                (i as f64 + rng.next_f64()) / n as f64,
+                (j as f64 + rng.next_f64()) / n as f64,
+            );
+            let u2 = DVec2::new(
+                (i as f64 + rng.next_f64()) / n as f64,
+                (j as f64 + rng.next_f64()) / n as f64,
+            );
+            for (l, from_brdf) in [(ggx_sample_vndf(v, alpha, u1), true), (ltc.sample(u2), false)] {
+                let fc = ggx_brdf_cos(v, l, alpha);
+                let d = ltc.density(l);
+                let pdf = ggx_vndf_pdf(v, l, alpha);
+                let q = if l.z > 0.0 { look.norm * d } else { 0.0 };
+                if pdf + d > 0.0 {
+                    err += (q - fc).abs() / (pdf + d);
+                }
+                if from_brdf && pdf > 0.0 {
+                    albedo += fc / pdf;
+                }
+            }
+        }
+    }
+    let m = (n * n) as f64;
+    Ok((err / m) / (albedo / m))
+}
