@@ -7,9 +7,12 @@
 //! 1. For each cell (view cosine, roughness) of the grid, estimate the directional albedo `A`, the
 //!    Fresnel weight and the average direction `Z` of the cosine-weighted BRDF `f cos` with
 //!    stratified visible-normal samples ([Hei18]). `Z` lies in the xz-plane; `X = Y x Z`, `Y = y`.
-//! 2. Parameterise the LTC in the frame of `Z` by three numbers, `M = [X Y Z] S` with
-//!    `S = [[m11, 0, m13], [0, m22, 0], [0, 0, 1]]` (optimised as `ln m11`, `ln m22`, `m13`, so that
-//!    the simplex adapts to lobes of any width down to `alpha = 1e-4`).
+//! 2. Parameterise the LTC in the frame of `Z`: `M = [X Y Z] S` with
+//!    `S = [[m11, 0, m13], [0, m22, 0], [m31, 0, 1]]`, optimised as `ln m11`, `ln m22`, `m13`
+//!    (and `m31`), so that the simplex adapts to lobes of any width down to `alpha = 1e-4`. The
+//!    reference fit keeps `m31 = 0` (three parameters); ours frees it, which is the fourth degree
+//!    of freedom of [HDHN16] §4.2 (`M = [[a, 0, b], [0, c, 0], [d, 0, 1]]`) expressed in the
+//!    frame of the average direction.
 //! 3. Minimise a sampled error between the LTC and `f cos / A` with Nelder–Mead, warm-started from
 //!    the neighbouring cell. The error is estimated by multiple importance sampling (balance
 //!    heuristic) with a fixed stratified set of uniform numbers pushed through both the BRDF
@@ -63,6 +66,14 @@ pub enum FitMode {
 }
 
 impl FitMode {
+    /// Number of free LTC parameters.
+    fn dims(self) -> usize {
+        match self {
+            FitMode::Arealight => 4,
+            FitMode::Reference => 3,
+        }
+    }
+
     fn grid(self, n: usize) -> Grid {
         match self {
             FitMode::Arealight => Grid {
@@ -117,8 +128,8 @@ impl FitConfig {
 pub struct FittedTable {
     mode: FitMode,
     table: LtcTable,
-    /// `(ln m11, ln m22, m13)` per cell, `k * n + j` order.
-    params: Vec<[f64; 3]>,
+    /// `(ln m11, ln m22, m13, m31)` per cell, `k * n + j` order.
+    params: Vec<Params>,
     /// Final objective value per cell.
     errors: Vec<f64>,
 }
@@ -137,9 +148,9 @@ impl FittedTable {
         &self.errors
     }
 
-    /// The fitted `(ln m11, ln m22, m13)` of each cell, indexed like [`Self::cell_errors`].
+    /// The fitted `(ln m11, ln m22, m13, m31)` of each cell, indexed like [`Self::cell_errors`].
     #[must_use]
-    pub fn cell_params(&self) -> &[[f64; 3]] {
+    pub fn cell_params(&self) -> &[[f64; 4]] {
         &self.params
     }
 
@@ -251,16 +262,16 @@ impl Cell {
         }
     }
 
-    fn matrix(&self, p: &[f64; 3]) -> DMat3 {
+    fn matrix(&self, p: &Params) -> DMat3 {
         let s = DMat3::from_cols(
-            DVec3::new(p[0].exp(), 0.0, 0.0),
+            DVec3::new(p[0].exp(), 0.0, p[3]),
             DVec3::new(0.0, p[1].exp(), 0.0),
             DVec3::new(p[2], 0.0, 1.0),
         );
         self.frame * s
     }
 
-    fn objective(&self, p: &[f64; 3], mode: FitMode, us: &[DVec2]) -> f64 {
+    fn objective(&self, p: &Params, mode: FitMode, us: &[DVec2]) -> f64 {
         const BAD: f64 = 1e10;
         if !p.iter().all(|x| x.is_finite()) || p[0].abs() > 30.0 || p[1].abs() > 30.0 {
             return BAD;
@@ -318,98 +329,81 @@ impl Cell {
     }
 }
 
-/// Nelder–Mead [NM65] on three parameters; returns the best point and value.
-fn nelder_mead(
-    f: &dyn Fn(&[f64; 3]) -> f64,
-    x0: [f64; 3],
-    step: [f64; 3],
+/// Nelder–Mead [NM65] in `D` dimensions with the standard coefficients (reflection 1, expansion
+/// 2, contraction 1/2, shrink 1/2); returns the best point and value.
+fn nelder_mead<const D: usize>(
+    f: &dyn Fn(&[f64; D]) -> f64,
+    x0: [f64; D],
+    step: [f64; D],
     max_evals: usize,
-) -> ([f64; 3], f64) {
-    let mut pts = [x0; 4];
-    for i in 0..3 {
+) -> ([f64; D], f64) {
+    let mut pts: Vec<[f64; D]> = vec![x0; D + 1];
+    for i in 0..D {
         pts[i + 1][i] += step[i];
     }
-    let mut vals = pts.map(|p| f(&p));
-    let mut evals = 4;
-    let lerp = |a: &[f64; 3], b: &[f64; 3], t: f64| -> [f64; 3] {
-        [
-            a[0] + t * (b[0] - a[0]),
-            a[1] + t * (b[1] - a[1]),
-            a[2] + t * (b[2] - a[2]),
-        ]
+    let mut vals: Vec<f64> = pts.iter().map(f).collect();
+    let mut evals = D + 1;
+    let lerp = |a: &[f64; D], b: &[f64; D], t: f64| -> [f64; D] {
+        core::array::from_fn(|i| a[i] + t * (b[i] - a[i]))
     };
     while evals < max_evals {
-        // Sort ascending by value.
-        let mut idx = [0usize, 1, 2, 3];
+        let mut idx: Vec<usize> = (0..=D).collect();
         idx.sort_by(|&a, &b| vals[a].total_cmp(&vals[b]));
-        pts = idx.map(|i| pts[i]);
-        vals = idx.map(|i| vals[i]);
-        let spread = vals[3] - vals[0];
-        if spread <= 1e-9 * vals[0].abs() + 1e-14 {
+        pts = idx.iter().map(|&i| pts[i]).collect();
+        vals = idx.iter().map(|&i| vals[i]).collect();
+        if vals[D] - vals[0] <= 1e-9 * vals[0].abs() + 1e-14 {
             break;
         }
-        let c = [
-            (pts[0][0] + pts[1][0] + pts[2][0]) / 3.0,
-            (pts[0][1] + pts[1][1] + pts[2][1]) / 3.0,
-            (pts[0][2] + pts[1][2] + pts[2][2]) / 3.0,
-        ];
-        // Reflection, expansion, contraction, shrink (standard coefficients 1, 2, 1/2, 1/2).
-        let xr = lerp(&c, &pts[3], -1.0);
+        // Centroid of all but the worst point.
+        let c: [f64; D] = core::array::from_fn(|i| pts[..D].iter().map(|p| p[i]).sum::<f64>() / D as f64);
+        let xr = lerp(&c, &pts[D], -1.0);
         let fr = f(&xr);
         evals += 1;
         if fr < vals[0] {
-            let xe = lerp(&c, &pts[3], -2.0);
+            let xe = lerp(&c, &pts[D], -2.0);
             let fe = f(&xe);
             evals += 1;
-            if fe < fr {
-                pts[3] = xe;
-                vals[3] = fe;
-            } else {
-                pts[3] = xr;
-                vals[3] = fr;
-            }
-        } else if fr < vals[2] {
-            pts[3] = xr;
-            vals[3] = fr;
+            (pts[D], vals[D]) = if fe < fr { (xe, fe) } else { (xr, fr) };
+        } else if fr < vals[D - 1] {
+            (pts[D], vals[D]) = (xr, fr);
         } else {
-            let (xc, fc) = if fr < vals[3] {
-                let xc = lerp(&c, &xr, 0.5);
-                (xc, f(&xc))
-            } else {
-                let xc = lerp(&c, &pts[3], 0.5);
-                (xc, f(&xc))
-            };
+            // Outside contraction if the reflection beat the worst point, inside otherwise.
+            let xc = if fr < vals[D] { lerp(&c, &xr, 0.5) } else { lerp(&c, &pts[D], 0.5) };
+            let fc = f(&xc);
             evals += 1;
-            if fc < vals[3].min(fr) {
-                pts[3] = xc;
-                vals[3] = fc;
+            if fc < vals[D].min(fr) {
+                (pts[D], vals[D]) = (xc, fc);
             } else {
-                for i in 1..4 {
+                for i in 1..=D {
                     pts[i] = lerp(&pts[0], &pts[i], 0.5);
                     vals[i] = f(&pts[i]);
                 }
-                evals += 3;
+                evals += D;
             }
         }
     }
-    let mut best = 0;
-    for i in 1..4 {
-        if vals[i] < vals[best] {
-            best = i;
-        }
-    }
+    let best = (0..=D).min_by(|&a, &b| vals[a].total_cmp(&vals[b])).unwrap_or(0);
     (pts[best], vals[best])
 }
 
-/// Optimises from `x0`, restarting the simplex at the best point until it stops improving.
-fn minimise(f: &dyn Fn(&[f64; 3]) -> f64, x0: [f64; 3]) -> ([f64; 3], f64) {
+/// The LTC parameters of a cell: `(ln m11, ln m22, m13, m31)`.
+type Params = [f64; 4];
+
+/// Optimises from `x0`, restarting the simplex at the best point until it stops improving. With
+/// `dims == 3`, `m31` stays fixed (the reference parameterisation).
+fn minimise(f: &dyn Fn(&Params) -> f64, x0: Params, dims: usize) -> (Params, f64) {
     let mut best = (x0, f(&x0));
     let mut scale = 0.2;
     for _ in 0..6 {
         let p = best.0;
         let s13 = scale * (0.5 * (p[0] + p[1])).exp();
-        let step = [scale, scale, s13];
-        let r = nelder_mead(f, p, step, 400);
+        let r = if dims == 4 {
+            nelder_mead::<4>(f, p, [scale, scale, s13, scale], 600)
+        } else {
+            let f3 = |q: &[f64; 3]| f(&[q[0], q[1], q[2], p[3]]);
+            let (q, v) = nelder_mead::<3>(&f3, [p[0], p[1], p[2]], [scale, scale, s13], 400);
+            ([q[0], q[1], q[2], p[3]], v)
+        };
         let improved = r.1 < best.1 * (1.0 - 1e-6);
         if r.1 < best.1 {
             best = r;
@@ -424,10 +418,10 @@ fn minimise(f: &dyn Fn(&[f64; 3]) -> f64, x0: [f64; 3]) -> ([f64; 3], f64) {
 
 /// Warm start from a neighbour at roughness `a_from`, for a cell at roughness `a_to`: the lobe
 /// width scales roughly like alpha, so also try the neighbour's matrix scaled by the ratio.
-fn warm_starts(p: [f64; 3], a_from: f64, a_to: f64) -> [[f64; 3]; 2] {
+fn warm_starts(p: Params, a_from: f64, a_to: f64) -> [Params; 2] {
     let r = a_to / a_from;
     let lr = r.ln();
-    [p, [p[0] + lr, p[1] + lr, p[2] * r]]
+    [p, [p[0] + lr, p[1] + lr, p[2] * r, p[3]]]
 }
 
 /// Fits a GGX LTC table; `progress` is called with the number of finished cell fits.
@@ -443,6 +437,7 @@ fn warm_starts(p: [f64; 3], a_from: f64, a_to: f64) -> [[f64; 3]; 2] {
 pub fn fit_ggx(cfg: &FitConfig, progress: impl Fn(usize) + Sync) -> FittedTable {
     let n = cfg.size.max(2);
     let mode = cfg.mode;
+    let dims = mode.dims();
     let grid = mode.grid(n);
     let us = stratified(cfg.samples.max(2));
     let stats = stratified(128);
@@ -461,47 +456,47 @@ pub fn fit_ggx(cfg: &FitConfig, progress: impl Fn(usize) + Sync) -> FittedTable 
 
     // Roughest row first, sequentially over the view angle.
     let mut top = Vec::with_capacity(n);
-    let mut prev = [0.0, 0.0, 0.0];
+    let mut prev = [0.0; 4];
     for j in 0..n {
         let c = cell(n - 1, j);
-        let f = |p: &[f64; 3]| c.objective(p, mode, &us);
-        let r = minimise(&f, prev);
+        let f = |p: &Params| c.objective(p, mode, &us);
+        let r = minimise(&f, prev, dims);
         prev = r.0;
         top.push(r);
         tick();
     }
 
     // Then each view column downwards in roughness, warm-started from the cell above.
-    let col_fit = |j: usize| -> Vec<([f64; 3], f64)> {
-        let mut out = vec![([0.0; 3], 0.0); n];
+    let col_fit = |j: usize| -> Vec<(Params, f64)> {
+        let mut out = vec![([0.0; 4], 0.0); n];
         out[n - 1] = top[j];
         for k in (0..n - 1).rev() {
             let c = cell(k, j);
-            let f = |p: &[f64; 3]| c.objective(p, mode, &us);
+            let f = |p: &Params| c.objective(p, mode, &us);
             let starts = warm_starts(out[k + 1].0, cell(k + 1, j).alpha, c.alpha);
             let x0 = if f(&starts[0]) <= f(&starts[1]) {
                 starts[0]
             } else {
                 starts[1]
             };
-            out[k] = minimise(&f, x0);
+            out[k] = minimise(&f, x0, dims);
             tick();
         }
         out
     };
-    let fitted: Vec<Vec<([f64; 3], f64)>> = par_map(n, threads, col_fit);
-    let mut res: Vec<([f64; 3], f64)> = (0..n * n).map(|i| fitted[i % n][i / n]).collect();
+    let fitted: Vec<Vec<(Params, f64)>> = par_map(n, threads, col_fit);
+    let mut res: Vec<(Params, f64)> = (0..n * n).map(|i| fitted[i % n][i / n]).collect();
 
     // Refinement: restart each cell from any neighbour's solution that is better there.
     for _pass in 0..2 {
         let snap = res.clone();
-        let refine_col = |j: usize| -> Vec<([f64; 3], f64)> {
+        let refine_col = |j: usize| -> Vec<(Params, f64)> {
             (0..n)
                 .map(|k| {
                     let c = cell(k, j);
-                    let f = |p: &[f64; 3]| c.objective(p, mode, &us);
+                    let f = |p: &Params| c.objective(p, mode, &us);
                     let mut best = snap[k * n + j];
-                    let mut cand: Vec<[f64; 3]> = Vec::new();
+                    let mut cand: Vec<Params> = Vec::new();
                     if j > 0 {
                         cand.push(snap[k * n + j - 1].0);
                     }
@@ -516,7 +511,7 @@ pub fn fit_ggx(cfg: &FitConfig, progress: impl Fn(usize) + Sync) -> FittedTable 
                     }
                     for p in cand {
                         if f(&p) < best.1 {
-                            let r = minimise(&f, p);
+                            let r = minimise(&f, p, dims);
                             if r.1 < best.1 {
                                 best = r;
                             }
@@ -526,7 +521,7 @@ pub fn fit_ggx(cfg: &FitConfig, progress: impl Fn(usize) + Sync) -> FittedTable 
                 })
                 .collect()
         };
-        let refined: Vec<Vec<([f64; 3], f64)>> = par_map(n, threads, refine_col);
+        let refined: Vec<Vec<(Params, f64)>> = par_map(n, threads, refine_col);
         res = (0..n * n).map(|i| refined[i % n][i / n]).collect();
     }
 

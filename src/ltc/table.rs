@@ -157,6 +157,20 @@ pub struct LtcLookup {
 }
 
 impl LtcLookup {
+    fn from_channels(v: &[f64; CHANNELS]) -> Self {
+        let m_inv = DMat3::from_cols(
+            DVec3::new(v[Channel::M00 as usize], 0.0, v[Channel::M20 as usize]),
+            DVec3::Y,
+            DVec3::new(v[Channel::M02 as usize], 0.0, v[Channel::M22 as usize]),
+        );
+        LtcLookup {
+            m_inv,
+            norm: v[Channel::Norm as usize],
+            albedo: v[Channel::Albedo as usize],
+            fresnel: v[Channel::Fresnel as usize],
+        }
+    }
+
     /// The LTC distribution of this lookup (normalised to integrate to one).
     ///
     /// # Errors
@@ -247,6 +261,16 @@ impl LtcTable {
         (j < self.grid.n && k < self.grid.n).then(|| (self.grid.node_cos(j), self.grid.node_alpha(k)))
     }
 
+    /// The values stored at view node `j`, roughness node `k` (see [`LtcTable::node`]), e.g. to
+    /// upload the table as a texture; `None` when an index is out of range.
+    #[must_use]
+    pub fn node_lookup(&self, j: usize, k: usize) -> Option<LtcLookup> {
+        (j < self.grid.n && k < self.grid.n).then(|| {
+            let v: [f64; CHANNELS] = core::array::from_fn(|ch| self.at(ch, k, j));
+            LtcLookup::from_channels(&v)
+        })
+    }
+
     #[cfg_attr(not(feature = "fit"), allow(dead_code))]
     pub(crate) fn grid(&self) -> &Grid {
         &self.grid
@@ -314,17 +338,7 @@ impl LtcTable {
             let b = self.at(ch, k0 + 1, j0) * (1.0 - tx) + self.at(ch, k0 + 1, j0 + 1) * tx;
             *out = a * (1.0 - ty) + b * ty;
         }
-        let m_inv = DMat3::from_cols(
-            DVec3::new(v[Channel::M00 as usize], 0.0, v[Channel::M20 as usize]),
-            DVec3::Y,
-            DVec3::new(v[Channel::M02 as usize], 0.0, v[Channel::M22 as usize]),
-        );
-        Ok(LtcLookup {
-            m_inv,
-            norm: v[Channel::Norm as usize],
-            albedo: v[Channel::Albedo as usize],
-            fresnel: v[Channel::Fresnel as usize],
-        })
+        Ok(LtcLookup::from_channels(&v))
     }
 }
 
