@@ -9,7 +9,9 @@
 
 use std::time::Instant;
 
-use arealight::ltc::fit::{FitConfig, FitMode, FittedTable, fit_ggx, shading_error};
+use arealight::ltc::fit::{
+    FitConfig, FitMode, FittedTable, fit_ggx, quad_shading_errors, shading_error,
+};
 
 const COMMAND: &str = "cargo run --release --features fit --example fit_ltc";
 
@@ -48,6 +50,19 @@ fn evaluate(name: &str, fitted: &FittedTable, count: usize) {
                 .collect();
             println!("  k={k:2} {}", row.join(" "));
         }
+    }
+    match quad_shading_errors(fitted.table(), 300, 256, 7) {
+        Ok(mut q) => {
+            q.sort_by(f64::total_cmp);
+            println!(
+                "{name}: random quads |LTC - brute force| / albedo over {}: median {:.4}% p90 {:.4}% max {:.3}%",
+                q.len(),
+                100.0 * percentile(&q, 0.5),
+                100.0 * percentile(&q, 0.9),
+                100.0 * q[q.len() - 1]
+            );
+        }
+        Err(e) => println!("{name}: quad evaluation failed: {e}"),
     }
     let mut cells: Vec<f64> = fitted.cell_errors().to_vec();
     cells.sort_by(f64::total_cmp);
