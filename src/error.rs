@@ -88,6 +88,32 @@ pub enum GeomError {
     /// The input is geometrically degenerate in a way the operation cannot resolve; the string
     /// says how.
     Degenerate(&'static str),
+    /// [shade] A mesh triangle refers to a vertex index past the end of the vertex list.
+    InvalidIndex {
+        /// Index of the triangle.
+        triangle: usize,
+        /// The offending vertex index.
+        index: usize,
+    },
+    /// [shade] A mesh triangle has (nearly) zero area, so it has no reliable normal.
+    DegenerateTriangle {
+        /// Index of the triangle.
+        triangle: usize,
+    },
+    /// [shade] A mesh that must be closed has an edge not shared by exactly two triangles with
+    /// opposite directions.
+    OpenMesh {
+        /// Index of a triangle at the offending edge.
+        triangle: usize,
+    },
+    /// [shade] A mesh that must be convex has a vertex in front of a face's plane (or faces
+    /// pointing inwards).
+    NotConvex {
+        /// Index of the face (triangle).
+        face: usize,
+        /// Index of the vertex in front of it.
+        vertex: usize,
+    },
 }
 
 impl fmt::Display for GeomError {
@@ -147,6 +173,25 @@ impl fmt::Display for GeomError {
                  holds them all; split the input first",
             ),
             GeomError::Degenerate(why) => write!(f, "degenerate input: {why}"),
+            GeomError::InvalidIndex { triangle, index } => write!(
+                f,
+                "triangle {triangle} refers to vertex {index}, past the end of the vertex list"
+            ),
+            GeomError::DegenerateTriangle { triangle } => write!(
+                f,
+                "triangle {triangle} has (nearly) zero area; remove it or merge its vertices"
+            ),
+            GeomError::OpenMesh { triangle } => write!(
+                f,
+                "triangle {triangle} has an edge not shared by exactly one other triangle running \
+                 the opposite way; a convex polyhedron must be a closed, consistently oriented mesh"
+            ),
+            GeomError::NotConvex { face, vertex } => write!(
+                f,
+                "vertex {vertex} lies in front of the plane of face {face}: the mesh is not convex \
+                 (or a face points inwards); build it with ConvexPolyhedron::hull or use a \
+                 TriangleMesh (per-triangle method)"
+            ),
         }
     }
 }

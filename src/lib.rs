@@ -7,6 +7,7 @@
 //! - [`sphere`]: spherical polygons: solid angle, gnomonic projection, ordering of silhouette edges,
 //!   hemisphere clipping.
 //! - [`ltc`]: linearly transformed cosines and polygon integrals.
+//! - [`shade`]: scenes of lights and occluders, and the radiance at a shading point.
 //!
 //! Scalars are `f64` and vectors are glam's `DVec2`/`DVec3`; glam is re-exported so that callers
 //! name the same version. Invalid input (NaN, infinity, degenerate geometry) is reported as a
@@ -32,6 +33,7 @@ pub mod ltc;
 #[allow(dead_code)] // a shim: each layer uses its own subset of the functions
 pub(crate) mod math;
 pub mod planar;
+pub mod shade;
 pub mod sphere;
 
 pub use error::GeomError;

@@ -1,0 +1,399 @@
+//! Scenes of lights and occluders, and the analytic shading of a point (seed 000 Alg. 1).
+
+use alloc::vec::Vec;
+
+use glam::{DMat3, DVec3};
+use smallvec::SmallVec;
+
+use super::brdf::Material;
+use super::cull::{BoundingSphere, above_horizon, may_occlude};
+use super::mesh::{ConvexPolyhedron, TriangleMesh};
+use super::silhouette::{ShadingFrame, TriangleRole, convex_silhouette, triangle_polygon};
+use crate::GeomError;
+use crate::ltc::{clamped_cosine_integral, lookup};
+use crate::sphere::SphericalPolygon;
+
+/// The geometry of a light or an occluder.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Shape {
+    /// A convex polyhedron: one silhouette polygon per shading point (seed 000 section 3.3).
+    Convex(ConvexPolyhedron),
+    /// Any triangle mesh: one spherical triangle per triangle (seed 000 section 4.4). As a light,
+    /// only front faces emit; as an occluder, every triangle blocks.
+    Mesh(TriangleMesh),
+}
+
+impl Shape {
+    /// The triangle mesh of the shape (the hull triangles of a convex polyhedron).
+    #[must_use]
+    pub fn mesh(&self) -> &TriangleMesh {
+        match self {
+            Shape::Convex(p) => p.mesh(),
+            Shape::Mesh(m) => m,
+        }
+    }
+
+    /// A sphere holding the shape.
+    #[must_use]
+    pub fn bounding_sphere(&self) -> BoundingSphere {
+        let (center, radius) = self.mesh().bounding_sphere();
+        BoundingSphere { center, radius }
+    }
+}
+
+impl From<ConvexPolyhedron> for Shape {
+    fn from(p: ConvexPolyhedron) -> Self {
+        Shape::Convex(p)
+    }
+}
+
+impl From<TriangleMesh> for Shape {
+    fn from(m: TriangleMesh) -> Self {
+        Shape::Mesh(m)
+    }
+}
+
+/// An area light: a shape emitting the uniform RGB radiance `radiance` from its outer surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Light {
+    shape: Shape,
+    radiance: DVec3,
+}
+
+impl Light {
+    /// A light of the given shape and RGB radiance.
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::OutOfRange`] for a negative or non-finite radiance component.
+    pub fn new(shape: impl Into<Shape>, radiance: DVec3) -> Result<Self, GeomError> {
+        for c in radiance.to_array() {
+            if !(c >= 0.0 && c.is_finite()) {
+                return Err(GeomError::OutOfRange {
+                    what: "light radiance (non-negative, finite)",
+                    value: c,
+                    limit: f64::MAX,
+                });
+            }
+        }
+        Ok(Light {
+            shape: shape.into(),
+            radiance,
+        })
+    }
+
+    /// The light's geometry.
+    #[must_use]
+    pub fn shape(&self) -> &Shape {
+        &self.shape
+    }
+
+    /// The emitted RGB radiance.
+    #[must_use]
+    pub fn radiance(&self) -> DVec3 {
+        self.radiance
+    }
+}
+
+/// How convex polyhedra are turned into spherical polygons.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// One silhouette polygon per convex polyhedron (seed 000 Alg. 2); meshes per triangle.
+    #[default]
+    Silhouette,
+    /// Every shape per triangle (seed 000 section 4.4), convex ones included. Slower; it exists
+    /// as a cross-check of the silhouette path and for comparisons.
+    PerTriangle,
+}
+
+/// Lights, occluders and the shading method: everything [`Scene::shade`] needs besides the
+/// shading point and its material.
+///
+/// A `Scene` is immutable after construction and holds no interior mutability, so it is
+/// `Send + Sync`: a renderer shares one `&Scene` among all its threads.
+///
+/// Lights do not block each other; occluders block every light.
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::shade::{Light, Material, Scene, TriangleMesh};
+/// // A 1 x 1 quad light facing down, 2 above a diffuse white floor.
+/// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+/// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![])?;
+/// let white = Material::diffuse(DVec3::ONE)?;
+/// let rgb = scene.shade(DVec3::ZERO, DVec3::Z, DVec3::Z, &white)?;
+/// // Irradiance of a square of side 2a at distance d on the axis, over pi:
+/// // (2 / pi) * 2 (a / sqrt(a^2 + d^2)) atan(a / sqrt(a^2 + d^2)).
+/// let (a, d) = (0.5f64, 2.0f64);
+/// let s = a / (a * a + d * d).sqrt();
+/// let expect = 4.0 / std::f64::consts::PI * s * s.atan();
+/// assert!((rgb.x - expect).abs() < 1e-12);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    lights: Vec<Light>,
+    occluders: Vec<Shape>,
+    light_bounds: Vec<BoundingSphere>,
+    occluder_bounds: Vec<BoundingSphere>,
+    method: Method,
+}
+
+/// Spherical polygons whose clamped-cosine integrals add up: the visible region of one light.
+pub(crate) type Pieces = SmallVec<[SphericalPolygon; 1]>;
+
+impl Scene {
+    /// A scene with the default [`Method::Silhouette`].
+    ///
+    /// # Errors
+    ///
+    /// None today (lights and shapes are validated when built); the `Result` leaves room for
+    /// scene-level checks.
+    pub fn new(lights: Vec<Light>, occluders: Vec<Shape>) -> Result<Self, GeomError> {
+        let light_bounds = lights.iter().map(|l| l.shape.bounding_sphere()).collect();
+        let occluder_bounds = occluders.iter().map(Shape::bounding_sphere).collect();
+        Ok(Scene {
+            lights,
+            occluders,
+            light_bounds,
+            occluder_bounds,
+            method: Method::Silhouette,
+        })
+    }
+
+    /// The same scene evaluated with another [`Method`].
+    #[must_use]
+    pub fn with_method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
+    /// The method in use.
+    #[must_use]
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// The lights.
+    #[must_use]
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// The occluders.
+    #[must_use]
+    pub fn occluders(&self) -> &[Shape] {
+        &self.occluders
+    }
+
+    /// Indices of the occluders that may hide part of light `light` from the frame's point (the
+    /// culling of [`may_occlude`]).
+    pub fn occluders_between(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> impl Iterator<Item = usize> + '_ {
+        let (x, n) = (frame.origin(), frame.normal());
+        let lb = self.light_bounds[light];
+        (0..self.occluders.len()).filter(move |&o| may_occlude(x, n, lb, self.occluder_bounds[o]))
+    }
+
+    /// The outgoing radiance (RGB) at `point` towards `view`, for a surface with normal
+    /// `normal` and material `material`: seed 000 Alg. 1 summed over the lights.
+    ///
+    /// `view` points from the surface towards the viewer; `normal` and `view` need not be
+    /// normalized. For each light the visible region is computed in the shading frame
+    /// ([`Scene::visible_region`]), and integrated with Baum's formula for the diffuse lobe and,
+    /// after the LTC transform `M^-1` looked up for the view angle and roughness, for the GGX lobe
+    /// (HDHN16 eq. 2 / seed 000 eq. 2, Alg. 1 lines 13-16).
+    ///
+    /// # Errors
+    ///
+    /// Invalid point, normal or view ([`ShadingFrame::new`]); a degenerate silhouette (the point
+    /// within rounding distance of a light's or occluder's edge line).
+    pub fn shade(
+        &self,
+        point: DVec3,
+        normal: DVec3,
+        view: DVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        let frame = ShadingFrame::new(point, normal, view)?;
+        let mut total = DVec3::ZERO;
+        let spec = if material.has_specular() {
+            let look = lookup(frame.view().z, material.alpha())?;
+            let f0 = material.f0();
+            let scale = DVec3::new(
+                look.specular_scale(f0.x),
+                look.specular_scale(f0.y),
+                look.specular_scale(f0.z),
+            );
+            Some((look.m_inv, scale))
+        } else {
+            None
+        };
+        for i in 0..self.lights.len() {
+            total += self.shade_light_in(i, &frame, material, spec)?;
+        }
+        Ok(total)
+    }
+
+    /// The contribution of light `light` alone to [`Scene::shade`] (occluders included).
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`]; [`GeomError::OutOfRange`] for a light index past the end.
+    pub fn shade_light(
+        &self,
+        light: usize,
+        point: DVec3,
+        normal: DVec3,
+        view: DVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        if light >= self.lights.len() {
+            return Err(GeomError::OutOfRange {
+                what: "light index",
+                value: light as f64,
+                limit: self.lights.len() as f64,
+            });
+        }
+        let frame = ShadingFrame::new(point, normal, view)?;
+        let spec = if material.has_specular() {
+            let look = lookup(frame.view().z, material.alpha())?;
+            let f0 = material.f0();
+            let scale = DVec3::new(
+                look.specular_scale(f0.x),
+                look.specular_scale(f0.y),
+                look.specular_scale(f0.z),
+            );
+            Some((look.m_inv, scale))
+        } else {
+            None
+        };
+        self.shade_light_in(light, &frame, material, spec)
+    }
+
+    fn shade_light_in(
+        &self,
+        i: usize,
+        frame: &ShadingFrame,
+        material: &Material,
+        spec: Option<(DMat3, DVec3)>,
+    ) -> Result<DVec3, GeomError> {
+        let light = &self.lights[i];
+        if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[i]) {
+            return Ok(DVec3::ZERO);
+        }
+        let pieces = self.visible_region(i, frame)?;
+        let mut diffuse = 0.0;
+        let mut specular = 0.0;
+        for p in &pieces {
+            diffuse += clamped_cosine_integral(p);
+            if let Some((m_inv, _)) = spec {
+                specular += clamped_cosine_integral(&transform(p, m_inv));
+            }
+        }
+        let mut out = material.albedo() * diffuse;
+        if let Some((_, scale)) = spec {
+            out += scale * specular;
+        }
+        Ok(out * light.radiance)
+    }
+
+    /// The part of light `light` visible from the frame's point, in the shading frame, clipped to
+    /// the upper hemisphere: pieces whose clamped-cosine integrals add up.
+    ///
+    /// Today this is the light's own region ([`Scene::light_region`]) with occlusion still to be
+    /// wired: see [`Scene::subtract_occluders`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`].
+    pub fn visible_region(&self, light: usize, frame: &ShadingFrame) -> Result<Pieces, GeomError> {
+        let region = self.light_region(light, frame)?;
+        self.subtract_occluders(light, frame, region)
+    }
+
+    /// The region covered by light `light` seen from the frame's point, clipped to the upper
+    /// hemisphere (seed 000 Alg. 1 lines 4-5): the silhouette of a convex light, or the front
+    /// faces of a mesh light.
+    ///
+    /// For a mesh light the front-facing triangles are returned as separate pieces; their
+    /// integrals add up exactly when their projections do not overlap (closed convex meshes,
+    /// planar lights). A non-convex light whose front faces overlap in projection needs their
+    /// union, which is the spherical boolean's job (not wired yet, see the module docs).
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`].
+    pub fn light_region(&self, light: usize, frame: &ShadingFrame) -> Result<Pieces, GeomError> {
+        let mut pieces = Pieces::new();
+        let up = DVec3::Z;
+        match (&self.lights[light].shape, self.method) {
+            (Shape::Convex(p), Method::Silhouette) => {
+                let s = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+                if !s.is_empty() {
+                    pieces.push(s);
+                }
+            }
+            (shape, _) => {
+                let mesh = shape.mesh();
+                for t in 0..mesh.triangle_count() {
+                    if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Emitter)? {
+                        let p = p.clip_to_hemisphere(up);
+                        if !p.is_empty() {
+                            pieces.push(p);
+                        }
+                    }
+                }
+            }
+        }
+        Ok(pieces)
+    }
+
+    /// The occlusion step of seed 000 Alg. 1 (lines 7-12): subtracts from the light's region the
+    /// regions of the occluders that may lie between the point and the light.
+    ///
+    /// NOT WIRED YET: this needs the spherical set difference `SphericalPolygon::boolean`, which
+    /// is being implemented in the `sphere` layer. Until it lands, the region is returned
+    /// unchanged, i.e. the analytic path shades without shadows. It is kept as this one separate
+    /// function so that the wiring is a local change.
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`].
+    pub fn subtract_occluders(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        region: Pieces,
+    ) -> Result<Pieces, GeomError> {
+        let _ = (light, frame);
+        Ok(region)
+    }
+}
+
+/// The polygon mapped by the linear transform `m` (directions `w -> m w / |m w|`), e.g. the LTC
+/// inverse matrix (HDHN16 eq. 4). Great circles map to great circles and an invertible map
+/// keeps rings simple and disjoint; a map with negative determinant mirrors, so the rings are
+/// reversed to keep the interior on the left.
+pub(crate) fn transform(p: &SphericalPolygon, m: DMat3) -> SphericalPolygon {
+    if p.is_full() || p.is_empty() {
+        return p.clone();
+    }
+    let flip = m.determinant() < 0.0;
+    let mut verts = SmallVec::<[DVec3; 12]>::new();
+    let mut ends = SmallVec::<[u32; 2]>::new();
+    for ring in p.rings() {
+        let start = verts.len();
+        verts.extend(ring.iter().map(|&w| (m * w).normalize()));
+        if flip {
+            verts[start..].reverse();
+        }
+        ends.push(verts.len() as u32);
+    }
+    SphericalPolygon::from_parts(verts, ends)
+}

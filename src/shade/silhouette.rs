@@ -1,0 +1,242 @@
+//! Spherical polygons of lights and occluders seen from a shading point: silhouettes of convex
+//! polyhedra (seed 000 Alg. 2, section 3.3; thesis 003 section 4.2) and single triangles (the
+//! per-triangle method, seed 000 section 4.4).
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use glam::{DMat3, DVec3};
+
+use super::mesh::{ConvexPolyhedron, FACE_TOLERANCE, TriangleMesh};
+use crate::GeomError;
+use crate::sphere::{SphericalPolygon, order_directed_edges};
+
+/// The local shading frame of a point (DESIGN.md): the normal on `+z`, the view direction in the
+/// xz-plane with `x >= 0`, right-handed; directions are taken from the shading point.
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::shade::ShadingFrame;
+/// let f = ShadingFrame::new(DVec3::ZERO, DVec3::Y, DVec3::new(0.0, 1.0, 1.0))?;
+/// assert!((f.to_local(DVec3::new(0.0, 2.0, 0.0)) - DVec3::new(0.0, 0.0, 2.0)).length() < 1e-15);
+/// let v = f.view();
+/// assert!(v.y.abs() < 1e-15 && v.x > 0.0 && (v.z - v.x).abs() < 1e-15);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadingFrame {
+    origin: DVec3,
+    /// Rows are the tangent, bitangent and normal: `to_local(p) = rot * (p - origin)`.
+    rot: DMat3,
+    view: DVec3,
+}
+
+impl ShadingFrame {
+    /// The frame at `point` with surface normal `normal` and direction to the viewer `view`
+    /// (neither needs to be normalized). A view along the normal picks an arbitrary tangent; a
+    /// view below the surface is allowed (the LTC lookup treats it as grazing).
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::NonFinite`] (`vertex` 0, 1, 2 for point, normal, view) or
+    /// [`GeomError::ZeroVector`] (`vertex` 1 or 2) for an unusable input.
+    pub fn new(point: DVec3, normal: DVec3, view: DVec3) -> Result<Self, GeomError> {
+        for (i, v) in [point, normal, view].into_iter().enumerate() {
+            if !v.is_finite() {
+                return Err(GeomError::NonFinite { ring: 0, vertex: i });
+            }
+        }
+        let n = normal
+            .try_normalize()
+            .ok_or(GeomError::ZeroVector { ring: 0, vertex: 1 })?;
+        let v = view
+            .try_normalize()
+            .ok_or(GeomError::ZeroVector { ring: 0, vertex: 2 })?;
+        // Tangent: the view's component in the surface plane; any tangent for a view along n.
+        let t = (v - n * v.dot(n))
+            .try_normalize()
+            .filter(|t| (v - n * v.dot(n)).length() > 1e-12 && t.is_finite())
+            .unwrap_or_else(|| n.any_orthonormal_vector());
+        let b = n.cross(t);
+        let rot = DMat3::from_cols(t, b, n).transpose();
+        let local_v = rot * v;
+        // Exactly in the xz-plane, x >= 0, as the LTC tables assume.
+        let view = DVec3::new(local_v.x.max(0.0), 0.0, local_v.z).normalize();
+        Ok(ShadingFrame {
+            origin: point,
+            rot,
+            view,
+        })
+    }
+
+    /// The shading point.
+    #[must_use]
+    pub fn origin(&self) -> DVec3 {
+        self.origin
+    }
+
+    /// The vector from the shading point to the world point `p`, in the local frame.
+    #[must_use]
+    pub fn to_local(&self, p: DVec3) -> DVec3 {
+        self.rot * (p - self.origin)
+    }
+
+    /// A world direction in the local frame.
+    #[must_use]
+    pub fn dir_to_local(&self, d: DVec3) -> DVec3 {
+        self.rot * d
+    }
+
+    /// A local direction in world coordinates.
+    #[must_use]
+    pub fn dir_to_world(&self, d: DVec3) -> DVec3 {
+        self.rot.transpose() * d
+    }
+
+    /// The unit view direction in the local frame (`y = 0`, `x >= 0`).
+    #[must_use]
+    pub fn view(&self) -> DVec3 {
+        self.view
+    }
+
+    /// The world-space surface normal.
+    #[must_use]
+    pub fn normal(&self) -> DVec3 {
+        self.rot.row(2)
+    }
+}
+
+/// The region a convex polyhedron covers, seen from the frame's origin, in the local frame.
+///
+/// Contour edges are the edges between a front-facing and a non-front-facing face (thesis 003
+/// eq. 4.1/4.2); for a convex polyhedron every contour edge is a silhouette edge (003 section 4.2).
+/// Each is oriented by its front face: a front face runs counter-clockwise seen from the point,
+/// which puts its interior on the right on the unit sphere (seen from outside the sphere), so the
+/// edge is taken in the reverse of its counter-clockwise direction around the front face. The
+/// directed edges are then chained with [`order_directed_edges`], which replaces the planar
+/// nearest-endpoint search of seed 000 Alg. 2 by exact merging on the sphere.
+///
+/// A face whose plane passes within [`FACE_TOLERANCE`] of the point is seen edge-on and counts as
+/// back-facing. A point inside the polyhedron (behind every face) sees the full sphere; a point on
+/// its surface (no face strictly in front) sees no front face, and gets the empty polygon: the
+/// polyhedron then lies in the closed half-space behind the face the point is on.
+///
+/// # Errors
+///
+/// Those of [`order_directed_edges`] when the projected silhouette is degenerate (the point
+/// within rounding distance of an edge's line).
+pub fn convex_silhouette(
+    poly: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+) -> Result<SphericalPolygon, GeomError> {
+    let mut s = Vec::new();
+    let tol = poly.facing(frame.origin(), &mut s);
+    if !s.iter().any(|&d| d > tol) {
+        return Ok(if s.iter().all(|&d| d < -tol) {
+            SphericalPolygon::full()
+        } else {
+            SphericalPolygon::empty()
+        });
+    }
+    let verts = poly.vertices();
+    let local: Vec<DVec3> = verts.iter().map(|&p| frame.to_local(p)).collect();
+    let mut edges = Vec::with_capacity(2 * (poly.edges().len() as f64).sqrt() as usize + 8);
+    for e in poly.edges() {
+        let front0 = s[e.f0 as usize] > tol;
+        let front1 = s[e.f1 as usize] > tol;
+        let (a, b) = (local[e.a as usize], local[e.b as usize]);
+        match (front0, front1) {
+            (true, false) => edges.push((b, a)),
+            (false, true) => edges.push((a, b)),
+            _ => {}
+        }
+    }
+    order_directed_edges(&edges)
+}
+
+/// How a triangle of a mesh enters the per-triangle method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TriangleRole {
+    /// Part of a light: only its front face emits, so a back-facing triangle covers nothing.
+    Emitter,
+    /// Part of an occluder: it blocks light from either side.
+    Blocker,
+}
+
+/// The spherical triangle that mesh triangle `i` covers, seen from the frame's origin, in the
+/// local frame; `None` when it covers nothing (seen edge-on within [`FACE_TOLERANCE`], or from
+/// behind for an [`TriangleRole::Emitter`]).
+///
+/// # Errors
+///
+/// Those of [`SphericalPolygon::new`] for a projection that rounding made degenerate.
+pub fn triangle_polygon(
+    mesh: &TriangleMesh,
+    i: usize,
+    frame: &ShadingFrame,
+    role: TriangleRole,
+) -> Result<Option<SphericalPolygon>, GeomError> {
+    let [a, b, c] = mesh.triangle(i);
+    let n = mesh.triangle_normal(i);
+    let x = frame.origin();
+    // Relative to the triangle's centroid, so the rounding of s scales with the distance to it.
+    let m = (a + b + c) / 3.0;
+    let s = n.dot(x - m);
+    let size = (a - m).length().max((b - m).length()).max((c - m).length());
+    let tol = FACE_TOLERANCE * ((x - m).length() + size);
+    let (a, b, c) = (frame.to_local(a), frame.to_local(b), frame.to_local(c));
+    // A front-facing triangle runs counter-clockwise seen from x: clockwise on the sphere seen
+    // from outside, so its covered region is the reversed ring (see `convex_silhouette`).
+    if s > tol {
+        SphericalPolygon::new(vec![vec![a, c, b]]).map(Some)
+    } else if s < -tol && role == TriangleRole::Blocker {
+        SphericalPolygon::new(vec![vec![a, b, c]]).map(Some)
+    } else {
+        Ok(None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::PI;
+
+    #[test]
+    fn cube_face_on_subtends_its_solid_angle() {
+        // Unit cube centered 2 above the origin: seen from below, only the bottom face, a square
+        // of side 1 at distance 1.5. Solid angle of a square (side 2a) at distance d:
+        // 4 asin(a^2 / (a^2 + d^2)).
+        let cube = ConvexPolyhedron::cuboid(DVec3::new(0.0, 0.0, 2.0), DVec3::splat(0.5)).unwrap();
+        let f = ShadingFrame::new(DVec3::ZERO, DVec3::Z, DVec3::Z).unwrap();
+        let p = convex_silhouette(&cube, &f).unwrap();
+        let (a, d) = (0.5f64, 1.5f64);
+        let expect = 4.0 * (a * a / (a * a + d * d)).asin();
+        assert!(
+            (p.solid_angle() - expect).abs() < 1e-12,
+            "{}",
+            p.solid_angle()
+        );
+        assert!(p.contains(DVec3::Z));
+        // Inside: full sphere.
+        let fi = ShadingFrame::new(DVec3::new(0.0, 0.0, 2.0), DVec3::Z, DVec3::Z).unwrap();
+        assert!(convex_silhouette(&cube, &fi).unwrap().is_full());
+        // In the plane of the bottom face (a cube standing on the ground), off to the side.
+        let fg = ShadingFrame::new(DVec3::new(2.0, 0.0, 1.5), DVec3::Z, DVec3::Z).unwrap();
+        let pg = convex_silhouette(&cube, &fg).unwrap();
+        assert!(pg.solid_angle() > 0.0 && pg.solid_angle() < 2.0 * PI);
+    }
+
+    #[test]
+    fn per_triangle_sum_equals_silhouette_for_convex() {
+        let ico = ConvexPolyhedron::icosphere(DVec3::new(0.3, -0.2, 3.0), 1.0, 1).unwrap();
+        let f = ShadingFrame::new(DVec3::new(0.1, 0.2, 0.0), DVec3::Z, DVec3::X).unwrap();
+        let sil = convex_silhouette(&ico, &f).unwrap().solid_angle();
+        let sum: f64 = (0..ico.mesh().triangle_count())
+            .filter_map(|i| triangle_polygon(ico.mesh(), i, &f, TriangleRole::Emitter).unwrap())
+            .map(|p| p.solid_angle())
+            .sum();
+        assert!((sil - sum).abs() < 1e-12, "{sil} {sum}");
+    }
+}
