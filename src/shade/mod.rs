@@ -7,6 +7,7 @@
 //!   silhouette, oriented by front faces) and of single triangles, in the [`ShadingFrame`].
 //! - [`cull`]: discarding occluders that cannot lie between the point and a light (`GetBetween`).
 //! - [`brdf`]: [`Material`] (Lambert + GGX with Schlick's Fresnel).
+//! - [`demo`]: the test scene of seed 000 (Fig. 4), shared by the render example, tests and benches.
 //! - [`scene`]: [`Scene::shade`], the analytic radiance at a shading point.
 //! - [`reference`]: a Monte Carlo estimator of the same radiance (solid-angle sampling of the
 //!   lights' triangles, exact ray-triangle visibility), with its standard error, for tests and
@@ -29,6 +30,7 @@
 
 pub mod brdf;
 pub mod cull;
+pub mod demo;
 pub mod mesh;
 pub mod reference;
 pub mod scene;
@@ -36,6 +38,7 @@ pub mod silhouette;
 
 pub use brdf::Material;
 pub use cull::{BoundingSphere, may_occlude};
+pub use demo::{Demo, DemoConfig, demo_scene};
 pub use mesh::{ConvexPolyhedron, TriangleMesh};
 pub use reference::{Estimate, MonteCarlo, Pcg32, ReferenceBrdf};
 pub use scene::{Light, Method, Scene, Shape};
