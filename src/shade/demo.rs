@@ -53,29 +53,30 @@ pub struct Demo {
 ///
 /// Never for the built-in geometry; the `Result` carries the constructors' checks.
 pub fn demo_scene(cfg: DemoConfig) -> Result<Demo, GeomError> {
+    // A 1.2 x 1.2 quad facing down (tilted 15 degrees towards +x), high on the left.
     let quad = TriangleMesh::quad(
-        DVec3::new(-1.6, -0.2, 2.6),
-        DVec3::new(0.0, 0.6, 0.15),
-        DVec3::new(0.6, 0.0, 0.0),
+        DVec3::new(-1.5, 0.4, 3.0),
+        DVec3::new(0.0, 0.6, 0.0),
+        DVec3::new(0.58, 0.0, 0.155),
     )?;
     let cylinder = ConvexPolyhedron::frustum(
-        DVec3::new(1.6, 1.2, 2.0),
-        DVec3::new(0.2, -0.1, 0.9),
+        DVec3::new(1.9, 1.6, 2.2),
+        DVec3::new(0.15, -0.1, 0.9),
         0.25,
         0.25,
         10,
     )?;
     let cone = ConvexPolyhedron::frustum(
-        DVec3::new(1.2, -1.8, 1.9),
-        DVec3::new(-0.3, 0.0, 0.7),
-        0.4,
+        DVec3::new(0.6, -0.9, 2.5),
+        DVec3::new(-0.2, 0.1, 0.6),
+        0.35,
         0.15,
         10,
     )?;
     let all_lights = vec![
-        Light::new(quad, DVec3::new(5.0, 4.4, 3.6))?,
-        Light::new(cylinder, DVec3::new(2.0, 3.0, 6.0))?,
-        Light::new(cone, DVec3::new(2.5, 5.0, 2.5))?,
+        Light::new(quad, DVec3::new(4.0, 3.5, 2.8))?,
+        Light::new(cylinder, DVec3::new(1.5, 2.2, 4.5))?,
+        Light::new(cone, DVec3::new(1.8, 3.6, 1.8))?,
     ];
     let cube = ConvexPolyhedron::cuboid(DVec3::new(-0.7, 0.5, 0.45), DVec3::splat(0.45))?;
     let ico = ConvexPolyhedron::icosphere(DVec3::new(0.7, -0.5, 0.75), 0.45, 1)?;
