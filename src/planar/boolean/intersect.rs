@@ -76,6 +76,49 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     ))
 }
 
+/// Inserts into each contour the vertices of the operand's *other* contours that lie exactly on
+/// its edges.
+///
+/// Contours of one shape may touch at isolated points, e.g. a hole's vertex on the outer
+/// contour's edge. Without this step, an edge of the other operand overlapping that outer edge
+/// would be split at the touching point while the outer edge is not, and the shared stretch would
+/// not be recognized as shared. The inserted points are existing vertices and lie exactly on the
+/// edge (`orient2d == 0`), so nothing bends.
+pub(crate) fn split_self_contacts(r: &mut Rings) {
+    if r.ends.len() < 2 {
+        return;
+    }
+    let nxt = r.next_table();
+    let mut ins = Inserts::new();
+    let mut start = 0usize;
+    for &end in &r.ends {
+        let end = end as usize;
+        for i in start..end {
+            let (p0, p1) = (r.pts[i], r.pts[nxt[i] as usize]);
+            for (k, &q) in r.pts.iter().enumerate() {
+                if (start..end).contains(&k) {
+                    continue;
+                }
+                if q.x < p0.x.min(p1.x)
+                    || q.x > p0.x.max(p1.x)
+                    || q.y < p0.y.min(p1.y)
+                    || q.y > p0.y.max(p1.y)
+                {
+                    continue;
+                }
+                if orient(p0, p1, q) == 0.0 && strictly_between(p0, p1, q) {
+                    push(&mut ins, i as u32, p0, p1, q, false);
+                }
+            }
+        }
+        start = end;
+    }
+    if !ins.is_empty() {
+        let mut dirty = SmallVec::new();
+        apply(r, &mut ins, &mut dirty);
+    }
+}
+
 /// One pass over all edge pairs in which at least one edge is new.
 fn find(
     a: &Rings,

@@ -119,20 +119,47 @@ fn winding(r: &Rings, nxt: &[u32], p: DVec2) -> i32 {
     w
 }
 
-/// Whether the direction from `v` towards `x` enters the interior of the other operand in its
-/// corner `prev -> v -> next` (interior on the left). FHP 2019, Table 1: convex corner, left of
-/// both edges; reflex corner, left of either.
-fn in_wedge(prev: DVec2, v: DVec2, next: DVec2, x: DVec2) -> bool {
-    let l1 = orient(prev, v, x) > 0.0;
-    let l2 = orient(v, next, x) > 0.0;
-    let c = orient(prev, v, next);
-    if c > 0.0 {
-        l1 && l2
-    } else if c < 0.0 {
-        l1 || l2
+/// Rank of the counter-clockwise angle from direction `v -> x` to ray `v -> r`: the ray sits in
+/// the open left half-plane (0), straight opposite (1), the open right half-plane (2), or along
+/// `v -> x` itself (3, last).
+fn ccw_class(v: DVec2, x: DVec2, r: DVec2) -> u8 {
+    let o = orient(v, x, r);
+    if o > 0.0 {
+        0
+    } else if o < 0.0 {
+        2
     } else {
-        l2
+        let d = x - v;
+        let same = if d.x.abs() >= d.y.abs() {
+            (x.x > v.x) == (r.x > v.x)
+        } else {
+            (x.y > v.y) == (r.y > v.y)
+        };
+        if same { 3 } else { 1 }
     }
+}
+
+/// Whether the direction from `v` towards `x` enters the interior of the other operand, given
+/// every edge of the other operand incident to `v` as a ray `(far end, is_incoming)`.
+///
+/// This is the local neighbourhood test of FHP 2019 (section 3.1, Table 1), generalized to
+/// several contours meeting at `v` (a hole touching its outer contour, two faces meeting at a
+/// corner): turning counter-clockwise from `v -> x`, the first boundary ray met is an incoming
+/// edge exactly when `v -> x` lies on its left, i.e. in the interior. Decided with exact
+/// `orient2d` only.
+fn inside_at(v: DVec2, x: DVec2, rays: &[(DVec2, bool)]) -> bool {
+    let mut best: Option<(DVec2, bool)> = None;
+    for &(r, incoming) in rays {
+        best = match best {
+            None => Some((r, incoming)),
+            Some((b, bin)) => {
+                let (cr, cb) = (ccw_class(v, x, r), ccw_class(v, x, b));
+                let earlier = cr < cb || (cr == cb && orient(v, r, b) > 0.0);
+                if earlier { Some((r, incoming)) } else { Some((b, bin)) }
+            }
+        };
+    }
+    best.is_some_and(|(_, incoming)| incoming)
 }
 
 /// Labels every split edge of `r` (edge `i` runs from vertex `i` to `r_nxt[i]`) against `o`.
@@ -168,17 +195,16 @@ pub(crate) fn label(
             } else if o_twins.of(o, w).is_empty() {
                 winding(o, o_nxt, w) != 0
             } else {
-                // Both ends on the other boundary: the corner(s) at `u` decide. Several twins
-                // mean the other operand's contours touch at `u`; their corners are disjoint.
-                tu.iter().any(|&k| {
-                    let k = k as usize;
-                    in_wedge(
-                        o.pts[o_prv[k] as usize],
-                        u,
-                        o.pts[o_nxt[k] as usize],
-                        w,
-                    )
-                })
+                // Both ends on the other boundary: the other operand's edges around `u` decide
+                // (several twins when its contours touch at `u`).
+                let rays: SmallVec<[(DVec2, bool); 8]> = tu
+                    .iter()
+                    .flat_map(|&k| {
+                        let k = k as usize;
+                        [(o.pts[o_nxt[k] as usize], false), (o.pts[o_prv[k] as usize], true)]
+                    })
+                    .collect();
+                inside_at(u, w, &rays)
             };
             if inside {
                 Status::Inside

@@ -166,6 +166,8 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
         });
     }
     let scale = ra.scale().max(rb.scale());
+    intersect::split_self_contacts(&mut ra);
+    intersect::split_self_contacts(&mut rb);
     intersect::split(&mut ra, &mut rb, scale)?;
 
     let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
