@@ -82,7 +82,8 @@ impl Shape {
                     });
                 }
             }
-            let cleaned = clean_ring(ring);
+            // Canonical zero: -0.0 and 0.0 compare equal but order differently bitwise.
+            let cleaned = clean_ring(ring.into_iter().map(|p| p + DVec2::ZERO).collect());
             if cleaned.len() < 3 {
                 return Err(GeomError::TooFewVertices {
                     ring: ri,

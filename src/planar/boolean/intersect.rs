@@ -26,6 +26,7 @@ use smallvec::SmallVec;
 
 use super::{Rings, Split};
 use crate::GeomError;
+use crate::math::sqrt;
 use crate::planar::predicates::{orient, strictly_between};
 
 /// Snapping distance for computed crossings, relative to the largest coordinate magnitude of the
@@ -148,55 +149,66 @@ fn find(
             {
                 continue;
             }
-            pair(p0, p1, i as u32, q0, q1, j as u32, snap2, ins_a, ins_b);
+            pair(
+                [p0, p1, q0, q1],
+                (i as u32, j as u32),
+                (&a.pts, &b.pts),
+                snap2,
+                ins_a,
+                ins_b,
+            );
         }
     }
 }
 
 /// Classifies one edge pair and records the points to insert.
-#[allow(clippy::too_many_arguments)]
 fn pair(
-    p0: DVec2,
-    p1: DVec2,
-    i: u32,
-    q0: DVec2,
-    q1: DVec2,
-    j: u32,
+    [p0, p1, q0, q1]: [DVec2; 4],
+    (i, j): (u32, u32),
+    (all_a, all_b): (&[DVec2], &[DVec2]),
     snap2: f64,
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
+    // A vertex within the snapping distance of the other edge's line counts as on it: it is
+    // inserted into that edge (bending it by at most the tolerance), exactly as FHP's
+    // vertex-on-edge case. Without this, a vertex a few ulps off an edge survives as a
+    // near-touch that the next operation in a chain sees as either a crossing or a gap.
+    let snap = sqrt(snap2);
+    let near = |o: f64, len: f64| o == 0.0 || o.abs() <= snap * len;
+    let lp = sqrt((p1 - p0).length_squared());
     let oq0 = orient(p0, p1, q0);
     let oq1 = orient(p0, p1, q1);
-    if (oq0 > 0.0 && oq1 > 0.0) || (oq0 < 0.0 && oq1 < 0.0) {
+    let (zq0, zq1) = (near(oq0, lp), near(oq1, lp));
+    if !zq0 && !zq1 && ((oq0 > 0.0 && oq1 > 0.0) || (oq0 < 0.0 && oq1 < 0.0)) {
         return;
     }
+    let lq = sqrt((q1 - q0).length_squared());
     let op0 = orient(q0, q1, p0);
     let op1 = orient(q0, q1, p1);
-    if (op0 > 0.0 && op1 > 0.0) || (op0 < 0.0 && op1 < 0.0) {
+    let (zp0, zp1) = (near(op0, lq), near(op1, lq));
+    if !zp0 && !zp1 && ((op0 > 0.0 && op1 > 0.0) || (op0 < 0.0 && op1 < 0.0)) {
         return;
     }
-    // Vertex on edge (and, when all four are zero, the ends of a collinear overlap). Exact: the
-    // vertex is copied bit for bit.
-    if oq0 == 0.0 && strictly_between(p0, p1, q0) {
-        push(ins_a, i, p0, p1, q0, false);
+    // Vertex on edge (and, when all four are zero, the ends of a collinear overlap). Exactly on:
+    // the vertex is copied bit for bit and nothing bends. Within the tolerance: the edge bends.
+    for (z, o, v) in [(zq0, oq0, q0), (zq1, oq1, q1)] {
+        if z && (o != 0.0 || strictly_between(p0, p1, v)) {
+            push(ins_a, i, p0, p1, v, o != 0.0);
+        }
     }
-    if oq1 == 0.0 && strictly_between(p0, p1, q1) {
-        push(ins_a, i, p0, p1, q1, false);
+    for (z, o, v) in [(zp0, op0, p0), (zp1, op1, p1)] {
+        if z && (o != 0.0 || strictly_between(q0, q1, v)) {
+            push(ins_b, j, q0, q1, v, o != 0.0);
+        }
     }
-    if op0 == 0.0 && strictly_between(q0, q1, p0) {
-        push(ins_b, j, q0, q1, p0, false);
-    }
-    if op1 == 0.0 && strictly_between(q0, q1, p1) {
-        push(ins_b, j, q0, q1, p1, false);
-    }
-    if oq0 == 0.0 || oq1 == 0.0 || op0 == 0.0 || op1 == 0.0 {
+    if zq0 || zq1 || zp0 || zp1 {
         return;
     }
     // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa. The signed
     // distances of p0 and p1 from line q give the parameter along p.
     let t = op0 / (op0 - op1);
-    let x = p0 + (p1 - p0) * t;
+    let x = p0 + (p1 - p0) * t + DVec2::ZERO;
     for (v, own_a) in [(p0, true), (p1, true), (q0, false), (q1, false)] {
         if (x - v).length_squared() <= snap2 {
             // Snap to an existing vertex: insert it into the other operand's edge only.
@@ -208,6 +220,17 @@ fn pair(
             return;
         }
     }
+    // Snap to any other vertex of either operand within the tolerance: a crossing a few ulps
+    // from a vertex elsewhere on the boundary (a point where the operand touches itself, or a
+    // vertex of the other operand lying on this edge) must become that vertex, or the boundary
+    // would carry two distinct points a few ulps apart and the split edges between them could
+    // double back.
+    let x = all_a
+        .iter()
+        .chain(all_b.iter())
+        .copied()
+        .find(|&v| (x - v).length_squared() <= snap2)
+        .unwrap_or(x);
     push(ins_a, i, p0, p1, x, true);
     push(ins_b, j, q0, q1, x, true);
 }
@@ -215,7 +238,11 @@ fn pair(
 fn push(ins: &mut Inserts, edge: u32, e0: DVec2, e1: DVec2, p: DVec2, bent: bool) {
     let d = e1 - e0;
     let t = (p - e0).dot(d) / d.length_squared();
-    ins.push(Insert { edge, t, p, bent });
+    // A point that projects outside the edge is a snapped vertex a few ulps beyond an endpoint;
+    // inserting it would make the edge double back, so it is left out (the endpoint stands in).
+    if t > 0.0 && t < 1.0 && p != e0 && p != e1 {
+        ins.push(Insert { edge, t, p, bent });
+    }
 }
 
 /// Rebuilds the rings with the inserted points, marking edges next to bent points as dirty.

@@ -55,7 +55,9 @@ impl Rings {
         let mut pts = Split::new();
         let mut ends = SmallVec::new();
         for c in &s.contours {
-            pts.extend_from_slice(&c.pts);
+            // `+ 0.0` turns -0.0 into 0.0, so that bitwise-ordered lookups (which distinguish
+            // the two zeros) agree with `==` (which does not).
+            pts.extend(c.pts.iter().map(|&p| p + DVec2::ZERO));
             ends.push(pts.len() as u32);
         }
         Rings { pts, ends }
@@ -203,4 +205,32 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
     let (alo, ahi) = bbox(a);
     let (blo, bhi) = bbox(b);
     ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
+}
+
+#[cfg(test)]
+mod debug_tests {
+    extern crate std;
+    use super::*;
+    use std::println;
+    use alloc::vec;
+
+    #[test]
+    fn dbg_case() {
+        let a = Shape::new(vec![vec![DVec2::new(-1.0, 2.0), DVec2::new(-1.368421052631579, 0.1578947368421053), DVec2::new(0.0, -1.6666666666666667), DVec2::new(4.0, 1.0), DVec2::new(1.8125, 1.4375), DVec2::new(1.0, -1.0), DVec2::new(0.0, 1.0), DVec2::new(1.1428571428571432, 1.5714285714285714)], vec![DVec2::new(-1.608695652173913, -1.0434782608695654), DVec2::new(-2.0, -3.0), DVec2::new(-0.4117647058823528, -1.9411764705882353)]]).unwrap();
+        let b = Shape::new(vec![vec![DVec2::new(2.0, -2.0), DVec2::new(0.0, 2.0), DVec2::new(-1.0, 1.0)]]).unwrap();
+        let mut ra = Rings::from_shape(&a);
+        let mut rb = Rings::from_shape(&b);
+        let scale = ra.scale().max(rb.scale());
+        intersect::split(&mut ra, &mut rb, scale).unwrap();
+        let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
+        let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
+        let a_twins = label::Twins::new(&ra);
+        let b_twins = label::Twins::new(&rb);
+        let mut sa = SmallVec::new();
+        let mut sb = SmallVec::new();
+        label::label(&ra, &a_nxt, &rb, &b_nxt, &b_prv, &b_twins, &mut sa);
+        label::label(&rb, &b_nxt, &ra, &a_nxt, &a_prv, &a_twins, &mut sb);
+        for i in 0..ra.pts.len() { println!("A {i} {:?} -> {:?} {:?}", ra.pts[i], ra.pts[a_nxt[i] as usize], sa[i]); }
+        for i in 0..rb.pts.len() { println!("B {i} {:?} -> {:?} {:?}", rb.pts[i], rb.pts[b_nxt[i] as usize], sb[i]); }
+    }
 }
