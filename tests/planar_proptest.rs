@@ -17,9 +17,13 @@ const REF_TOL: f64 = 1e-7;
 /// Relative tolerance for identities among our own results.
 const ID_TOL: f64 = 1e-9;
 
+/// 256 cases per property; `PLANAR_CASES=N` raises it for a longer hunt.
 fn config() -> ProptestConfig {
     ProptestConfig {
-        cases: 256,
+        cases: std::env::var("PLANAR_CASES")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(256),
         ..ProptestConfig::default()
     }
 }

@@ -49,3 +49,12 @@ fn chain_grid_triangles_2() {
         &["-2:1, -3:-0, 1:-3", "2:2, 0:1, 1:-1", "2:-1, 0:3, -1:2"],
     );
 }
+
+/// proptest `chains_compose`: result boundary did not close.
+#[test]
+fn chain_grid_triangles_3() {
+    chain(
+        "2:0, 3:1, 3:2, 2:2, -1:3",
+        &["1:-1, -3:4, -3:-1", "2:3, -3:3, 0:1", "-3:2, -1:1, -1:4"],
+    );
+}

@@ -77,6 +77,55 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     ))
 }
 
+/// Makes vertices of `b` that lie within the snapping distance of a vertex of `a` identical to it
+/// (FHP's vertex-on-vertex case, made robust). Two distinct points a few ulps apart would
+/// otherwise each be inserted into the other operand's edges and produce spikes between them.
+/// Consecutive points that become equal are merged; a ring left with fewer than three points is
+/// dropped (it was a sliver thinner than the tolerance).
+pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
+    let snap = SNAP_REL * scale;
+    let snap2 = snap * snap;
+    let mut changed = false;
+    for q in b.pts.iter_mut() {
+        if let Some(&p) = a
+            .pts
+            .iter()
+            .find(|&&p| p != *q && (p - *q).length_squared() <= snap2)
+        {
+            *q = p;
+            changed = true;
+        }
+    }
+    if !changed {
+        return;
+    }
+    let mut pts: Split = SmallVec::with_capacity(b.pts.len());
+    let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
+    let mut start = 0usize;
+    for &end in &b.ends {
+        let end = end as usize;
+        let ring_start = pts.len();
+        for k in start..end {
+            let p = b.pts[k];
+            if pts.len() > ring_start && pts.last() == Some(&p) {
+                continue;
+            }
+            pts.push(p);
+        }
+        while pts.len() > ring_start + 1 && pts.last() == pts.get(ring_start) {
+            pts.pop();
+        }
+        if pts.len() - ring_start < 3 {
+            pts.truncate(ring_start);
+        } else {
+            ends.push(pts.len() as u32);
+        }
+        start = end;
+    }
+    b.pts = pts;
+    b.ends = ends;
+}
+
 /// Inserts into each contour the vertices of the operand's *other* contours that lie exactly on
 /// its edges.
 ///
@@ -207,8 +256,26 @@ fn pair(
     }
     // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa. The signed
     // distances of p0 and p1 from line q give the parameter along p.
+    //
+    // The same point is also found from the parameter along q; each coordinate is taken from the
+    // edge with the smaller extent in that coordinate, whose rounding error is proportional to
+    // that extent. In particular a crossing of an axis-parallel edge is exact in that coordinate.
     let t = op0 / (op0 - op1);
-    let x = p0 + (p1 - p0) * t + DVec2::ZERO;
+    let u = oq0 / (oq0 - oq1);
+    let xp = p0 + (p1 - p0) * t;
+    let xq = q0 + (q1 - q0) * u;
+    let x = DVec2::new(
+        if (p1.x - p0.x).abs() <= (q1.x - q0.x).abs() {
+            xp.x
+        } else {
+            xq.x
+        },
+        if (p1.y - p0.y).abs() <= (q1.y - q0.y).abs() {
+            xp.y
+        } else {
+            xq.y
+        },
+    ) + DVec2::ZERO;
     for (v, own_a) in [(p0, true), (p1, true), (q0, false), (q1, false)] {
         if (x - v).length_squared() <= snap2 {
             // Snap to an existing vertex: insert it into the other operand's edge only.

@@ -168,6 +168,7 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
         });
     }
     let scale = ra.scale().max(rb.scale());
+    intersect::snap_vertices(&ra, &mut rb, scale);
     intersect::split_self_contacts(&mut ra);
     intersect::split_self_contacts(&mut rb);
     intersect::split(&mut ra, &mut rb, scale)?;
@@ -214,13 +215,24 @@ mod debug_tests {
     use std::println;
     use alloc::vec;
 
+    fn sh(v: &[(f64, f64)]) -> Shape {
+        Shape::new(vec![v.iter().map(|&(x, y)| DVec2::new(x, y)).collect()]).unwrap()
+    }
+
     #[test]
     fn dbg_case() {
-        let a = Shape::new(vec![vec![DVec2::new(-1.0, 2.0), DVec2::new(-1.368421052631579, 0.1578947368421053), DVec2::new(0.0, -1.6666666666666667), DVec2::new(4.0, 1.0), DVec2::new(1.8125, 1.4375), DVec2::new(1.0, -1.0), DVec2::new(0.0, 1.0), DVec2::new(1.1428571428571432, 1.5714285714285714)], vec![DVec2::new(-1.608695652173913, -1.0434782608695654), DVec2::new(-2.0, -3.0), DVec2::new(-0.4117647058823528, -1.9411764705882353)]]).unwrap();
-        let b = Shape::new(vec![vec![DVec2::new(2.0, -2.0), DVec2::new(0.0, 2.0), DVec2::new(-1.0, 1.0)]]).unwrap();
+        let light = sh(&[(2.0, 0.0), (3.0, 1.0), (3.0, 2.0), (2.0, 2.0), (-1.0, 3.0)]);
+        let t1 = sh(&[(1.0, -1.0), (-3.0, 4.0), (-3.0, -1.0)]);
+        let t2 = sh(&[(2.0, 3.0), (-3.0, 3.0), (0.0, 1.0)]);
+        let t3 = sh(&[(-3.0, 2.0), (-1.0, 1.0), (-1.0, 4.0)]);
+        let mut occ = boolean(&t1, &t2, BoolOp::Union).unwrap();
+        occ = boolean(&occ, &t3, BoolOp::Union).unwrap();
+        println!("occ {occ:?}");
+        let (a, b) = (light, occ);
         let mut ra = Rings::from_shape(&a);
         let mut rb = Rings::from_shape(&b);
         let scale = ra.scale().max(rb.scale());
+        intersect::snap_vertices(&ra, &mut rb, scale);
         intersect::split(&mut ra, &mut rb, scale).unwrap();
         let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
         let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
