@@ -11,6 +11,7 @@ use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
 use planar_support::*;
 use proptest::prelude::*;
+use proptest::test_runner::FileFailurePersistence;
 
 /// Relative tolerance against the references (they snap to an integer grid).
 const REF_TOL: f64 = 1e-7;
@@ -24,6 +25,9 @@ fn config() -> ProptestConfig {
             .ok()
             .and_then(|v| v.parse().ok())
             .unwrap_or(256),
+        failure_persistence: Some(Box::new(FileFailurePersistence::Direct(
+            "proptest-regressions/planar_proptest.txt",
+        ))),
         ..ProptestConfig::default()
     }
 }
@@ -228,5 +232,34 @@ proptest! {
         }
         let direct = boolean(&light, &occ, BoolOp::Difference).map_err(|e| TestCaseError::fail(e.to_string()))?;
         prop_assert!((direct.area() - visible.area()).abs() <= ID_TOL * light.area());
+    }
+
+    #[test]
+    fn chains_over_float_mesh_fan(
+        c in (-0.5f64..0.5, -0.5f64..0.5),
+        radii in prop::collection::vec(0.5f64..3.0, 6..40),
+        skip in prop::collection::vec(any::<bool>(), 40),
+        light in star_shape(12),
+    ) {
+        // A projected triangle fan: float coordinates, every triangle sharing the apex and two
+        // edges with its neighbours, subtracted one by one and compared with union-first.
+        let apex = DVec2::new(c.0, c.1);
+        let ring = star(apex, &radii, 0.1);
+        let n = ring.len();
+        let mut visible = light.clone();
+        let mut occ = Shape::empty();
+        for k in 0..n {
+            if skip[k] {
+                continue;
+            }
+            let Ok(t) = Shape::new(vec![vec![apex, ring[k], ring[(k + 1) % n]]]) else { continue };
+            visible = boolean(&visible, &t, BoolOp::Difference).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            occ = boolean(&occ, &t, BoolOp::Union).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            visible.validate().map_err(|e| TestCaseError::fail(format!("visible: {e}")))?;
+            occ.validate().map_err(|e| TestCaseError::fail(format!("occ: {e}")))?;
+        }
+        let direct = boolean(&light, &occ, BoolOp::Difference).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        prop_assert!((direct.area() - visible.area()).abs() <= ID_TOL * light.area(),
+            "chain {} vs union-first {}", visible.area(), direct.area());
     }
 }
