@@ -50,10 +50,7 @@ const SINGULAR_EPS: f64 = 1e-14;
 fn check_matrix(m: DMat3) -> Result<(), GeomError> {
     let cols = m.to_cols_array();
     if let Some(i) = cols.iter().position(|c| !c.is_finite()) {
-        return Err(GeomError::NonFinite {
-            ring: 0,
-            vertex: i,
-        });
+        return Err(GeomError::NonFinite { ring: 0, vertex: i });
     }
     let frob2: f64 = cols.iter().map(|c| c * c).sum();
     let scale = frob2 * sqrt(frob2);

@@ -306,7 +306,12 @@ impl Cell {
                         continue;
                     }
                     let fc = ggx_brdf_cos(self.v, l, self.alpha);
-                    err += term(fc, ltc.density(l), ggx_vndf_pdf(self.v, l, self.alpha), true);
+                    err += term(
+                        fc,
+                        ltc.density(l),
+                        ggx_vndf_pdf(self.v, l, self.alpha),
+                        true,
+                    );
                 }
             }
             FitMode::Reference => {
@@ -355,7 +360,8 @@ fn nelder_mead<const D: usize>(
             break;
         }
         // Centroid of all but the worst point.
-        let c: [f64; D] = core::array::from_fn(|i| pts[..D].iter().map(|p| p[i]).sum::<f64>() / D as f64);
+        let c: [f64; D] =
+            core::array::from_fn(|i| pts[..D].iter().map(|p| p[i]).sum::<f64>() / D as f64);
         let xr = lerp(&c, &pts[D], -1.0);
         let fr = f(&xr);
         evals += 1;
@@ -368,7 +374,11 @@ fn nelder_mead<const D: usize>(
             (pts[D], vals[D]) = (xr, fr);
         } else {
             // Outside contraction if the reflection beat the worst point, inside otherwise.
-            let xc = if fr < vals[D] { lerp(&c, &xr, 0.5) } else { lerp(&c, &pts[D], 0.5) };
+            let xc = if fr < vals[D] {
+                lerp(&c, &xr, 0.5)
+            } else {
+                lerp(&c, &pts[D], 0.5)
+            };
             let fc = f(&xc);
             evals += 1;
             if fc < vals[D].min(fr) {
@@ -382,7 +392,9 @@ fn nelder_mead<const D: usize>(
             }
         }
     }
-    let best = (0..=D).min_by(|&a, &b| vals[a].total_cmp(&vals[b])).unwrap_or(0);
+    let best = (0..=D)
+        .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
+        .unwrap_or(0);
     (pts[best], vals[best])
 }
 
@@ -623,7 +635,10 @@ pub fn shading_error(
                 (i as f64 + rng.next_f64()) / n as f64,
                 (j as f64 + rng.next_f64()) / n as f64,
             );
-            for (l, from_brdf) in [(ggx_sample_vndf(v, alpha, u1), true), (ltc.sample(u2), false)] {
+            for (l, from_brdf) in [
+                (ggx_sample_vndf(v, alpha, u1), true),
+                (ltc.sample(u2), false),
+            ] {
                 let fc = ggx_brdf_cos(v, l, alpha);
                 let d = ltc.density(l);
                 let pdf = ggx_vndf_pdf(v, l, alpha);

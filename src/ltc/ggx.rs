@@ -149,7 +149,11 @@ pub fn ggx_sample_vndf(v: DVec3, alpha: f64, u: DVec2) -> DVec3 {
     // Unstretch back to the ellipsoid's normal.
     let ne = DVec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(0.0));
     let len2 = ne.length_squared();
-    let h = if len2 > 0.0 { ne / sqrt(len2) } else { DVec3::Z };
+    let h = if len2 > 0.0 {
+        ne / sqrt(len2)
+    } else {
+        DVec3::Z
+    };
     let l = 2.0 * v.dot(h) * h - v;
     l / sqrt(l.length_squared())
 }

@@ -35,15 +35,15 @@
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
 mod distribution;
-mod integrate;
 #[cfg(feature = "fit")]
 pub mod fit;
 pub mod ggx;
+mod integrate;
 mod table;
 #[rustfmt::skip]
 mod table_data;
 
 pub use distribution::Ltc;
-pub use integrate::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
 pub use ggx::{GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf};
+pub use integrate::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
 pub use table::{LtcLookup, LtcTable, lookup};

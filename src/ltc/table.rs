@@ -258,7 +258,8 @@ impl LtcTable {
     /// when an index is out of range. Looking up exactly these inputs returns the stored values.
     #[must_use]
     pub fn node(&self, j: usize, k: usize) -> Option<(f64, f64)> {
-        (j < self.grid.n && k < self.grid.n).then(|| (self.grid.node_cos(j), self.grid.node_alpha(k)))
+        (j < self.grid.n && k < self.grid.n)
+            .then(|| (self.grid.node_cos(j), self.grid.node_alpha(k)))
     }
 
     /// The values stored at view node `j`, roughness node `k` (see [`LtcTable::node`]), e.g. to

@@ -155,7 +155,11 @@ fn inside_at(v: DVec2, x: DVec2, rays: &[(DVec2, bool)]) -> bool {
             Some((b, bin)) => {
                 let (cr, cb) = (ccw_class(v, x, r), ccw_class(v, x, b));
                 let earlier = cr < cb || (cr == cb && orient(v, r, b) > 0.0);
-                if earlier { Some((r, incoming)) } else { Some((b, bin)) }
+                if earlier {
+                    Some((r, incoming))
+                } else {
+                    Some((b, bin))
+                }
             }
         };
     }
@@ -201,7 +205,10 @@ pub(crate) fn label(
                     .iter()
                     .flat_map(|&k| {
                         let k = k as usize;
-                        [(o.pts[o_nxt[k] as usize], false), (o.pts[o_prv[k] as usize], true)]
+                        [
+                            (o.pts[o_nxt[k] as usize], false),
+                            (o.pts[o_prv[k] as usize], true),
+                        ]
                     })
                     .collect();
                 inside_at(u, w, &rays)

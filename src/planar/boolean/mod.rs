@@ -183,9 +183,17 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
     label::label(&rb, &b_nxt, &ra, &a_nxt, &a_prv, &a_twins, &mut sb);
 
     let mut classes = SmallVec::new();
-    let on_b: SmallVec<[bool; 64]> = ra.pts.iter().map(|&p| !b_twins.of(&rb, p).is_empty()).collect();
+    let on_b: SmallVec<[bool; 64]> = ra
+        .pts
+        .iter()
+        .map(|&p| !b_twins.of(&rb, p).is_empty())
+        .collect();
     label::classify(&a_nxt, &a_prv, &on_b, &sa, &mut classes)?;
-    let on_a: SmallVec<[bool; 64]> = rb.pts.iter().map(|&p| !a_twins.of(&ra, p).is_empty()).collect();
+    let on_a: SmallVec<[bool; 64]> = rb
+        .pts
+        .iter()
+        .map(|&p| !a_twins.of(&ra, p).is_empty())
+        .collect();
     label::classify(&b_nxt, &b_prv, &on_a, &sb, &mut classes)?;
 
     let mut edges = SmallVec::new();
@@ -207,4 +215,3 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
     let (blo, bhi) = bbox(b);
     ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
 }
-

@@ -145,9 +145,8 @@ pub(crate) fn trace(edges: &Edges, scale: f64) -> Result<Vec<Contour>, GeomError
                 closed = true;
                 break;
             }
-            let lo = order.partition_point(|&k| {
-                cmp_pt(edges[k as usize].0, v) == core::cmp::Ordering::Less
-            });
+            let lo = order
+                .partition_point(|&k| cmp_pt(edges[k as usize].0, v) == core::cmp::Ordering::Less);
             let mut best: Option<usize> = None;
             for &k in order[lo..]
                 .iter()
