@@ -310,3 +310,12 @@ fn per_triangle_chain_equals_silhouette_difference() {
         assert!((ic - id).abs() <= 1e-10, "{ic} vs {id}");
     }
 }
+
+/// Minimized proptest failures, kept as named regressions.
+#[test]
+fn regression_hole_pinched_at_all_its_vertices() {
+    // The difference produced a hole touching the outer ring at all four of its vertices; the
+    // validity check then probed a shared vertex and misjudged the nesting.
+    let (a, b) = pair(9528998366313849765).unwrap();
+    check_identities(&a, &b).unwrap();
+}
