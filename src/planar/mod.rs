@@ -1,1 +1,48 @@
 //! Planar polygons and their boolean operations.
+//!
+//! A [`Shape`] is a set of closed [`Contour`]s — outer contours counter-clockwise, holes
+//! clockwise — that never cross but may touch at points. [`boolean`] computes the regularized
+//! intersection, union, difference or symmetric difference of two shapes with Greiner–Hormann
+//! clipping extended to degenerate contacts after Foster, Hormann and Popa (2019): shared
+//! vertices, vertices on edges, overlapping edges and identical contours are the normal case here
+//! (adjacent triangles of one mesh, projected), and are decided with exact `orient2d` predicates
+//! rather than perturbation.
+//!
+//! Tolerances are relative to the coordinate scale (the largest coordinate magnitude of the
+//! operands) and are documented where they are defined: [`SNAP_REL`] and [`SLIVER_REL`].
+//! Coordinates must be finite with magnitude at most [`MAX_COORD`].
+//!
+//! # Examples
+//!
+//! ```
+//! use arealight::glam::DVec2;
+//! use arealight::planar::{BoolOp, Shape, boolean};
+//!
+//! let light = Shape::new(vec![vec![
+//!     DVec2::new(0.0, 0.0),
+//!     DVec2::new(4.0, 0.0),
+//!     DVec2::new(4.0, 4.0),
+//!     DVec2::new(0.0, 4.0),
+//! ]])?;
+//! let occluder = Shape::new(vec![vec![
+//!     DVec2::new(0.0, 0.0),
+//!     DVec2::new(4.0, 0.0),
+//!     DVec2::new(0.0, 4.0),
+//! ]])?;
+//! let visible = boolean(&light, &occluder, BoolOp::Difference)?;
+//! assert_eq!(visible.area(), 8.0);
+//! visible.validate()?;
+//! # Ok::<(), arealight::GeomError>(())
+//! ```
+
+mod boolean;
+mod contour;
+mod predicates;
+mod shape;
+
+pub use boolean::intersect::{MAX_PASSES, SNAP_REL};
+pub use boolean::trace::SLIVER_REL;
+pub use boolean::{BoolOp, boolean};
+pub use contour::Contour;
+pub use predicates::MAX_COORD;
+pub use shape::Shape;

@@ -181,8 +181,12 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     }
 
     if chains.is_empty() {
-        let circle_inside = on_circle_ring
-            .unwrap_or_else(|| poly.ring_count() > 0 && circle_point_inside(poly, n, u, v));
+        let circle_inside = on_circle_ring.unwrap_or_else(|| {
+            poly.ring_count() > 0
+                && winds_clockwise_about(poly, n)
+                    .or_else(|| winds_clockwise_about(poly, -n))
+                    .unwrap_or_else(|| circle_point_inside(poly, u, v))
+        });
         if circle_inside {
             push_circle(&mut out_verts, &mut out_ends, n, u, v);
         }
@@ -267,10 +271,32 @@ fn corner_contains(a: DVec3, b: DVec3, c: DVec3, t: DVec3) -> bool {
     sweep(t) < sweep(da)
 }
 
+/// When every vertex lies strictly inside the open hemisphere about `c`: whether the circle
+/// bounding that hemisphere lies inside the region, else `None`.
+///
+/// In the gnomonic plane about `c` the rings are closed polygons and the circle is at infinity;
+/// the unbounded face is inside the region iff the outermost rings run clockwise, i.e. iff the
+/// total signed area is negative (nested rings alternate and are smaller than their parents).
+/// The projected cross product is `(p x q) . c / ((p . c)(q . c))`.
+fn winds_clockwise_about(poly: &SphericalPolygon, c: DVec3) -> Option<bool> {
+    let mut area2 = 0.0;
+    for ring in poly.rings() {
+        let m = ring.len();
+        for i in 0..m {
+            let (p, q) = (ring[i], ring[(i + 1) % m]);
+            let (wp, wq) = (p.dot(c), q.dot(c));
+            if !(wp > HORIZON_TOLERANCE) {
+                return None;
+            }
+            area2 += p.cross(q).dot(c) / (wp * wq);
+        }
+    }
+    Some(area2 < 0.0)
+}
+
 /// Whether the clipping circle lies inside the region, when no ring crosses it: the region's side
 /// at the circle point farthest from the boundary, among 16 evenly spaced ones.
-fn circle_point_inside(poly: &SphericalPolygon, n: DVec3, u: DVec3, v: DVec3) -> bool {
-    let _ = n;
+fn circle_point_inside(poly: &SphericalPolygon, u: DVec3, v: DVec3) -> bool {
     let mut best = (f64::NEG_INFINITY, false);
     for k in 0..16 {
         let th = k as f64 * (PI / 8.0);

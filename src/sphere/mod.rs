@@ -5,6 +5,7 @@
 //! on its left (see [`SphericalPolygon`]). This layer knows nothing of light: it is the geometry
 //! that the `ltc` and shading layers integrate over.
 
+mod boolean;
 mod clip;
 mod gnomonic;
 mod order;

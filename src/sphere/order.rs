@@ -143,10 +143,15 @@ fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, Ge
     for e in (0..n).filter(|&e| live[e]) {
         for c in [cluster[2 * e], cluster[2 * e + 1]] {
             let (o, i) = (out_of[c].len(), into[c].len());
-            if o + i > 2 {
+            // Directed loops may pinch (touch themselves or each other at a vertex): any even
+            // degree with as many edges in as out. Undirected loops cannot be told apart there.
+            if directed {
+                if o != i {
+                    return Err(GeomError::OpenChain { edge: e });
+                }
+            } else if o + i > 2 {
                 return Err(GeomError::Branching { edge: e });
-            }
-            if o + i < 2 || (directed && o != i) {
+            } else if o + i < 2 {
                 return Err(GeomError::OpenChain { edge: e });
             }
         }
@@ -166,14 +171,28 @@ fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, Ge
             used[e] = true;
             ring.push(rep[at]);
             let (ca, cb) = (cluster[2 * e], cluster[2 * e + 1]);
-            let next = if at == ca { cb } else { ca };
-            at = next;
-            let cand = out_of[at].iter().chain(into[at].iter()).copied();
-            match cand
-                .filter(|&f| !used[f])
-                .find(|&f| !directed || cluster[2 * f] == at)
-            {
+            let from = at;
+            at = if at == ca { cb } else { ca };
+            let next = if directed {
+                // At a pinch, continue along the outgoing edge first met turning clockwise from
+                // the edge we came in on: that keeps the loops touching without crossing.
+                let pick =
+                    pick_clockwise(rep[from], rep[at], &out_of[at], |f| rep[cluster[2 * f + 1]]);
+                if pick == start {
+                    break;
+                }
+                Some(pick).filter(|&f| !used[f])
+            } else {
+                let cand = out_of[at].iter().chain(into[at].iter()).copied();
+                cand.filter(|&f| !used[f]).next()
+            };
+            match next {
                 Some(f) => e = f,
+                None if directed => {
+                    return Err(GeomError::Degenerate(
+                        "directed edges revisit an edge before closing a loop",
+                    ));
+                }
                 None => break,
             }
         }
@@ -189,6 +208,27 @@ fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, Ge
         return Err(GeomError::TooFewVertices { ring: 0, count: 0 });
     }
     Ok(rings)
+}
+
+/// Among the edges `cands` leaving `at` (their far ends given by `far`), the one first met
+/// turning clockwise about `at` from the direction back toward `from`.
+fn pick_clockwise(from: DVec3, at: DVec3, cands: &[usize], far: impl Fn(usize) -> DVec3) -> usize {
+    if cands.len() == 1 {
+        return cands[0];
+    }
+    let (u, v) = super::predicates::tangent_frame(at);
+    let ang = |p: DVec3| crate::math::atan2(p.dot(v), p.dot(u));
+    let back = ang(from);
+    let mut best = (f64::INFINITY, cands[0]);
+    for &f in cands {
+        let cw = (back - ang(far(f))).rem_euclid(2.0 * PI);
+        // A zero turn would retrace the incoming edge: that is the last choice, not the first.
+        let cw = if cw <= 0.0 { 2.0 * PI } else { cw };
+        if cw < best.0 {
+            best = (cw, f);
+        }
+    }
+    best.1
 }
 
 /// Union–find of endpoints closer than [`MATCH_TOLERANCE`]: sort by x and compare only within the

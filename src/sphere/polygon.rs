@@ -391,11 +391,13 @@ impl SphericalPolygon {
                 if i != j {
                     // A vertex of ring j that is not a pinch shared with ring i, so that it lies
                     // strictly on one side of ring i (all shared would mean overlapping edges).
+                    // If every vertex is such a pinch, an edge midpoint is off ring i (edges
+                    // never overlap).
                     let probe = rings[j]
                         .iter()
                         .find(|p| !rings[i].contains(p))
                         .copied()
-                        .unwrap_or(rings[j][0]);
+                        .unwrap_or_else(|| (rings[j][0] + rings[j][1]).normalize());
                     side[i * k + j] = nearest_feature(core::iter::once(rings[i]), probe)
                         .is_some_and(|(_, inside)| inside);
                 }

@@ -1,0 +1,361 @@
+//! Phase 1: find every contact between the boundaries of the two operands and split both at it.
+//!
+//! This is the intersection phase of Greiner and Hormann (1998, section 3.1), extended to the
+//! degenerate contacts of Foster, Hormann and Popa (2019, section 2: "vertex on edge",
+//! "vertex on vertex" and overlapping collinear edges) without perturbation. For every pair of
+//! edges the four exact orientations `orient2d(p0, p1, q0)`, `orient2d(p0, p1, q1)`,
+//! `orient2d(q0, q1, p0)`, `orient2d(q0, q1, p1)` decide which case applies:
+//!
+//! - all zero: the edges are collinear; every endpoint of one lying strictly inside the other is
+//!   inserted into the other, so an overlap becomes a run of identical edges in both operands;
+//! - one zero with the point strictly inside the other edge: a vertex on an edge; the vertex is
+//!   inserted into the other operand verbatim (bit-identical), which is exact;
+//! - strictly opposite signs on both sides: a proper crossing; the point is computed in `f64` and
+//!   inserted into both operands with the same bits.
+//!
+//! A computed crossing within [`SNAP_REL`] times the coordinate scale of an endpoint is replaced
+//! by that endpoint (this is what makes "vertex almost on edge" behave like "vertex on edge").
+//! Inserting a computed or snapped point bends the split edges by a few units in the last place,
+//! which can create contacts that the straight edges did not have; so the phase repeats on the
+//! bent edges until nothing new is found (a fixpoint, bounded by [`MAX_PASSES`]). At the fixpoint
+//! the split boundaries meet only in shared vertices, as exact predicates on the stored
+//! coordinates see them, which is what the labelling phase relies on.
+
+use glam::DVec2;
+use smallvec::SmallVec;
+
+use super::{Rings, Split};
+use crate::GeomError;
+use crate::math::sqrt;
+use crate::planar::predicates::{orient, strictly_between};
+
+/// Snapping distance for computed crossings, relative to the largest coordinate magnitude of the
+/// two operands: `64 * f64::EPSILON` (about `1.4e-14`). A crossing computed in `f64` is off by a
+/// few ulps of the coordinate scale; closer than this to an endpoint, the endpoint is used
+/// instead. At the scale `1e6` of gnomonic coordinates near the horizon this is `1.4e-8`.
+pub const SNAP_REL: f64 = 64.0 * f64::EPSILON;
+
+/// Bound on the number of splitting passes. In practice the second pass finds nothing new; more
+/// than a handful of passes means the input is pathological (edges almost overlapping over long
+/// stretches), and the operation returns [`GeomError::Degenerate`] instead of looping.
+pub const MAX_PASSES: usize = 8;
+
+/// One point to insert into an edge, with its parameter along the edge for ordering.
+#[derive(Clone, Copy)]
+struct Insert {
+    edge: u32,
+    t: f64,
+    p: DVec2,
+    /// Whether the point is not exactly on the straight edge, so the split edges need re-checking.
+    bent: bool,
+}
+
+type Inserts = SmallVec<[Insert; 16]>;
+
+/// Splits both operands at all their mutual contacts.
+pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), GeomError> {
+    let snap2 = {
+        let s = SNAP_REL * scale;
+        s * s
+    };
+    let mut dirty_a: SmallVec<[bool; 64]> = SmallVec::from_elem(true, a.pts.len());
+    let mut dirty_b: SmallVec<[bool; 64]> = SmallVec::from_elem(true, b.pts.len());
+    let mut ins_a = Inserts::new();
+    let mut ins_b = Inserts::new();
+    for _ in 0..MAX_PASSES {
+        ins_a.clear();
+        ins_b.clear();
+        find(a, b, &dirty_a, &dirty_b, snap2, &mut ins_a, &mut ins_b);
+        if ins_a.is_empty() && ins_b.is_empty() {
+            return Ok(());
+        }
+        apply(a, &mut ins_a, &mut dirty_a);
+        apply(b, &mut ins_b, &mut dirty_b);
+    }
+    Err(GeomError::Degenerate(
+        "edge intersections did not settle; the operands have long nearly-overlapping edges",
+    ))
+}
+
+/// Makes vertices of `b` that lie within the snapping distance of a vertex of `a` identical to it
+/// (FHP's vertex-on-vertex case, made robust). Two distinct points a few ulps apart would
+/// otherwise each be inserted into the other operand's edges and produce spikes between them.
+/// Consecutive points that become equal are merged; a ring left with fewer than three points is
+/// dropped (it was a sliver thinner than the tolerance).
+pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
+    let snap = SNAP_REL * scale;
+    let snap2 = snap * snap;
+    let mut changed = false;
+    for q in b.pts.iter_mut() {
+        if let Some(&p) = a
+            .pts
+            .iter()
+            .find(|&&p| p != *q && (p - *q).length_squared() <= snap2)
+        {
+            *q = p;
+            changed = true;
+        }
+    }
+    if !changed {
+        return;
+    }
+    let mut pts: Split = SmallVec::with_capacity(b.pts.len());
+    let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
+    let mut start = 0usize;
+    for &end in &b.ends {
+        let end = end as usize;
+        let ring_start = pts.len();
+        for k in start..end {
+            let p = b.pts[k];
+            if pts.len() > ring_start && pts.last() == Some(&p) {
+                continue;
+            }
+            pts.push(p);
+        }
+        while pts.len() > ring_start + 1 && pts.last() == pts.get(ring_start) {
+            pts.pop();
+        }
+        if pts.len() - ring_start < 3 {
+            pts.truncate(ring_start);
+        } else {
+            ends.push(pts.len() as u32);
+        }
+        start = end;
+    }
+    b.pts = pts;
+    b.ends = ends;
+}
+
+/// Inserts into each contour the vertices of the operand's *other* contours that lie exactly on
+/// its edges.
+///
+/// Contours of one shape may touch at isolated points, e.g. a hole's vertex on the outer
+/// contour's edge. Without this step, an edge of the other operand overlapping that outer edge
+/// would be split at the touching point while the outer edge is not, and the shared stretch would
+/// not be recognized as shared. The inserted points are existing vertices and lie exactly on the
+/// edge (`orient2d == 0`), so nothing bends.
+pub(crate) fn split_self_contacts(r: &mut Rings) {
+    if r.ends.len() < 2 {
+        return;
+    }
+    let nxt = r.next_table();
+    let mut ins = Inserts::new();
+    let mut start = 0usize;
+    for &end in &r.ends {
+        let end = end as usize;
+        for i in start..end {
+            let (p0, p1) = (r.pts[i], r.pts[nxt[i] as usize]);
+            for (k, &q) in r.pts.iter().enumerate() {
+                if (start..end).contains(&k) {
+                    continue;
+                }
+                if q.x < p0.x.min(p1.x)
+                    || q.x > p0.x.max(p1.x)
+                    || q.y < p0.y.min(p1.y)
+                    || q.y > p0.y.max(p1.y)
+                {
+                    continue;
+                }
+                if orient(p0, p1, q) == 0.0 && strictly_between(p0, p1, q) {
+                    push(&mut ins, i as u32, p0, p1, q, false);
+                }
+            }
+        }
+        start = end;
+    }
+    if !ins.is_empty() {
+        let mut dirty = SmallVec::new();
+        apply(r, &mut ins, &mut dirty);
+    }
+}
+
+/// One pass over all edge pairs in which at least one edge is new.
+fn find(
+    a: &Rings,
+    b: &Rings,
+    dirty_a: &[bool],
+    dirty_b: &[bool],
+    snap2: f64,
+    ins_a: &mut Inserts,
+    ins_b: &mut Inserts,
+) {
+    let na = a.next_table();
+    let nb = b.next_table();
+    for (i, &ni) in na.iter().enumerate() {
+        let (p0, p1) = (a.pts[i], a.pts[ni as usize]);
+        let (pminx, pmaxx) = (p0.x.min(p1.x), p0.x.max(p1.x));
+        let (pminy, pmaxy) = (p0.y.min(p1.y), p0.y.max(p1.y));
+        let da = dirty_a.get(i).copied().unwrap_or(true);
+        for (j, &nj) in nb.iter().enumerate() {
+            if !da && !dirty_b.get(j).copied().unwrap_or(true) {
+                continue;
+            }
+            let (q0, q1) = (b.pts[j], b.pts[nj as usize]);
+            if q0.x.max(q1.x) < pminx
+                || q0.x.min(q1.x) > pmaxx
+                || q0.y.max(q1.y) < pminy
+                || q0.y.min(q1.y) > pmaxy
+            {
+                continue;
+            }
+            pair(
+                [p0, p1, q0, q1],
+                (i as u32, j as u32),
+                (&a.pts, &b.pts),
+                snap2,
+                ins_a,
+                ins_b,
+            );
+        }
+    }
+}
+
+/// Classifies one edge pair and records the points to insert.
+fn pair(
+    [p0, p1, q0, q1]: [DVec2; 4],
+    (i, j): (u32, u32),
+    (all_a, all_b): (&[DVec2], &[DVec2]),
+    snap2: f64,
+    ins_a: &mut Inserts,
+    ins_b: &mut Inserts,
+) {
+    // A vertex within the snapping distance of the other edge's line counts as on it: it is
+    // inserted into that edge (bending it by at most the tolerance), exactly as FHP's
+    // vertex-on-edge case. Without this, a vertex a few ulps off an edge survives as a
+    // near-touch that the next operation in a chain sees as either a crossing or a gap.
+    let snap = sqrt(snap2);
+    let near = |o: f64, len: f64| o == 0.0 || o.abs() <= snap * len;
+    let lp = sqrt((p1 - p0).length_squared());
+    let oq0 = orient(p0, p1, q0);
+    let oq1 = orient(p0, p1, q1);
+    let (zq0, zq1) = (near(oq0, lp), near(oq1, lp));
+    if !zq0 && !zq1 && ((oq0 > 0.0 && oq1 > 0.0) || (oq0 < 0.0 && oq1 < 0.0)) {
+        return;
+    }
+    let lq = sqrt((q1 - q0).length_squared());
+    let op0 = orient(q0, q1, p0);
+    let op1 = orient(q0, q1, p1);
+    let (zp0, zp1) = (near(op0, lq), near(op1, lq));
+    if !zp0 && !zp1 && ((op0 > 0.0 && op1 > 0.0) || (op0 < 0.0 && op1 < 0.0)) {
+        return;
+    }
+    // Vertex on edge (and, when all four are zero, the ends of a collinear overlap). Exactly on:
+    // the vertex is copied bit for bit and nothing bends. Within the tolerance: the edge bends.
+    for (z, o, v) in [(zq0, oq0, q0), (zq1, oq1, q1)] {
+        if z && (o != 0.0 || strictly_between(p0, p1, v)) {
+            push(ins_a, i, p0, p1, v, o != 0.0);
+        }
+    }
+    for (z, o, v) in [(zp0, op0, p0), (zp1, op1, p1)] {
+        if z && (o != 0.0 || strictly_between(q0, q1, v)) {
+            push(ins_b, j, q0, q1, v, o != 0.0);
+        }
+    }
+    if zq0 || zq1 || zp0 || zp1 {
+        return;
+    }
+    // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa. The signed
+    // distances of p0 and p1 from line q give the parameter along p.
+    //
+    // The same point is also found from the parameter along q; each coordinate is taken from the
+    // edge with the smaller extent in that coordinate, whose rounding error is proportional to
+    // that extent. In particular a crossing of an axis-parallel edge is exact in that coordinate.
+    let t = op0 / (op0 - op1);
+    let u = oq0 / (oq0 - oq1);
+    let xp = p0 + (p1 - p0) * t;
+    let xq = q0 + (q1 - q0) * u;
+    let x = DVec2::new(
+        if (p1.x - p0.x).abs() <= (q1.x - q0.x).abs() {
+            xp.x
+        } else {
+            xq.x
+        },
+        if (p1.y - p0.y).abs() <= (q1.y - q0.y).abs() {
+            xp.y
+        } else {
+            xq.y
+        },
+    ) + DVec2::ZERO;
+    for (v, own_a) in [(p0, true), (p1, true), (q0, false), (q1, false)] {
+        if (x - v).length_squared() <= snap2 {
+            // Snap to an existing vertex: insert it into the other operand's edge only.
+            if own_a {
+                push(ins_b, j, q0, q1, v, true);
+            } else {
+                push(ins_a, i, p0, p1, v, true);
+            }
+            return;
+        }
+    }
+    // Snap to any other vertex of either operand within the tolerance: a crossing a few ulps
+    // from a vertex elsewhere on the boundary (a point where the operand touches itself, or a
+    // vertex of the other operand lying on this edge) must become that vertex, or the boundary
+    // would carry two distinct points a few ulps apart and the split edges between them could
+    // double back.
+    let x = all_a
+        .iter()
+        .chain(all_b.iter())
+        .copied()
+        .find(|&v| (x - v).length_squared() <= snap2)
+        .unwrap_or(x);
+    push(ins_a, i, p0, p1, x, true);
+    push(ins_b, j, q0, q1, x, true);
+}
+
+fn push(ins: &mut Inserts, edge: u32, e0: DVec2, e1: DVec2, p: DVec2, bent: bool) {
+    let d = e1 - e0;
+    let t = (p - e0).dot(d) / d.length_squared();
+    // A point that projects outside the edge is a snapped vertex a few ulps beyond an endpoint;
+    // inserting it would make the edge double back, so it is left out (the endpoint stands in).
+    if t > 0.0 && t < 1.0 && p != e0 && p != e1 {
+        ins.push(Insert { edge, t, p, bent });
+    }
+}
+
+/// Rebuilds the rings with the inserted points, marking edges next to bent points as dirty.
+fn apply(r: &mut Rings, ins: &mut Inserts, dirty: &mut SmallVec<[bool; 64]>) {
+    if ins.is_empty() {
+        dirty.iter_mut().for_each(|d| *d = false);
+        return;
+    }
+    ins.sort_unstable_by(|x, y| x.edge.cmp(&y.edge).then(x.t.total_cmp(&y.t)));
+    let mut pts: Split = SmallVec::with_capacity(r.pts.len() + ins.len());
+    let mut bent: SmallVec<[bool; 64]> = SmallVec::with_capacity(r.pts.len() + ins.len());
+    let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
+    let mut k = 0;
+    let mut start = 0usize;
+    for &end in &r.ends {
+        let end = end as usize;
+        for e in start..end {
+            pts.push(r.pts[e]);
+            bent.push(false);
+            let e1 = r.pts[if e + 1 == end { start } else { e + 1 }];
+            while let Some(x) = ins.get(k) {
+                if x.edge as usize != e {
+                    break;
+                }
+                k += 1;
+                let last = pts.last().copied();
+                if Some(x.p) == last || x.p == e1 {
+                    continue;
+                }
+                pts.push(x.p);
+                bent.push(x.bent);
+            }
+        }
+        ends.push(pts.len() as u32);
+        start = end;
+    }
+    dirty.clear();
+    let mut s = 0usize;
+    for &end in &ends {
+        let end = end as usize;
+        for e in s..end {
+            let n = if e + 1 == end { s } else { e + 1 };
+            dirty.push(bent[e] || bent[n]);
+        }
+        s = end;
+    }
+    r.pts = pts;
+    r.ends = ends;
+}

@@ -1,0 +1,182 @@
+//! Helpers shared by the planar integration tests: a compact text format for shapes, the
+//! identity checks, and adapters to the reference clippers (i_overlay, clipper2).
+#![allow(dead_code)]
+
+use arealight::glam::DVec2;
+use arealight::planar::{BoolOp, Shape, boolean};
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::float::single::SingleFloatOverlay;
+
+pub const OPS: [BoolOp; 4] = [
+    BoolOp::Intersection,
+    BoolOp::Union,
+    BoolOp::Difference,
+    BoolOp::Xor,
+];
+
+/// Parses S2-style text: `"0:0, 4:0, 4:4, 0:4; 1:1, 1:2, 2:2"` (rings separated by `;`).
+pub fn rings(text: &str) -> Vec<Vec<DVec2>> {
+    text.split(';')
+        .filter(|r| !r.trim().is_empty())
+        .map(|r| {
+            r.split(',')
+                .map(|p| {
+                    let mut it = p.trim().split(':');
+                    let x: f64 = it.next().unwrap().trim().parse().unwrap();
+                    let y: f64 = it.next().unwrap().trim().parse().unwrap();
+                    DVec2::new(x, y)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// A shape from the text format; panics (test input) if invalid.
+pub fn shape(text: &str) -> Shape {
+    Shape::new(rings(text)).unwrap_or_else(|e| panic!("bad test shape {text:?}: {e}"))
+}
+
+pub fn op_name(op: BoolOp) -> &'static str {
+    match op {
+        BoolOp::Intersection => "intersection",
+        BoolOp::Union => "union",
+        BoolOp::Difference => "difference",
+        BoolOp::Xor => "xor",
+    }
+}
+
+/// Runs all four operations, checks each result is valid, and checks the identities
+/// area(A-B) + area(A&B) = area(A), area(A|B) = area(A) + area(B) - area(A&B),
+/// area(A^B) = area(A|B) - area(A&B), to `tol` of the operands' area.
+pub fn check_all(a: &Shape, b: &Shape, tol: f64) -> Result<[Shape; 4], String> {
+    let mut out: Vec<Shape> = Vec::new();
+    for op in OPS {
+        let r = boolean(a, b, op).map_err(|e| format!("{}: error {e}", op_name(op)))?;
+        r.validate()
+            .map_err(|e| format!("{} result invalid: {e}\n{r:?}", op_name(op)))?;
+        out.push(r);
+    }
+    let (aa, ab) = (a.area(), b.area());
+    let [i, u, d, x]: [Shape; 4] = out.try_into().unwrap();
+    let (ai, au, ad, ax) = (i.area(), u.area(), d.area(), x.area());
+    let eps = tol * (aa + ab).max(f64::MIN_POSITIVE);
+    if (ad + ai - aa).abs() > eps {
+        return Err(format!("area(A-B) {ad} + area(A&B) {ai} != area(A) {aa}"));
+    }
+    if (au - (aa + ab - ai)).abs() > eps {
+        return Err(format!("area(A|B) {au} != {aa} + {ab} - {ai}"));
+    }
+    if (ax - (au - ai)).abs() > eps {
+        return Err(format!("area(A^B) {ax} != area(A|B) {au} - area(A&B) {ai}"));
+    }
+    if ai > aa.min(ab) + eps || au + eps < aa.max(ab) {
+        return Err(format!(
+            "bounds violated: A&B {ai}, A|B {au}, A {aa}, B {ab}"
+        ));
+    }
+    Ok([i, u, d, x])
+}
+
+pub type IPaths = Vec<Vec<[f64; 2]>>;
+
+pub fn to_paths(s: &Shape) -> IPaths {
+    s.contours()
+        .map(|c| c.iter().map(|p| [p.x, p.y]).collect())
+        .collect()
+}
+
+/// Area of i_overlay output: each shape's first contour is its outer boundary, the rest holes.
+pub fn ioverlay_area(shapes: &[Vec<Vec<[f64; 2]>>]) -> f64 {
+    shapes
+        .iter()
+        .map(|sh| {
+            sh.iter()
+                .enumerate()
+                .map(|(k, c)| {
+                    let a = ring_area(c).abs();
+                    if k == 0 { a } else { -a }
+                })
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+pub fn ring_area(c: &[[f64; 2]]) -> f64 {
+    let n = c.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let o = c[0];
+    let mut s = 0.0;
+    for k in 1..n - 1 {
+        let (p, q) = (c[k], c[k + 1]);
+        s += (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]);
+    }
+    0.5 * s
+}
+
+fn rule(op: BoolOp) -> OverlayRule {
+    match op {
+        BoolOp::Intersection => OverlayRule::Intersect,
+        BoolOp::Union => OverlayRule::Union,
+        BoolOp::Difference => OverlayRule::Difference,
+        BoolOp::Xor => OverlayRule::Xor,
+    }
+}
+
+/// i_overlay's result for `a op b` (64-bit integer engine, non-zero fill).
+pub fn ioverlay(a: &IPaths, b: &IPaths, op: BoolOp) -> Vec<Vec<Vec<[f64; 2]>>> {
+    a.overlay_as::<i64>(b, rule(op), FillRule::NonZero)
+}
+
+/// Area of the symmetric difference between our result and i_overlay's reference, measured by
+/// i_overlay itself (so the measurement does not depend on the code under test).
+pub fn sym_diff_vs_ioverlay(a: &Shape, b: &Shape, op: BoolOp, ours: &Shape) -> f64 {
+    let reference = ioverlay(&to_paths(a), &to_paths(b), op);
+    let ref_paths: IPaths = reference.into_iter().flatten().collect();
+    let x = to_paths(ours).overlay_as::<i64>(&ref_paths, OverlayRule::Xor, FillRule::EvenOdd);
+    ioverlay_area(&x)
+}
+
+/// Fixed-point scaler for clipper2: 2^-30 resolution, plenty for the test coordinate ranges.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Hash)]
+pub struct Fine;
+impl clipper2::PointScaler for Fine {
+    const MULTIPLIER: f64 = 1073741824.0;
+}
+
+pub fn to_clipper(s: &Shape) -> clipper2::Paths<Fine> {
+    let v: Vec<Vec<(f64, f64)>> = s
+        .contours()
+        .map(|c| c.iter().map(|p| (p.x, p.y)).collect())
+        .collect();
+    v.into()
+}
+
+/// clipper2's area of `a op b` (non-zero fill).
+pub fn clipper_area(a: &Shape, b: &Shape, op: BoolOp) -> f64 {
+    let (pa, pb) = (to_clipper(a), to_clipper(b));
+    let f = clipper2::FillRule::NonZero;
+    let r = match op {
+        BoolOp::Intersection => clipper2::intersect(pa, pb, f),
+        BoolOp::Union => clipper2::union(pa, pb, f),
+        BoolOp::Difference => clipper2::difference(pa, pb, f),
+        BoolOp::Xor => clipper2::xor(pa, pb, f),
+    };
+    r.map(|p| p.signed_area().abs()).unwrap_or(f64::NAN)
+}
+
+/// Regular-ish star polygon around `c`: vertex k at angle 2 pi k / n with radius `radii[k]`.
+/// Star-shaped around `c`, hence simple.
+pub fn star(c: DVec2, radii: &[f64], phase: f64) -> Vec<DVec2> {
+    let n = radii.len();
+    radii
+        .iter()
+        .enumerate()
+        .map(|(k, &r)| {
+            let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
+            c + DVec2::new(t.cos(), t.sin()) * r
+        })
+        .collect()
+}
