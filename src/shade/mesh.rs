@@ -108,6 +108,8 @@ pub struct TriangleMesh {
     normals: Vec<DVec3>,
     center: DVec3,
     radius: f64,
+    /// All triangles in one plane, facing the same way.
+    planar: bool,
 }
 
 impl TriangleMesh {
@@ -142,12 +144,19 @@ impl TriangleMesh {
             );
         }
         let (center, radius) = bounding_sphere(&vertices);
+        let n0 = normals[0];
+        let p0 = vertices[triangles[0][0] as usize];
+        let planar = normals.iter().all(|n| (*n - n0).length() <= 1e-12)
+            && vertices
+                .iter()
+                .all(|v| n0.dot(*v - p0).abs() <= FACE_TOLERANCE * radius);
         Ok(TriangleMesh {
             vertices,
             triangles,
             normals,
             center,
             radius,
+            planar,
         })
     }
 
@@ -203,6 +212,14 @@ impl TriangleMesh {
     #[must_use]
     pub fn bounding_sphere(&self) -> (DVec3, f64) {
         (self.center, self.radius)
+    }
+
+    /// Whether every vertex lies in one plane and every triangle faces the same way (a flat
+    /// light such as a quad). The triangles of a planar mesh are assumed not to overlap, so their
+    /// projections from any point are disjoint.
+    #[must_use]
+    pub fn is_planar(&self) -> bool {
+        self.planar
     }
 
     /// The mesh of all triangles of `self` and `other` (no vertices are merged).

@@ -13,12 +13,6 @@
 //!   lights' triangles, exact ray-triangle visibility), with its standard error, for tests and
 //!   comparisons.
 //!
-//! # Status
-//!
-//! Occlusion ([`Scene::subtract_occluders`]) needs the spherical set difference of the `sphere`
-//! layer and is not wired yet: the analytic path currently shades without shadows, while the
-//! Monte Carlo reference includes them.
-//!
 //! # References
 //!
 //! - Seed 000: *Fast analytic soft shadows from area lights* (Alg. 1 overview, Alg. 2 silhouettes,

@@ -11,6 +11,7 @@ use super::mesh::{ConvexPolyhedron, TriangleMesh};
 use super::silhouette::{ShadingFrame, TriangleRole, convex_silhouette, triangle_polygon};
 use crate::GeomError;
 use crate::ltc::{clamped_cosine_integral, lookup};
+use crate::planar::BoolOp;
 use crate::sphere::SphericalPolygon;
 
 /// The geometry of a light or an occluder.
@@ -140,9 +141,6 @@ pub struct Scene {
     occluder_bounds: Vec<BoundingSphere>,
     method: Method,
 }
-
-/// Spherical polygons whose clamped-cosine integrals add up: the visible region of one light.
-pub(crate) type Pieces = SmallVec<[SphericalPolygon; 1]>;
 
 impl Scene {
     /// A scene with the default [`Method::Silhouette`].
@@ -287,13 +285,11 @@ impl Scene {
         if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[i]) {
             return Ok(DVec3::ZERO);
         }
-        let pieces = self.visible_region(i, frame)?;
-        let mut diffuse = 0.0;
-        let mut specular = 0.0;
-        for p in &pieces {
-            diffuse += clamped_cosine_integral(p);
+        let (mut diffuse, mut specular) = (0.0, 0.0);
+        for vis in self.visible_region(i, frame)? {
+            diffuse += clamped_cosine_integral(&vis);
             if let Some((m_inv, _)) = spec {
-                specular += clamped_cosine_integral(&transform(p, m_inv));
+                specular += clamped_cosine_integral(&transform(&vis, m_inv));
             }
         }
         let mut out = material.albedo() * diffuse;
@@ -304,75 +300,148 @@ impl Scene {
     }
 
     /// The part of light `light` visible from the frame's point, in the shading frame, clipped to
-    /// the upper hemisphere: pieces whose clamped-cosine integrals add up.
-    ///
-    /// Today this is the light's own region ([`Scene::light_region`]) with occlusion still to be
-    /// wired: see [`Scene::subtract_occluders`].
+    /// the upper hemisphere, as pieces with disjoint interiors whose integrals add up: each piece
+    /// of the light's region ([`Scene::light_region`]) minus the regions of the occluders that may
+    /// lie in between ([`Scene::subtract_occluders`]).
     ///
     /// # Errors
     ///
     /// As [`Scene::shade`].
-    pub fn visible_region(&self, light: usize, frame: &ShadingFrame) -> Result<Pieces, GeomError> {
-        let region = self.light_region(light, frame)?;
-        self.subtract_occluders(light, frame, region)
+    pub fn visible_region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        let mut out = self.light_region(light, frame)?;
+        for piece in &mut out {
+            let p = core::mem::take(piece);
+            *piece = self.subtract_occluders(light, frame, p)?;
+        }
+        out.retain(|p| !p.is_empty());
+        Ok(out)
     }
 
     /// The region covered by light `light` seen from the frame's point, clipped to the upper
-    /// hemisphere (seed 000 Alg. 1 lines 4-5): the silhouette of a convex light, or the front
-    /// faces of a mesh light.
+    /// hemisphere (seed 000 Alg. 1 lines 4-5), as pieces with disjoint interiors:
     ///
-    /// For a mesh light the front-facing triangles are returned as separate pieces; their
-    /// integrals add up exactly when their projections do not overlap (closed convex meshes,
-    /// planar lights). A non-convex light whose front faces overlap in projection needs their
-    /// union, which is the spherical boolean's job (not wired yet, see the module docs).
+    /// - a convex light with [`Method::Silhouette`]: its silhouette, one piece;
+    /// - a convex light with [`Method::PerTriangle`], or a planar mesh light: each front-facing
+    ///   triangle, one piece each (seed 000 section 4.4). Their projections cannot overlap, so
+    ///   their integrals add up exactly;
+    /// - any other mesh light: the union of its front-facing triangles, one piece. The union, not
+    ///   the sum, makes a non-convex light's self-occlusion right: where front faces overlap in
+    ///   projection, the nearer one is seen, with the same radiance.
     ///
     /// # Errors
     ///
-    /// As [`Scene::shade`].
-    pub fn light_region(&self, light: usize, frame: &ShadingFrame) -> Result<Pieces, GeomError> {
-        let mut pieces = Pieces::new();
+    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`].
+    pub fn light_region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> Result<Vec<SphericalPolygon>, GeomError> {
         let up = DVec3::Z;
-        match (&self.lights[light].shape, self.method) {
-            (Shape::Convex(p), Method::Silhouette) => {
-                let s = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
-                if !s.is_empty() {
-                    pieces.push(s);
-                }
-            }
-            (shape, _) => {
-                let mesh = shape.mesh();
-                for t in 0..mesh.triangle_count() {
-                    if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Emitter)? {
-                        let p = p.clip_to_hemisphere(up);
-                        if !p.is_empty() {
-                            pieces.push(p);
-                        }
-                    }
+        let shape = &self.lights[light].shape;
+        if let (Shape::Convex(p), Method::Silhouette) = (shape, self.method) {
+            let s = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+            return Ok(if s.is_empty() {
+                Vec::new()
+            } else {
+                alloc::vec![s]
+            });
+        }
+        let mesh = shape.mesh();
+        let mut pieces = Vec::new();
+        for t in 0..mesh.triangle_count() {
+            if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Emitter)? {
+                let p = p.clip_to_hemisphere(up);
+                if !p.is_empty() {
+                    pieces.push(p);
                 }
             }
         }
-        Ok(pieces)
+        let disjoint = matches!(shape, Shape::Convex(_)) || mesh.is_planar();
+        if disjoint || pieces.len() <= 1 {
+            return Ok(pieces);
+        }
+        let mut union = pieces.pop().unwrap_or_default();
+        for p in &pieces {
+            union = union.boolean(p, BoolOp::Union)?;
+        }
+        Ok(alloc::vec![union])
     }
 
     /// The occlusion step of seed 000 Alg. 1 (lines 7-12): subtracts from the light's region the
-    /// regions of the occluders that may lie between the point and the light.
+    /// regions of the occluders that may lie between the point and the light ([`may_occlude`],
+    /// the paper's `GetBetween`), each clipped to the upper hemisphere first (Alg. 1 line 10).
     ///
-    /// NOT WIRED YET: this needs the spherical set difference `SphericalPolygon::boolean`, which
-    /// is being implemented in the `sphere` layer. Until it lands, the region is returned
-    /// unchanged, i.e. the analytic path shades without shadows. It is kept as this one separate
-    /// function so that the wiring is a local change.
+    /// A convex occluder subtracts its silhouette (with [`Method::Silhouette`]); a mesh occluder,
+    /// or any occluder with [`Method::PerTriangle`], subtracts each of its triangles seen from
+    /// either side (seed 000 section 4.4), after a per-triangle bounding-sphere cull.
+    ///
+    /// Occluders are assumed not to interpenetrate the light: an occluder partly behind the
+    /// light (farther along some direction the light covers) is subtracted as if in front. The
+    /// culling removes occluders entirely behind the light.
     ///
     /// # Errors
     ///
-    /// As [`Scene::shade`].
+    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`].
     pub fn subtract_occluders(
         &self,
         light: usize,
         frame: &ShadingFrame,
-        region: Pieces,
-    ) -> Result<Pieces, GeomError> {
-        let _ = (light, frame);
-        Ok(region)
+        region: SphericalPolygon,
+    ) -> Result<SphericalPolygon, GeomError> {
+        let up = DVec3::Z;
+        let mut vis = region;
+        if vis.is_empty() {
+            return Ok(vis);
+        }
+        let (x, n) = (frame.origin(), frame.normal());
+        let lb = self.light_bounds[light];
+        for o in self.occluders_between(light, frame) {
+            match (&self.occluders[o], self.method) {
+                (Shape::Convex(p), Method::Silhouette) => {
+                    let occ = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+                    if !occ.is_empty() {
+                        vis = vis.boolean(&occ, BoolOp::Difference)?;
+                    }
+                }
+                (shape, _) => {
+                    let mesh = shape.mesh();
+                    for t in 0..mesh.triangle_count() {
+                        let tri = mesh.triangle(t);
+                        let c = (tri[0] + tri[1] + tri[2]) / 3.0;
+                        let r = tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max)
+                            * (1.0 + 1e-12);
+                        if !may_occlude(
+                            x,
+                            n,
+                            lb,
+                            BoundingSphere {
+                                center: c,
+                                radius: r,
+                            },
+                        ) {
+                            continue;
+                        }
+                        if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Blocker)? {
+                            let p = p.clip_to_hemisphere(up);
+                            if !p.is_empty() {
+                                vis = vis.boolean(&p, BoolOp::Difference)?;
+                                if vis.is_empty() {
+                                    return Ok(vis);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            if vis.is_empty() {
+                break;
+            }
+        }
+        Ok(vis)
     }
 }
 

@@ -120,8 +120,9 @@ impl ShadingFrame {
 ///
 /// A face whose plane passes within [`FACE_TOLERANCE`] of the point is seen edge-on and counts as
 /// back-facing. A point inside the polyhedron (behind every face) sees the full sphere; a point on
-/// its surface (no face strictly in front) sees no front face, and gets the empty polygon: the
-/// polyhedron then lies in the closed half-space behind the face the point is on.
+/// its surface (no face strictly in front, some within the tolerance) is covered by the
+/// intersection of the half-spaces behind the faces it lies on: a hemisphere for a point on a
+/// face, a lune on an edge.
 ///
 /// # Errors
 ///
@@ -134,11 +135,18 @@ pub fn convex_silhouette(
     let mut s = Vec::new();
     let tol = poly.facing(frame.origin(), &mut s);
     if !s.iter().any(|&d| d > tol) {
-        return Ok(if s.iter().all(|&d| d < -tol) {
-            SphericalPolygon::full()
-        } else {
-            SphericalPolygon::empty()
-        });
+        // No front face: the point is inside or on the surface. The polyhedron then covers, seen
+        // from the point, the intersection of the closed half-spaces behind the faces the point
+        // lies on: the full sphere inside, a hemisphere on a face (a cube standing on the
+        // ground covers the ground point's whole upper hemisphere), a lune on an edge.
+        let mut region = SphericalPolygon::full();
+        for (f, &d) in s.iter().enumerate() {
+            if d >= -tol {
+                let n = frame.dir_to_local(poly.mesh().triangle_normal(f));
+                region = region.clip_to_hemisphere(-n);
+            }
+        }
+        return Ok(region);
     }
     let verts = poly.vertices();
     let local: Vec<DVec3> = verts.iter().map(|&p| frame.to_local(p)).collect();
@@ -222,6 +230,18 @@ mod tests {
         // Inside: full sphere.
         let fi = ShadingFrame::new(DVec3::new(0.0, 0.0, 2.0), DVec3::Z, DVec3::Z).unwrap();
         assert!(convex_silhouette(&cube, &fi).unwrap().is_full());
+        // On the bottom face (a ground point under a cube standing on it): the upper hemisphere.
+        let fb = ShadingFrame::new(DVec3::new(0.1, 0.2, 1.5), DVec3::Z, DVec3::Z).unwrap();
+        let pb = convex_silhouette(&cube, &fb).unwrap();
+        assert!((pb.solid_angle() - 2.0 * PI).abs() < 1e-12 && pb.contains(DVec3::Z));
+        // On a bottom edge: a quarter of the sphere.
+        let fe = ShadingFrame::new(DVec3::new(0.5, 0.2, 1.5), DVec3::Z, DVec3::Z).unwrap();
+        let pe = convex_silhouette(&cube, &fe).unwrap();
+        assert!(
+            (pe.solid_angle() - PI).abs() < 1e-12,
+            "{}",
+            pe.solid_angle()
+        );
         // In the plane of the bottom face (a cube standing on the ground), off to the side.
         let fg = ShadingFrame::new(DVec3::new(2.0, 0.0, 1.5), DVec3::Z, DVec3::Z).unwrap();
         let pg = convex_silhouette(&cube, &fg).unwrap();
