@@ -1,1 +1,58 @@
-fn main() {}
+//! Shading-point benchmarks: one shading point in a penumbra with 1 light and 0, 1, 3 occluders,
+//! and the silhouette path against the per-triangle path for a subdivided-icosahedron light.
+//! Fixed inputs; results in BENCHMARKS.md (section `shade`).
+
+use arealight::glam::DVec3;
+use arealight::shade::{ConvexPolyhedron, DemoConfig, Light, Material, Method, Scene, demo_scene};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+
+fn occluders(c: &mut Criterion) {
+    let demo = demo_scene(DemoConfig::default()).unwrap();
+    // The truncated-cone light alone, with the first k occluders (cube, icosphere, ellipsoid).
+    let cone = demo.scene.lights()[2].clone();
+    // A ground point in the penumbra of the icosphere under the cone light.
+    let (x, n, v) = (
+        DVec3::new(0.9, -0.25, 0.0),
+        DVec3::Z,
+        DVec3::new(0.2, -0.7, 0.7),
+    );
+    let m = demo.ground;
+    let mut group = c.benchmark_group("shade/one point, 1 light");
+    for k in [0usize, 1, 3] {
+        let occ = match k {
+            1 => vec![demo.scene.occluders()[1].clone()],
+            _ => demo.scene.occluders()[..k].to_vec(),
+        };
+        let scene = Scene::new(vec![cone.clone()], occ).unwrap();
+        group.bench_with_input(BenchmarkId::new("occluders", k), &scene, |b, s| {
+            b.iter(|| s.shade(black_box(x), n, v, &m).unwrap())
+        });
+    }
+    group.finish();
+}
+
+fn silhouette_vs_per_triangle(c: &mut Criterion) {
+    // An icosahedron subdivided twice (162 vertices, 320 triangles) as a light, 3 above a
+    // diffuse + GGX floor, no occluders.
+    let ico = ConvexPolyhedron::icosphere(DVec3::new(0.2, 0.1, 3.0), 1.0, 2).unwrap();
+    let scene = Scene::new(vec![Light::new(ico, DVec3::ONE).unwrap()], vec![]).unwrap();
+    let per_tri = scene.clone().with_method(Method::PerTriangle);
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    let (x, n, v) = (
+        DVec3::new(0.5, -0.3, 0.0),
+        DVec3::Z,
+        DVec3::new(0.3, 0.0, 1.0),
+    );
+    let mut group = c.benchmark_group("shade/icosphere light (162 vertices)");
+    group.bench_function("silhouette", |b| {
+        b.iter(|| scene.shade(black_box(x), n, v, &m).unwrap())
+    });
+    group.bench_function("per-triangle", |b| {
+        b.iter(|| per_tri.shade(black_box(x), n, v, &m).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, occluders, silhouette_vs_per_triangle);
+criterion_main!(benches);

@@ -1,0 +1,287 @@
+//! Meshes, hulls, silhouettes, culling and non-convex shapes (per-triangle method), with fixed
+//! seeds. Analytic results are checked against the Monte Carlo reference with the LTC BRDF within
+//! `4 sigma_hat + 1e-6` (see tests/shade_mc.rs for why the floor), or against exact identities.
+
+use arealight::GeomError;
+use arealight::glam::DVec3;
+use arealight::shade::reference::Pcg32;
+use arealight::shade::{
+    BoundingSphere, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
+    ShadingFrame, Shape, TriangleMesh, TriangleRole, convex_silhouette, may_occlude,
+    triangle_polygon,
+};
+
+fn rand_dir(rng: &mut Pcg32) -> DVec3 {
+    let z = 2.0 * rng.next_f64() - 1.0;
+    let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+#[test]
+fn hulls_of_random_clouds_are_convex_and_silhouettes_match_per_triangle() {
+    let mut rng = Pcg32::new(3, 4);
+    for case in 0..40 {
+        let n = 4 + (rng.next_u32() % 60) as usize;
+        let scale = DVec3::new(
+            0.2 + rng.next_f64(),
+            0.2 + rng.next_f64(),
+            0.2 + rng.next_f64(),
+        );
+        let pts: Vec<DVec3> = (0..n)
+            .map(|_| rand_dir(&mut rng) * rng.next_f64().cbrt() * scale)
+            .collect();
+        let hull = ConvexPolyhedron::hull(&pts).unwrap();
+        let mesh = hull.mesh();
+        // Every input point is on or behind every face.
+        for t in 0..mesh.triangle_count() {
+            let [a, ..] = mesh.triangle(t);
+            let nn = mesh.triangle_normal(t);
+            for p in &pts {
+                assert!(
+                    nn.dot(*p - a) <= 1e-12,
+                    "case {case}: point in front of face {t}"
+                );
+            }
+        }
+        // Euler's formula for a closed genus-0 surface.
+        let (v, e, f) = (
+            hull.vertices().len() as i64,
+            hull.edges().len() as i64,
+            mesh.triangle_count() as i64,
+        );
+        assert_eq!(v - e + f, 2, "case {case}");
+        // From outside, the silhouette covers what the front triangles cover.
+        for _ in 0..5 {
+            let x = rand_dir(&mut rng) * (2.0 + 3.0 * rng.next_f64());
+            let frame = ShadingFrame::new(x, rand_dir(&mut rng), rand_dir(&mut rng)).unwrap();
+            let sil = convex_silhouette(&hull, &frame).unwrap();
+            let sum: f64 = (0..mesh.triangle_count())
+                .filter_map(|t| triangle_polygon(mesh, t, &frame, TriangleRole::Emitter).unwrap())
+                .map(|p| p.solid_angle())
+                .sum();
+            assert!(
+                (sil.solid_angle() - sum).abs() <= 1e-9,
+                "case {case}: {} vs {sum}",
+                sil.solid_angle()
+            );
+            let centroid = pts.iter().copied().sum::<DVec3>() / n as f64;
+            assert!(sil.contains(frame.to_local(centroid)), "case {case}");
+        }
+    }
+}
+
+#[test]
+fn culling_is_conservative() {
+    // Whenever a point of the occluder's sphere, above the horizon, lies in front of a point of
+    // the light's sphere along the same ray from x, the occluder must be kept.
+    let mut rng = Pcg32::new(5, 6);
+    let mut kept_needed = 0;
+    for _ in 0..20_000 {
+        let x = rand_dir(&mut rng) * rng.next_f64() * 2.0;
+        let n = rand_dir(&mut rng);
+        let light = BoundingSphere {
+            center: rand_dir(&mut rng) * 4.0 * rng.next_f64(),
+            radius: 0.2 + rng.next_f64(),
+        };
+        let occ = BoundingSphere {
+            center: rand_dir(&mut rng) * 4.0 * rng.next_f64(),
+            radius: 0.1 + rng.next_f64(),
+        };
+        let keep = may_occlude(x, n, light, occ);
+        for _ in 0..8 {
+            let p = occ.center + rand_dir(&mut rng) * occ.radius * rng.next_f64().cbrt();
+            let d = (p - x).normalize();
+            if d.dot(n) <= 0.0 {
+                continue;
+            }
+            // Far intersection of the ray with the light's sphere.
+            let oc = light.center - x;
+            let along = oc.dot(d);
+            let h2 = light.radius * light.radius - (oc.length_squared() - along * along);
+            if h2 < 0.0 {
+                continue;
+            }
+            let t_far = along + h2.sqrt();
+            if t_far > (p - x).length() {
+                kept_needed += 1;
+                assert!(keep, "x {x} n {n} light {light:?} occ {occ:?}");
+            }
+        }
+    }
+    assert!(kept_needed > 1000);
+}
+
+fn box_mesh(c: DVec3, h: DVec3) -> TriangleMesh {
+    ConvexPolyhedron::cuboid(c, h).unwrap().mesh().clone()
+}
+
+/// Analytic (per-triangle method) against Monte Carlo with the LTC BRDF on ground points.
+fn check_scene(scene: &Scene, seed: u64, points: usize) -> (usize, usize) {
+    let mut rng = Pcg32::new(seed, 7);
+    let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
+    let mc = MonteCarlo::new(4096, ReferenceBrdf::Ltc);
+    let (mut ok, mut errors) = (0, 0);
+    for i in 0..points {
+        let x = DVec3::new(4.0 * rng.next_f64() - 2.0, 4.0 * rng.next_f64() - 2.0, 0.0);
+        let v = DVec3::new(
+            rng.next_f64() - 0.5,
+            rng.next_f64() - 0.5,
+            0.5 + rng.next_f64(),
+        );
+        let a = match scene.shade(x, DVec3::Z, v, &m) {
+            Ok(a) => a,
+            Err(e) => {
+                eprintln!("point {i}: {e}");
+                errors += 1;
+                continue;
+            }
+        };
+        let e = mc
+            .estimate(scene, x, DVec3::Z, v, &m, seed * 7919 + i as u64)
+            .unwrap();
+        for c in 0..3 {
+            assert!(
+                (a[c] - e.mean[c]).abs() <= 4.0 * e.std_error[c] + 1e-6,
+                "point {i} ch {c}: analytic {} mc {} +- {}",
+                a[c],
+                e.mean[c],
+                e.std_error[c]
+            );
+        }
+        ok += 1;
+    }
+    (ok, errors)
+}
+
+#[test]
+fn non_convex_light_is_the_union_of_its_front_faces() {
+    // Two boxes as one mesh: from the ground, the upper box is partly hidden behind the lower one,
+    // so summing the front faces would count the overlap twice.
+    let mesh = box_mesh(DVec3::new(0.0, 0.0, 2.5), DVec3::new(0.6, 0.4, 0.3))
+        .merged(&box_mesh(
+            DVec3::new(0.3, 0.2, 3.4),
+            DVec3::new(0.5, 0.5, 0.3),
+        ))
+        .unwrap();
+    // Seen from below the pair, the front faces overlap: their summed solid angles exceed the
+    // union's, so a sum would be wrong and the Monte Carlo check below would tell.
+    let frame = ShadingFrame::new(DVec3::new(0.2, 0.1, 0.0), DVec3::Z, DVec3::Z).unwrap();
+    let sum: f64 = (0..mesh.triangle_count())
+        .filter_map(|t| triangle_polygon(&mesh, t, &frame, TriangleRole::Emitter).unwrap())
+        .map(|p| p.solid_angle())
+        .sum();
+    let scene = Scene::new(
+        vec![Light::new(mesh, DVec3::new(1.0, 2.0, 3.0)).unwrap()],
+        vec![],
+    )
+    .unwrap();
+    let region = scene.light_region(0, &frame).unwrap();
+    assert_eq!(region.len(), 1);
+    assert!(
+        sum > 1.2 * region[0].solid_angle(),
+        "{sum} vs {}",
+        region[0].solid_angle()
+    );
+    let (ok, errors) = check_scene(&scene, 11, 60);
+    // KNOWN WEAKNESS (sphere layer): unions of many edge-sharing spherical triangles still hit
+    // `Degenerate` / crossing-ring errors in `SphericalPolygon::boolean` on a few points; those
+    // are printed and at most 5% are tolerated.
+    assert!(ok >= 57, "{ok} points checked, {errors} errors");
+}
+
+#[test]
+fn non_convex_occluder_subtracts_all_its_triangles() {
+    // An L-shaped occluder (two boxes as one mesh) under a quad light.
+    let quad = TriangleMesh::quad(
+        DVec3::new(0.0, 0.0, 3.0),
+        DVec3::new(0.0, 0.8, 0.0),
+        DVec3::new(0.8, 0.0, 0.0),
+    )
+    .unwrap();
+    let l_shape = box_mesh(DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.6, 0.15, 0.15))
+        .merged(&box_mesh(
+            DVec3::new(0.45, 0.4, 1.0),
+            DVec3::new(0.15, 0.25, 0.15),
+        ))
+        .unwrap();
+    let scene = Scene::new(
+        vec![Light::new(quad, DVec3::ONE).unwrap()],
+        vec![Shape::Mesh(l_shape)],
+    )
+    .unwrap();
+    let (ok, errors) = check_scene(&scene, 13, 60);
+    // As above: at most 5% of points may hit a boolean-operation error (printed).
+    assert!(ok >= 57, "{ok} points checked, {errors} errors");
+    // The same scene with the silhouette method uses the per-triangle path for meshes anyway.
+    assert_eq!(
+        scene.clone().with_method(Method::PerTriangle).method(),
+        Method::PerTriangle
+    );
+}
+
+#[test]
+fn invalid_geometry_is_an_error() {
+    let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    assert!(matches!(
+        TriangleMesh::new(
+            vec![DVec3::ZERO, DVec3::X, DVec3::INFINITY],
+            vec![[0, 1, 2]]
+        ),
+        Err(GeomError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        TriangleMesh::new(v.clone(), vec![[0, 1, 9]]),
+        Err(GeomError::InvalidIndex { .. })
+    ));
+    assert!(matches!(
+        TriangleMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::X * 2.0], vec![[0, 1, 2]]),
+        Err(GeomError::DegenerateTriangle { .. })
+    ));
+    assert!(TriangleMesh::new(v.clone(), vec![]).is_err());
+    assert!(TriangleMesh::quad(DVec3::ZERO, DVec3::X, DVec3::X).is_err());
+    // Coplanar and too few points have no hull.
+    assert!(
+        ConvexPolyhedron::hull(&[DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)])
+            .is_err()
+    );
+    assert!(ConvexPolyhedron::hull(&v[..3]).is_err());
+    assert!(ConvexPolyhedron::hull(&[DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::NAN]).is_err());
+    // A non-convex closed mesh is not a ConvexPolyhedron.
+    let l_shape = box_mesh(DVec3::ZERO, DVec3::ONE)
+        .merged(&box_mesh(DVec3::new(3.0, 0.0, 0.0), DVec3::ONE))
+        .unwrap();
+    assert!(matches!(
+        ConvexPolyhedron::from_mesh(&l_shape),
+        Err(GeomError::NotConvex { .. })
+    ));
+    assert!(ConvexPolyhedron::frustum(DVec3::ZERO, DVec3::ZERO, 1.0, 1.0, 10).is_err());
+    assert!(ConvexPolyhedron::frustum(DVec3::ZERO, DVec3::Z, -1.0, 1.0, 10).is_err());
+    assert!(ConvexPolyhedron::frustum(DVec3::ZERO, DVec3::Z, 1.0, 1.0, 2).is_err());
+    assert!(ConvexPolyhedron::icosphere(DVec3::ZERO, 0.0, 1).is_err());
+    assert!(ConvexPolyhedron::icosphere(DVec3::ZERO, 1.0, 9).is_err());
+    assert!(
+        Light::new(
+            Shape::Mesh(box_mesh(DVec3::ZERO, DVec3::ONE)),
+            DVec3::new(-1.0, 0.0, 0.0)
+        )
+        .is_err()
+    );
+    assert!(
+        Light::new(
+            Shape::Mesh(box_mesh(DVec3::ZERO, DVec3::ONE)),
+            DVec3::splat(f64::NAN)
+        )
+        .is_err()
+    );
+    assert!(Material::new(DVec3::ONE, DVec3::ZERO, f64::NAN).is_err());
+    assert!(Material::new(DVec3::splat(1.5), DVec3::ZERO, 0.5).is_err());
+    assert!(ShadingFrame::new(DVec3::ZERO, DVec3::Z * 1e-320, DVec3::Z).is_err());
+}
+
+#[test]
+fn scene_is_send_and_sync() {
+    fn send_sync<T: Send + Sync>() {}
+    send_sync::<Scene>();
+    send_sync::<ConvexPolyhedron>();
+}
