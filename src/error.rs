@@ -88,25 +88,25 @@ pub enum GeomError {
     /// The input is geometrically degenerate in a way the operation cannot resolve; the string
     /// says how.
     Degenerate(&'static str),
-    /// [shade] A mesh triangle refers to a vertex index past the end of the vertex list.
+    /// (shade) A mesh triangle refers to a vertex index past the end of the vertex list.
     InvalidIndex {
         /// Index of the triangle.
         triangle: usize,
         /// The offending vertex index.
         index: usize,
     },
-    /// [shade] A mesh triangle has (nearly) zero area, so it has no reliable normal.
+    /// (shade) A mesh triangle has (nearly) zero area, so it has no reliable normal.
     DegenerateTriangle {
         /// Index of the triangle.
         triangle: usize,
     },
-    /// [shade] A mesh that must be closed has an edge not shared by exactly two triangles with
+    /// (shade) A mesh that must be closed has an edge not shared by exactly two triangles with
     /// opposite directions.
     OpenMesh {
         /// Index of a triangle at the offending edge.
         triangle: usize,
     },
-    /// [shade] A mesh that must be convex has a vertex in front of a face's plane (or faces
+    /// (shade) A mesh that must be convex has a vertex in front of a face's plane (or faces
     /// pointing inwards).
     NotConvex {
         /// Index of the face (triangle).

@@ -256,7 +256,7 @@ fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
     // The cross product of the two edges adjacent to the largest angle is the best conditioned.
     let n = e0.cross(-e2);
     let len = n.length();
-    if !(len > DEGENERATE_TRIANGLE * longest2) || !len.is_finite() {
+    if len.is_nan() || len <= DEGENERATE_TRIANGLE * longest2 || !len.is_finite() {
         return None;
     }
     Some(n / len)
@@ -503,7 +503,7 @@ impl ConvexPolyhedron {
                 limit: 10_000.0,
             });
         }
-        if !(r0 >= 0.0) || !(r1 >= 0.0) {
+        if r0.is_nan() || r1.is_nan() || r0 < 0.0 || r1 < 0.0 {
             return Err(GeomError::OutOfRange {
                 what: "frustum radius (non-negative)",
                 value: if r0 >= 0.0 { r1 } else { r0 },
@@ -511,7 +511,7 @@ impl ConvexPolyhedron {
             });
         }
         let len = axis.length();
-        if !(len > 0.0) || !len.is_finite() {
+        if len.is_nan() || len <= 0.0 || !len.is_finite() {
             return Err(GeomError::ZeroVector { ring: 0, vertex: 0 });
         }
         let w = axis / len;
@@ -679,7 +679,7 @@ fn hull_triangles(points: &[DVec3]) -> Result<Vec<[u32; 3]>, GeomError> {
         .unwrap_or(0);
     let n = d01.cross(points[i2] - points[i0]);
     let scale = d01.length_squared();
-    if !(n.length() > DEGENERATE_TRIANGLE * scale) {
+    if n.length().is_nan() || n.length() <= DEGENERATE_TRIANGLE * scale {
         return Err(COPLANAR);
     }
     let i3 = (0..points.len())
@@ -689,7 +689,8 @@ fn hull_triangles(points: &[DVec3]) -> Result<Vec<[u32; 3]>, GeomError> {
                 .total_cmp(&n.dot(points[b] - points[i0]).abs())
         })
         .unwrap_or(0);
-    if !(n.dot(points[i3] - points[i0]).abs() > DEGENERATE_TRIANGLE * scale * d01.length()) {
+    let height = n.dot(points[i3] - points[i0]).abs();
+    if height.is_nan() || height <= DEGENERATE_TRIANGLE * scale * d01.length() {
         return Err(COPLANAR);
     }
     let (a, b, c, d) = (i0 as u32, i1 as u32, i2 as u32, i3 as u32);

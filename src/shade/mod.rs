@@ -9,7 +9,7 @@
 //! - [`brdf`]: [`Material`] (Lambert + GGX with Schlick's Fresnel).
 //! - [`demo`]: the test scene of seed 000 (Fig. 4), shared by the render example, tests and benches.
 //! - [`scene`]: [`Scene::shade`], the analytic radiance at a shading point.
-//! - [`reference`]: a Monte Carlo estimator of the same radiance (solid-angle sampling of the
+//! - [`reference`](mod@reference): a Monte Carlo estimator of the same radiance (solid-angle sampling of the
 //!   lights' triangles, exact ray-triangle visibility), with its standard error, for tests and
 //!   comparisons.
 //!
@@ -18,8 +18,8 @@
 //! - Seed 000: *Fast analytic soft shadows from area lights* (Alg. 1 overview, Alg. 2 silhouettes,
 //!   section 3.5 culling, section 4.4 per-triangle method).
 //! - Thesis 003: section 4.2 (silhouettes of convex polyhedra oriented by front faces),
-//!   section 6 (solid-angle sampling of silhouettes, [Arv95], [Pet20]).
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//!   section 6 (solid-angle sampling of silhouettes, \[Arv95\], \[Pet20\]).
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
 pub mod brdf;

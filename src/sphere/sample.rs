@@ -8,7 +8,7 @@ use crate::math::{atan2, sin_cos, sqrt};
 
 /// A spherical triangle prepared for uniform sampling over its solid angle.
 ///
-/// [Arv95]'s method: the solid angle `A_hat` of a sub-triangle `(A, B, C_hat)` is drawn uniformly in
+/// \[Arv95\]'s method: the solid angle `A_hat` of a sub-triangle `(A, B, C_hat)` is drawn uniformly in
 /// `[0, area]`, which fixes the point `C_hat` on the arc `AC`; the sample is then drawn on the arc
 /// from `B` to `C_hat` with the density that makes the result uniform. The triangle's area is taken
 /// from Van Oosterom–Strackee (full relative precision for small triangles) and the angle at `A`
@@ -30,7 +30,7 @@ use crate::math::{atan2, sin_cos, sqrt};
 ///
 /// # References
 ///
-/// - [Arv95] J. Arvo. *Stratified sampling of spherical triangles.* SIGGRAPH 1995.
+/// - \[Arv95\] J. Arvo. *Stratified sampling of spherical triangles.* SIGGRAPH 1995.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SphericalTriangle {
     a: DVec3,
@@ -72,7 +72,12 @@ impl SphericalTriangle {
             ));
         };
         let alpha = atan2(tb.cross(tc).length(), tb.dot(tc));
-        if !(area > 0.0) || !(alpha > 0.0) || area >= 2.0 * core::f64::consts::PI {
+        if area.is_nan()
+            || alpha.is_nan()
+            || area <= 0.0
+            || alpha <= 0.0
+            || area >= 2.0 * core::f64::consts::PI
+        {
             return Err(GeomError::Degenerate(
                 "spherical triangle of zero solid angle (or a hemisphere or more) cannot be sampled",
             ));
@@ -107,7 +112,7 @@ impl SphericalTriangle {
     #[must_use]
     pub fn sample(&self, u: DVec2) -> DVec3 {
         let (a, b) = (self.a, self.b);
-        // Sub-triangle area A_hat and the point C_hat on arc AC ([Arv95], section 2).
+        // Sub-triangle area A_hat and the point C_hat on arc AC (\[Arv95\], section 2).
         let a_hat = u.x.clamp(0.0, 1.0) * self.area;
         let (s, t) = sin_cos(a_hat - self.alpha);
         let cos_c = a.dot(b);
