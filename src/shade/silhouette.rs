@@ -9,7 +9,12 @@ use glam::{DMat3, DVec3};
 
 use super::mesh::{ConvexPolyhedron, FACE_TOLERANCE, TriangleMesh};
 use crate::GeomError;
-use crate::sphere::{SphericalPolygon, order_directed_edges};
+use crate::sphere::{ANTIPODAL_TOLERANCE, SphericalPolygon, order_directed_edges};
+use smallvec::SmallVec;
+
+/// Consecutive silhouette vertices closer than this (chord length) go to the general ordering
+/// path, which merges them; the same tolerance as `order_directed_edges` uses for endpoints.
+const MATCH_TOLERANCE: f64 = 1e-9;
 
 /// The local shading frame of a point (DESIGN.md): the normal on `+z`, the view direction in the
 /// xz-plane with `x >= 0`, right-handed; directions are taken from the shading point.
@@ -115,8 +120,10 @@ impl ShadingFrame {
 /// Each is oriented by its front face: a front face runs counter-clockwise seen from the point,
 /// which puts its interior on the right on the unit sphere (seen from outside the sphere), so the
 /// edge is taken in the reverse of its counter-clockwise direction around the front face. The
-/// directed edges are then chained with [`order_directed_edges`], which replaces the planar
-/// nearest-endpoint search of seed 000 Alg. 2 by exact merging on the sphere.
+/// directed edges are then chained by vertex index (exact and combinatorial: each silhouette
+/// vertex has one outgoing contour edge), which replaces the planar nearest-endpoint search of
+/// seed 000 Alg. 2; configurations that are not one simple loop (near-degenerate views) go through
+/// [`order_directed_edges`] instead, which merges endpoints by tolerance and validates.
 ///
 /// A face whose plane passes within [`FACE_TOLERANCE`] of the point is seen edge-on and counts as
 /// back-facing. A point inside the polyhedron (behind every face) sees the full sphere; a point on
@@ -148,20 +155,91 @@ pub fn convex_silhouette(
         }
         return Ok(region);
     }
-    let verts = poly.vertices();
-    let local: Vec<DVec3> = verts.iter().map(|&p| frame.to_local(p)).collect();
-    let mut edges = Vec::with_capacity(2 * (poly.edges().len() as f64).sqrt() as usize + 8);
+    // Contour edges as directed pairs of vertex indices.
+    let mut contour: SmallVec<[(u32, u32); 24]> = SmallVec::new();
     for e in poly.edges() {
-        let front0 = s[e.f0 as usize] > tol;
-        let front1 = s[e.f1 as usize] > tol;
-        let (a, b) = (local[e.a as usize], local[e.b as usize]);
-        match (front0, front1) {
-            (true, false) => edges.push((b, a)),
-            (false, true) => edges.push((a, b)),
+        match (s[e.f0 as usize] > tol, s[e.f1 as usize] > tol) {
+            (true, false) => contour.push((e.b, e.a)),
+            (false, true) => contour.push((e.a, e.b)),
             _ => {}
         }
     }
+    let verts = poly.vertices();
+    if let Some(ring) = chain_by_index(&contour, verts.len()) {
+        // The silhouette of a convex polyhedron seen from outside is one simple loop through
+        // distinct vertices, which are at least about FACE_TOLERANCE apart in direction (they
+        // span front faces, whose planes miss the point by more than the tolerance). So when the
+        // combinatorial walk closes one loop, only consecutive-vertex spacing needs checking,
+        // not the quadratic simplicity test of `SphericalPolygon::new`.
+        let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(ring.len());
+        for &i in &ring {
+            let Some(u) = frame.to_local(verts[i as usize]).try_normalize() else {
+                return order_edges_of(&contour, verts, frame);
+            };
+            out.push(u);
+        }
+        let n = out.len();
+        let spaced = n >= 3
+            && (0..n).all(|k| {
+                let (a, b) = (out[k], out[(k + 1) % n]);
+                (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+            });
+        if spaced {
+            let ends: SmallVec<[u32; 2]> = smallvec::smallvec![n as u32];
+            return Ok(SphericalPolygon::from_parts(out, ends));
+        }
+    }
+    order_edges_of(&contour, verts, frame)
+}
+
+/// The general path: the contour's directed edges ordered with [`order_directed_edges`], which
+/// merges endpoints by tolerance, allows pinches and validates the result.
+fn order_edges_of(
+    contour: &[(u32, u32)],
+    verts: &[DVec3],
+    frame: &ShadingFrame,
+) -> Result<SphericalPolygon, GeomError> {
+    let edges: Vec<(DVec3, DVec3)> = contour
+        .iter()
+        .map(|&(a, b)| {
+            (
+                frame.to_local(verts[a as usize]),
+                frame.to_local(verts[b as usize]),
+            )
+        })
+        .collect();
     order_directed_edges(&edges)
+}
+
+/// Walks directed edges (vertex index pairs) as one loop: `Some(vertex indices)` when every
+/// vertex used has exactly one outgoing edge and the walk from the first edge uses all of them,
+/// `None` otherwise (several loops or pinches: left to the general path).
+fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<SmallVec<[u32; 24]>> {
+    const NONE: u32 = u32::MAX;
+    if edges.len() < 3 {
+        return None;
+    }
+    let mut next = alloc::vec![NONE; nverts];
+    for &(a, b) in edges {
+        if next[a as usize] != NONE {
+            return None;
+        }
+        next[a as usize] = b;
+    }
+    let mut ring = SmallVec::new();
+    let start = edges[0].0;
+    let mut at = start;
+    for _ in 0..edges.len() {
+        ring.push(at);
+        at = next[at as usize];
+        if at == NONE {
+            return None;
+        }
+        if at == start {
+            break;
+        }
+    }
+    (at == start && ring.len() == edges.len()).then_some(ring)
 }
 
 /// How a triangle of a mesh enters the per-triangle method.
