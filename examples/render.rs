@@ -366,13 +366,14 @@ fn run(args: &Args) -> Result<(), String> {
         }
     };
 
-    // Monte Carlo with the true BRDF at equal time: passes of one sample per light per pixel until
-    // the analytic time is spent (at least one pass).
+    // Monte Carlo with the true BRDF at equal time: passes of one sample per light per pixel while
+    // another pass ends closer to the analytic time than stopping now (at least one pass, so with
+    // a fast analytic path Monte Carlo may get more time, never less than half a pass).
     let t0 = Instant::now();
     let mut acc = vec![DVec3::ZERO; w * h];
     let mut passes = 0u64;
     let one = MonteCarlo::new(1, ReferenceBrdf::True);
-    while passes == 0 || t0.elapsed().as_secs_f64() < t_analytic {
+    while passes == 0 || t0.elapsed().as_secs_f64() * (1.0 + 0.5 / passes as f64) < t_analytic {
         let pass = render(w, h, threads, &hits, |i, hit| match hit {
             Hit::Nothing => DVec3::ZERO,
             Hit::Emitter(l) => *l,
