@@ -420,7 +420,7 @@ impl SphericalPolygon {
 }
 
 /// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
-fn ring_left_area(ring: &[DVec3]) -> f64 {
+pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
     let n = ring.len();
     let apex = fan_apex(ring);
     let mut sum = 0.0;
