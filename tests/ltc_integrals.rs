@@ -153,3 +153,70 @@ proptest! {
         prop_assert!((diff - signed).abs() <= 1e-12, "{} vs {}", diff, signed);
     }
 }
+
+#[test]
+fn rational_edge_factor_error_is_as_documented() {
+    use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, edge_factor_rational};
+    let mut worst: f64 = 0.0;
+    let n = 400_000;
+    for i in 0..=n {
+        // Dense in cos(theta), including the ends; x -> -1 approached to 1e-9.
+        let x = -1.0 + 1e-9 + (2.0 - 1e-9) * i as f64 / n as f64;
+        let exact = if x >= 1.0 {
+            1.0
+        } else {
+            x.acos() / (1.0 - x * x).sqrt()
+        };
+        worst = worst.max((edge_factor_rational(x) / exact - 1.0).abs());
+    }
+    assert!(
+        worst <= EDGE_FACTOR_RATIONAL_MAX_ERROR,
+        "max relative error {worst}"
+    );
+    assert!(
+        worst > 0.5 * EDGE_FACTOR_RATIONAL_MAX_ERROR,
+        "documented bound is loose: {worst}"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+
+    /// The rational variant stays within its documented error of the exact integral.
+    #[test]
+    fn rational_integral_within_bound(seed in any::<u64>()) {
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let clipped = p.clip_to_hemisphere(DVec3::Z);
+        let perimeter: f64 = boundary_edges(&clipped).map(|(a, b)| a.cross(b).length().atan2(a.dot(b))).sum();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-14;
+        let (a, b) = (clamped_cosine_integral(&p), clamped_cosine_integral_rational(&p));
+        prop_assert!((a - b).abs() <= bound, "{} vs {} (bound {})", a, b, bound);
+    }
+
+    /// Integrating an LTC over a polygon (transform + clamped cosine) equals quadrature of the
+    /// LTC density over the polygon (HDHN16 eq. 14).
+    #[test]
+    fn ltc_integral_matches_density_quadrature(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{Ltc, ltc_integral};
+        let mut rng = Rng::new(seed);
+        let m_inv = DMat3::from_cols(
+            DVec3::new(rng.range(0.3, 2.0), 0.0, rng.range(-0.8, 0.8)),
+            DVec3::new(0.0, rng.range(0.3, 2.0), 0.0),
+            DVec3::new(rng.range(-0.5, 0.5), 0.0, 1.0),
+        );
+        prop_assume!(m_inv.determinant() > 0.05);
+        let c = DVec3::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), 1.0).normalize();
+        let n = 3 + (rng.next_u64() % 6) as usize;
+        let rho = rng.range(0.05, 0.5);
+        let ring = star_ring(&mut rng, c, n, rho, 0.7);
+        let poly = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+        let ltc = Ltc::from_inverse(m_inv).unwrap();
+        let quad: f64 = (0..n)
+            .map(|i| triangle_quadrature(c, ring[i], ring[(i + 1) % n], 24, |d| ltc.density(d)))
+            .sum();
+        let exact = ltc_integral(&poly, m_inv).unwrap();
+        prop_assert!((exact - quad).abs() <= 1e-8, "{} vs quadrature {}", exact, quad);
+    }
+}

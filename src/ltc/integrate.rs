@@ -19,6 +19,62 @@ fn edge_term(a: DVec3, b: DVec3) -> f64 {
     crate::math::atan2(s, a.dot(b)) / s * c.z
 }
 
+/// A rational approximation of the edge factor `theta / sin(theta)` as a function of
+/// `x = cos(theta) = a . b`, for renderers that prefer it to an `atan2`.
+///
+/// On `[0, 1]` it is a (2, 2) rational function fitted by this crate (minimax on the relative
+/// error, see `tests/ltc_integrals.rs`); for `x < 0` it uses the reflection
+/// `theta / sin(theta) = pi / sin(theta) - (pi - theta) / sin(pi - theta)`, which needs one
+/// square root. Maximum relative error over `[-1, 1]`: [`EDGE_FACTOR_RATIONAL_MAX_ERROR`]
+/// (the factor diverges as `x -> -1`; `1 - x^2` is clamped at `1e-14`).
+#[inline]
+#[must_use]
+pub fn edge_factor_rational(x: f64) -> f64 {
+    let y = x.abs();
+    let v =
+        (5.429131712 + (3.130161863 + 0.089934273 * y) * y) / (3.456294690 + (4.192928007 + y) * y);
+    if x >= 0.0 {
+        v
+    } else {
+        PI / crate::math::sqrt((1.0 - x * x).max(1e-14)) - v
+    }
+}
+
+/// Largest relative error of [`edge_factor_rational`] against `acos(x) / sqrt(1 - x^2)` over
+/// `[-1, 1]`, as measured on a dense grid by the tests.
+pub const EDGE_FACTOR_RATIONAL_MAX_ERROR: f64 = 6.1e-7;
+
+/// [`clamped_cosine_integral`] with the edge factor from [`edge_factor_rational`] instead of an
+/// `atan2` per edge: exact clipping, approximate edge terms. Each edge term is off by at most
+/// [`EDGE_FACTOR_RATIONAL_MAX_ERROR`] times `theta_e`, so the result is off by at most that
+/// constant times the clipped polygon's perimeter over `2 pi` (below the constant itself for a
+/// convex polygon, whose perimeter inside a hemisphere is below `2 pi`).
+#[must_use]
+pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
+    let clipped = poly.clip_to_hemisphere(DVec3::Z);
+    let mut sum = 0.0;
+    for ring in clipped.rings() {
+        let n = ring.len();
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            sum += edge_factor_rational(a.dot(b)) * a.cross(b).z;
+        }
+    }
+    (sum / (2.0 * PI)).clamp(0.0, 1.0)
+}
+
+/// Integral of a linearly transformed cosine over a polygon in the shading frame: the polygon is
+/// mapped by `m_inv` (HDHN16 eq. 14: integrating `D` over `P` equals integrating the clamped
+/// cosine over `M^-1 P`) and its clamped-cosine integral is taken. Multiply by the lookup's
+/// normalization (`LtcLookup::norm`, `specular_scale`) for the specular response.
+///
+/// # Errors
+///
+/// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
+pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
+    Ok(clamped_cosine_integral(&poly.transformed(m_inv)?))
+}
+
 /// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem
 /// (Baum, Rushmeier and Winget 1989; HDHN16 eq. 11): `(1 / 2 pi) sum theta_e n_e . z`.
 fn boundary_sum(poly: &SphericalPolygon) -> f64 {

@@ -194,6 +194,44 @@ impl SphericalPolygon {
         out
     }
 
+    /// The image of the region under the linear map `m` applied to directions: each vertex `v`
+    /// becomes `m v / |m v|`. Great circles map to great circles, so the rings stay valid; a map
+    /// with negative determinant mirrors the sphere, and the rings are reversed to keep the
+    /// interior on the left. This is how a polygon enters the space of a linearly transformed
+    /// cosine (HDHN16 section 3).
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::Degenerate`] when `m` is singular (or nearly so: `|det m|` below `1e-12`
+    /// times the product of its column lengths) or not finite.
+    pub fn transformed(&self, m: glam::DMat3) -> Result<SphericalPolygon, GeomError> {
+        let det = m.determinant();
+        let scale = m.x_axis.length() * m.y_axis.length() * m.z_axis.length();
+        if !det.is_finite() || !(det.abs() > 1e-12 * scale) {
+            return Err(GeomError::Degenerate(
+                "the linear map is singular or not finite",
+            ));
+        }
+        if self.full || self.ends.is_empty() {
+            return Ok(self.clone());
+        }
+        let mut out = self.clone();
+        for v in out.verts.iter_mut() {
+            *v = normalize_any(m * *v)
+                .ok_or(GeomError::Degenerate("a vertex maps to the zero vector"))?;
+        }
+        Ok(if det < 0.0 {
+            let mut start = 0usize;
+            for &e in &self.ends {
+                out.verts[start..e as usize].reverse();
+                start = e as usize;
+            }
+            out
+        } else {
+            out
+        })
+    }
+
     /// Solid angle of the region in steradians, in `[0, 4 pi]`.
     ///
     /// Each ring's left region is measured as a fan of Van Oosterom–Strackee triangles from one of
