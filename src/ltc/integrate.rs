@@ -75,6 +75,36 @@ pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, 
     Ok(clamped_cosine_integral(&poly.transformed(m_inv)?))
 }
 
+/// The GGX specular response to a uniform unit-radiance polygon light: approximately
+/// `integral over P of f(v, l) F(v, l) cos(theta_l) dl` with the height-correlated GGX BRDF and
+/// Schlick's Fresnel with reflectance `f0` (HDHN16 section 4 and eq. 14; the albedo/Fresnel split
+/// follows the Fresnel tables of this crate's fit).
+///
+/// `poly` is given in the shading frame (normal `+z`, view in the xz-plane with `x >= 0`) with
+/// the view at `cos_theta_v` from the normal; `alpha` is GGX's roughness parameter (`alpha =
+/// roughness^2` in the usual artist mapping). The table lookup, the transform by `M^-1`, the
+/// exact horizon clip and Baum's edge sum are all evaluated here.
+///
+/// # Errors
+///
+/// [`crate::GeomError::OutOfRange`] for NaN parameters (see [`super::lookup`]).
+pub fn ggx_polygon_integral(
+    poly: &SphericalPolygon,
+    cos_theta_v: f64,
+    alpha: f64,
+    f0: f64,
+) -> Result<f64, crate::GeomError> {
+    if !f0.is_finite() {
+        return Err(crate::GeomError::OutOfRange {
+            what: "Fresnel reflectance f0",
+            value: f0,
+            limit: 1.0,
+        });
+    }
+    let l = super::lookup(cos_theta_v, alpha)?;
+    Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * ltc_integral(poly, l.m_inv)?)
+}
+
 /// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem
 /// (Baum, Rushmeier and Winget 1989; HDHN16 eq. 11): `(1 / 2 pi) sum theta_e n_e . z`.
 fn boundary_sum(poly: &SphericalPolygon) -> f64 {
