@@ -220,3 +220,28 @@ proptest! {
         prop_assert!((exact - quad).abs() <= 1e-8, "{} vs quadrature {}", exact, quad);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(512), ..ProptestConfig::default() })]
+
+    /// The stack-only clip-free LTC path agrees with transform + exact clip, for any matrix
+    /// (mirroring ones included), and the rational path stays within its bound.
+    #[test]
+    fn fast_ltc_paths_agree_with_exact(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let mut rng = Rng::new(seed ^ 0x17C);
+        let m = DMat3::from_cols(rng.dir() * rng.range(0.2, 3.0), rng.dir(), rng.dir() * rng.range(0.2, 3.0));
+        let Ok(t) = p.transformed(m) else { return Ok(()); };
+        let exact = clamped_cosine_integral(&t);
+        let fast = ltc_integral(&p, m).unwrap();
+        prop_assert!((exact - fast).abs() <= 1e-12, "{} vs {}", exact, fast);
+        let perimeter: f64 = boundary_edges(&t.clip_to_hemisphere(DVec3::Z))
+            .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
+            .sum();
+        let rational = ltc_integral_rational(&p, m).unwrap();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+        prop_assert!((exact - rational).abs() <= bound, "{} vs {} (bound {})", exact, rational, bound);
+    }
+}

@@ -3,6 +3,7 @@
 use core::f64::consts::PI;
 
 use glam::DVec3;
+use smallvec::SmallVec;
 
 use crate::sphere::{HORIZON_TOLERANCE, SphericalPolygon};
 
@@ -72,7 +73,36 @@ pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
 ///
 /// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
 pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
-    Ok(clamped_cosine_integral(&poly.transformed(m_inv)?))
+    // The stack-only clip-free path (thesis 003 eq. 4.6/4.7) when the map keeps orientation;
+    // the exact clip otherwise. Both agree to rounding (tested).
+    if poly.is_full() || poly.is_empty() || !(m_inv.determinant() > 0.0) {
+        return Ok(clamped_cosine_integral(&poly.transformed(m_inv)?));
+    }
+    match transformed_clip_free(poly, m_inv, edge_term) {
+        Some(v) => Ok(v),
+        None => Ok(clamped_cosine_integral(&poly.transformed(m_inv)?)),
+    }
+}
+
+/// [`ltc_integral`] with the rational edge factor ([`edge_factor_rational`]): one `atan2` in total
+/// per polygon (for the horizon arcs), none per edge. Error bound as for
+/// [`clamped_cosine_integral_rational`], applied to the transformed polygon.
+///
+/// # Errors
+///
+/// As [`ltc_integral`].
+pub fn ltc_integral_rational(
+    poly: &SphericalPolygon,
+    m_inv: glam::DMat3,
+) -> Result<f64, crate::GeomError> {
+    let rational = |a: DVec3, b: DVec3| edge_factor_rational(a.dot(b)) * a.cross(b).z;
+    if poly.is_full() || poly.is_empty() || !(m_inv.determinant() > 0.0) {
+        return Ok(clamped_cosine_integral_rational(&poly.transformed(m_inv)?));
+    }
+    match transformed_clip_free(poly, m_inv, rational) {
+        Some(v) => Ok(v),
+        None => Ok(clamped_cosine_integral_rational(&poly.transformed(m_inv)?)),
+    }
 }
 
 /// The GGX specular response to a uniform unit-radiance polygon light: approximately
@@ -164,26 +194,43 @@ pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
     if poly.is_full() {
         return 1.0;
     }
+    clip_free_sum(poly.rings(), edge_term).unwrap_or_else(|| clamped_cosine_integral(poly))
+}
+
+/// The clip-free sum of [`clamped_cosine_integral_clip_free`] over rings of unit vectors, with
+/// the edge term given; `None` where the exact path must decide (a vertex on the horizon, or no
+/// crossing while some vertex is below).
+fn clip_free_sum<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    edge: impl Fn(DVec3, DVec3) -> f64,
+) -> Option<f64> {
     let mut sum = 0.0;
     // Running complex product of entry points and conjugates of exit points on the horizon.
     let (mut re, mut im) = (1.0f64, 0.0f64);
     let mut crossings = 0usize;
+    let mut any_below = false;
+    let mut any = false;
     // Twice the signed area of the rings projected from +z, for the no-crossing case.
     let mut planar_area2 = 0.0;
-    for ring in poly.rings() {
+    for ring in rings {
         let n = ring.len();
         for i in 0..n {
+            any = true;
             let (a, b) = (ring[i], ring[(i + 1) % n]);
-            if a.z.abs() <= HORIZON_TOLERANCE || b.z.abs() <= HORIZON_TOLERANCE {
-                return clamped_cosine_integral(poly);
+            if a.z.abs() <= HORIZON_TOLERANCE {
+                return None;
             }
             match (a.z > 0.0, b.z > 0.0) {
                 (true, true) => {
-                    sum += edge_term(a, b);
+                    sum += edge(a, b);
                     planar_area2 += (a.x * b.y - a.y * b.x) / (a.z * b.z);
                 }
-                (false, false) => {}
+                (false, false) => any_below = true,
                 (up_a, _) => {
+                    any_below = true;
+                    if b.z.abs() <= HORIZON_TOLERANCE {
+                        return None;
+                    }
                     // The crossing point, as a positive combination of a and b on the horizon.
                     let x = if up_a {
                         b * a.z - a * b.z
@@ -194,27 +241,47 @@ pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
                     let (pr, pi) = (x.x, if up_a { -x.y } else { x.y });
                     (re, im) = (re * pr - im * pi, re * pi + im * pr);
                     crossings += 1;
-                    if up_a {
-                        sum += edge_term(a, x);
-                    } else {
-                        sum += edge_term(x, b);
-                    }
+                    sum += if up_a { edge(a, x) } else { edge(x, b) };
                 }
             }
         }
     }
     let horizon = if crossings > 0 {
         crate::math::atan2(im, re).rem_euclid(2.0 * PI)
-    } else if poly.vertex_count() == 0 {
+    } else if !any {
         0.0
-    } else if poly.rings().flatten().all(|p| p.z > 0.0) {
+    } else if !any_below {
         // Everything strictly above: the horizon is inside the region iff the rings, seen from
         // +z, wind clockwise overall (the unbounded planar face is then inside).
         if planar_area2 < 0.0 { 2.0 * PI } else { 0.0 }
     } else {
-        return clamped_cosine_integral(poly);
+        return None;
     };
-    ((sum + horizon) / (2.0 * PI)).clamp(0.0, 1.0)
+    Some(((sum + horizon) / (2.0 * PI)).clamp(0.0, 1.0))
+}
+
+/// Maps every vertex by `m` and normalizes, into a stack buffer, and runs the clip-free sum on
+/// the images; `None` when the exact path is needed (or `m` mirrors, reversing orientation).
+fn transformed_clip_free(
+    poly: &SphericalPolygon,
+    m: glam::DMat3,
+    edge: impl Fn(DVec3, DVec3) -> f64,
+) -> Option<f64> {
+    let mut buf: SmallVec<[DVec3; 16]> = SmallVec::new();
+    let mut ends: SmallVec<[usize; 2]> = SmallVec::new();
+    for ring in poly.rings() {
+        for &v in ring {
+            buf.push((m * v).try_normalize()?);
+        }
+        ends.push(buf.len());
+    }
+    let mut start = 0;
+    let rings = ends.iter().map(|&e| {
+        let r = &buf[start..e];
+        start = e;
+        r
+    });
+    clip_free_sum(rings, edge)
 }
 
 #[cfg(test)]

@@ -48,5 +48,6 @@ pub use ggx::{GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pd
 pub use integrate::{
     EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral, clamped_cosine_integral_clip_free,
     clamped_cosine_integral_rational, edge_factor_rational, ggx_polygon_integral, ltc_integral,
+    ltc_integral_rational,
 };
 pub use table::{LtcLookup, LtcTable, lookup};

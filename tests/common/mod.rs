@@ -43,15 +43,16 @@ pub fn polar(c: DVec3, rho: f64, theta: f64) -> DVec3 {
 }
 
 /// A ring star-shaped about `c` (counter-clockwise seen from outside): `n` sorted azimuths with
-/// gaps below 2 pi / 3 and radii in `[rho * shrink, rho]`.
+/// gaps below pi (at most 1.4 times the even spacing) and radii in `[rho * shrink, rho]`.
 pub fn star_ring(rng: &mut Rng, c: DVec3, n: usize, rho: f64, shrink: f64) -> Vec<DVec3> {
     let n = n.max(3);
-    // Evenly spaced azimuths jittered by at most a third of the spacing keep every gap < 2pi/3.
+    // Evenly spaced azimuths jittered by at most a fifth of the spacing: every gap is below
+    // 1.4 * 2 pi / 3 < pi, so c sees every edge from inside and fans from c cover the ring once.
     let step = 2.0 * PI / n as f64;
     let start = rng.range(0.0, 2.0 * PI);
     (0..n)
         .map(|i| {
-            let th = start + step * (i as f64 + rng.range(-0.3, 0.3));
+            let th = start + step * (i as f64 + rng.range(-0.2, 0.2));
             polar(c, rho * rng.range(shrink, 1.0), th)
         })
         .collect()
