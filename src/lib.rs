@@ -35,3 +35,8 @@ pub mod planar;
 pub mod sphere;
 
 pub use error::GeomError;
+
+// The README's example is compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

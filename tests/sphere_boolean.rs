@@ -39,7 +39,7 @@ fn pair(seed: u64) -> Option<(SphericalPolygon, SphericalPolygon)> {
     let mut rng = Rng::new(seed);
     let c = rng.dir();
     let a = polygon_about(&mut rng, c)?;
-    let b = match rng.next_u64() % 5 {
+    let b = match rng.next_u64() % 6 {
         0 => a.clone(),
         1 => a.complement(),
         2 => {
@@ -54,8 +54,14 @@ fn pair(seed: u64) -> Option<(SphericalPolygon, SphericalPolygon)> {
                 .collect();
             SphericalPolygon::new(vec![keep]).ok()?
         }
-        _ => {
+        3 => {
             let d = (c + rng.dir() * rng.range(0.0, 0.8)).normalize();
+            polygon_about(&mut rng, d)?
+        }
+        _ => {
+            // Far apart: the operands' vertices span more than a hemisphere, which sends the
+            // operation through the octant split.
+            let d = (-c + rng.dir() * rng.range(0.0, 0.5)).normalize();
             polygon_about(&mut rng, d)?
         }
     };
@@ -264,4 +270,50 @@ fn regression_hole_pinched_at_all_its_vertices() {
     // validity check then probed a shared vertex and misjudged the nesting.
     let (a, b) = pair(9528998366313849765).unwrap();
     check_identities(&a, &b).unwrap();
+}
+
+#[test]
+fn near_antipodal_operands() {
+    // Lunes from the north pole to within 1e-6 of the south pole (edges nearly pi long), against
+    // a band around the equator and against each other.
+    let lune = |phi0: f64, phi1: f64| {
+        let eq = |phi: f64| DVec3::new(phi.cos(), phi.sin(), 0.0);
+        let south = DVec3::new(1e-6, 0.0, -1.0).normalize();
+        SphericalPolygon::new(vec![vec![DVec3::Z, eq(phi0), south, eq(phi1)]]).unwrap()
+    };
+    let band = SphericalPolygon::new(vec![vec![
+        DVec3::new(1.0, -0.5, -0.2),
+        DVec3::new(1.0, 0.5, -0.2),
+        DVec3::new(1.0, 0.5, 0.2),
+        DVec3::new(1.0, -0.5, 0.2),
+    ]])
+    .unwrap();
+    let cases = [
+        (lune(-0.3, 0.3), band.clone()),
+        (lune(-0.3, 0.3), lune(0.0, 0.6)),
+        (lune(-0.3, 0.3).complement(), band.clone()),
+        (lune(0.2, 2.8), lune(2.7, 4.0)),
+    ];
+    for (k, (a, b)) in cases.iter().enumerate() {
+        check_identities(a, b).unwrap();
+        for op in [BoolOp::Difference, BoolOp::Intersection] {
+            let r = a.boolean(b, op).unwrap();
+            let mut rng = Rng::new(k as u64);
+            let mc = mc_solid_angle(&mut rng, 64, 128, |d| {
+                let (x, y) = (a.contains(d), b.contains(d));
+                if op == BoolOp::Difference {
+                    x && !y
+                } else {
+                    x && y
+                }
+            });
+            let cells = crossed_cells(boundary_edges(a).chain(boundary_edges(b)), 64, 128);
+            assert_mc_agrees(
+                r.solid_angle(),
+                mc,
+                cells,
+                &format!("near-antipodal case {k} {op:?}"),
+            );
+        }
+    }
 }
