@@ -53,7 +53,7 @@ use glam::{DMat3, DVec2, DVec3};
 
 use super::distribution::Ltc;
 use super::ggx::{ggx_brdf_cos, ggx_sample_vndf, ggx_vndf_pdf};
-use super::table::{CHANNELS, Grid, LtcTable, ViewAxis};
+use super::table::{CHANNELS, Grid, LtcTable};
 use crate::GeomError;
 
 /// Which objective and grid to fit; see the [module documentation](self).
@@ -78,14 +78,12 @@ impl FitMode {
         match self {
             FitMode::Arealight => Grid {
                 n,
-                view: ViewAxis::SqrtOneMinusCos,
                 cos_min: 1e-3,
                 alpha_min: 1e-4,
                 rough_from_zero: false,
             },
             FitMode::Reference => Grid {
                 n,
-                view: ViewAxis::SqrtOneMinusCos,
                 cos_min: 1.57f64.cos(),
                 alpha_min: 1e-4,
                 rough_from_zero: true,
