@@ -58,8 +58,8 @@ fn albedo_tends_to_one_for_smooth_surfaces_at_normal_incidence() {
         prev = a;
     }
     assert!(prev > 0.995 && prev <= 1.0 + 1e-6, "albedo at alpha 0.01: {prev}");
-    // At grazing view the height-correlated masking removes a large part of the energy.
-    assert!(albedo_quad(view(0.05), 0.5) < 0.7);
+    // Rougher surfaces lose more energy at normal incidence (single scattering only).
+    assert!(albedo_quad(DVec3::Z, 1.0) < albedo_quad(DVec3::Z, 0.5));
 }
 
 #[test]
@@ -95,7 +95,9 @@ fn vndf_pdf_integrates_to_one() {
     for &alpha in &[0.01, 0.1, 0.4, 1.0] {
         for &c in &[1.0, 0.7, 0.3, 0.02] {
             let v = view(c);
-            let i = sphere_quad(mirror(v), 3.0, 1200, 256, |l| ggx_vndf_pdf(v, l, alpha));
+            // At grazing view the lobe of reflected directions is strongly anisotropic: resolve
+            // the azimuth finely.
+            let i = sphere_quad(mirror(v), 3.0, 1200, 2048, |l| ggx_vndf_pdf(v, l, alpha));
             assert!((i - 1.0).abs() < 2e-3, "alpha {alpha} cos {c}: {i}");
         }
     }
