@@ -25,7 +25,9 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 fn evaluate(name: &str, fitted: &FittedTable, count: usize) {
     let mut state = 0x1234_5678_9abc_def0u64;
     let mut next = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let mut errs = Vec::with_capacity(count);
@@ -118,7 +120,10 @@ fn main() {
                 eprintln!("  reference fit: {d}/{total} cells");
             }
         });
-        println!("reference-reproduction fit: {:.1} s", t1.elapsed().as_secs_f64());
+        println!(
+            "reference-reproduction fit: {:.1} s",
+            t1.elapsed().as_secs_f64()
+        );
         evaluate("reference", &theirs, 400);
     }
 }

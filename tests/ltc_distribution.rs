@@ -15,11 +15,7 @@ fn random_matrix(rng: &mut Rng) -> DMat3 {
         rng.range(-1.5, 1.5),
         rng.range(-3.0, 3.0),
     );
-    let diag = DMat3::from_diagonal(DVec3::new(
-        rng.range(0.08, 1.0),
-        rng.range(0.08, 1.0),
-        1.0,
-    ));
+    let diag = DMat3::from_diagonal(DVec3::new(rng.range(0.08, 1.0), rng.range(0.08, 1.0), 1.0));
     let shear = DMat3::from_cols(
         DVec3::X,
         DVec3::Y,
@@ -41,11 +37,19 @@ fn density_integrates_to_one_for_arbitrary_matrices() {
         let m = random_matrix(&mut rng);
         let ltc = Ltc::new(m).unwrap();
         let total = sphere_quad(peak(&ltc), 2.0, 800, 400, |w| ltc.density(w));
-        assert!((total - 1.0).abs() < 2e-3, "case {case}: {m:?} integrates to {total}");
+        assert!(
+            (total - 1.0).abs() < 2e-3,
+            "case {case}: {m:?} integrates to {total}"
+        );
         // The horizon mass formula against quadrature of the density over z > 0.
-        let upper = sphere_quad(peak(&ltc), 2.0, 800, 400, |w| if w.z > 0.0 { ltc.density(w) } else { 0.0 });
+        let upper = sphere_quad(peak(&ltc), 2.0, 800, 400, |w| {
+            if w.z > 0.0 { ltc.density(w) } else { 0.0 }
+        });
         let h = ltc.upper_hemisphere_mass();
-        assert!((upper - h).abs() < 3e-3, "case {case}: upper mass {upper} vs formula {h}");
+        assert!(
+            (upper - h).abs() < 3e-3,
+            "case {case}: upper mass {upper} vs formula {h}"
+        );
     }
 }
 
@@ -56,7 +60,12 @@ fn inverse_constructor_is_consistent() {
         let m = random_matrix(&mut rng);
         let a = Ltc::new(m).unwrap();
         let b = Ltc::from_inverse(m.inverse()).unwrap();
-        let w = DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)).normalize();
+        let w = DVec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        )
+        .normalize();
         let (da, db) = (a.density(w), b.density(w));
         assert!((da - db).abs() <= 1e-9 * da.max(1.0), "{da} vs {db}");
     }
@@ -86,10 +95,16 @@ fn samples_follow_the_density() {
 fn invalid_matrices_are_errors() {
     let nan = DMat3::from_diagonal(DVec3::new(f64::NAN, 1.0, 1.0));
     assert!(matches!(Ltc::new(nan), Err(GeomError::NonFinite { .. })));
-    assert!(matches!(Ltc::from_inverse(nan), Err(GeomError::NonFinite { .. })));
+    assert!(matches!(
+        Ltc::from_inverse(nan),
+        Err(GeomError::NonFinite { .. })
+    ));
     let singular = DMat3::from_cols(DVec3::X, DVec3::X, DVec3::Z);
     assert!(matches!(Ltc::new(singular), Err(GeomError::Degenerate(_))));
-    assert!(matches!(Ltc::new(DMat3::ZERO), Err(GeomError::Degenerate(_))));
+    assert!(matches!(
+        Ltc::new(DMat3::ZERO),
+        Err(GeomError::Degenerate(_))
+    ));
     // A valid LTC returns NaN, not a panic, for a NaN direction.
     let ltc = Ltc::new(DMat3::IDENTITY).unwrap();
     assert!(ltc.density(DVec3::NAN).is_nan());

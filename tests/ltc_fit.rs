@@ -14,5 +14,8 @@ fn quad_shading_meets_the_issue_goal() {
     println!("random quads, |LTC - brute force| / albedo: median {median:.5}, p90 {p90:.5}");
     // The issue's goal: median <= 0.2 %, p90 <= 1.5 %. The public reference tables (and our
     // reproduction of their fit, 0.28 % / 2.35 % on the fitter's 300 quads) fail the p90 bound.
-    assert!(median <= 0.002 && p90 <= 0.015, "median {median}, p90 {p90}");
+    assert!(
+        median <= 0.002 && p90 <= 0.015,
+        "median {median}, p90 {p90}"
+    );
 }

@@ -30,7 +30,10 @@ fn lookup_at_nodes_returns_stored_values() {
             let got = channels(&t.lookup(c, a).unwrap());
             let want = channels(&t.node_lookup(j, k).unwrap());
             for (g, w) in got.iter().zip(want) {
-                assert!((g - w).abs() <= 1e-9 * w.abs().max(1.0), "node ({j}, {k}): {got:?} vs {want:?}");
+                assert!(
+                    (g - w).abs() <= 1e-9 * w.abs().max(1.0),
+                    "node ({j}, {k}): {got:?} vs {want:?}"
+                );
             }
         }
     }
@@ -55,17 +58,27 @@ fn lookup_is_bilinear_between_nodes() {
         // Interpolation weights, recovered from 1D lookups along the cell's edges (so the test does
         // not assume the grid's parameterisation): the weight of the channel that changes most.
         let weight = |lo: &[f64; 7], hi: &[f64; 7], mid: &[f64; 7]| {
-            let ch = (0..7).max_by(|&x, &y| (hi[x] - lo[x]).abs().total_cmp(&(hi[y] - lo[y]).abs())).unwrap();
+            let ch = (0..7)
+                .max_by(|&x, &y| (hi[x] - lo[x]).abs().total_cmp(&(hi[y] - lo[y]).abs()))
+                .unwrap();
             let w = (mid[ch] - lo[ch]) / (hi[ch] - lo[ch]);
-            assert!((-1e-9..=1.0 + 1e-9).contains(&w), "weight {w} outside the cell");
+            assert!(
+                (-1e-9..=1.0 + 1e-9).contains(&w),
+                "weight {w} outside the cell"
+            );
             w
         };
         let tx = weight(&v00, &v10, &channels(&t.lookup(c, a0).unwrap()));
         let ty = weight(&v00, &v01, &channels(&t.lookup(c0, a).unwrap()));
         let got = channels(&t.lookup(c, a).unwrap());
         for ch in 0..7 {
-            let want = (v00[ch] * (1.0 - tx) + v10[ch] * tx) * (1.0 - ty) + (v01[ch] * (1.0 - tx) + v11[ch] * tx) * ty;
-            assert!((got[ch] - want).abs() <= 1e-9 * want.abs().max(1.0), "channel {ch}: {} vs {want}", got[ch]);
+            let want = (v00[ch] * (1.0 - tx) + v10[ch] * tx) * (1.0 - ty)
+                + (v01[ch] * (1.0 - tx) + v11[ch] * tx) * ty;
+            assert!(
+                (got[ch] - want).abs() <= 1e-9 * want.abs().max(1.0),
+                "channel {ch}: {} vs {want}",
+                got[ch]
+            );
         }
     }
 }
@@ -73,16 +86,37 @@ fn lookup_is_bilinear_between_nodes() {
 #[test]
 fn out_of_range_inputs_clamp_and_nan_is_an_error() {
     let t = LtcTable::ggx();
-    assert!(matches!(lookup(f64::NAN, 0.3), Err(GeomError::OutOfRange { .. })));
-    assert!(matches!(lookup(0.3, f64::NAN), Err(GeomError::OutOfRange { .. })));
+    assert!(matches!(
+        lookup(f64::NAN, 0.3),
+        Err(GeomError::OutOfRange { .. })
+    ));
+    assert!(matches!(
+        lookup(0.3, f64::NAN),
+        Err(GeomError::OutOfRange { .. })
+    ));
     let same = |a: LtcLookup, b: LtcLookup| assert_eq!(channels(&a), channels(&b));
-    same(lookup(-0.5, 0.3).unwrap(), lookup(t.cos_min(), 0.3).unwrap());
-    same(lookup(f64::NEG_INFINITY, 0.3).unwrap(), lookup(t.cos_min(), 0.3).unwrap());
+    same(
+        lookup(-0.5, 0.3).unwrap(),
+        lookup(t.cos_min(), 0.3).unwrap(),
+    );
+    same(
+        lookup(f64::NEG_INFINITY, 0.3).unwrap(),
+        lookup(t.cos_min(), 0.3).unwrap(),
+    );
     same(lookup(1.5, 0.3).unwrap(), lookup(1.0, 0.3).unwrap());
     same(lookup(0.5, 7.0).unwrap(), lookup(0.5, 1.0).unwrap());
-    same(lookup(0.5, f64::INFINITY).unwrap(), lookup(0.5, 1.0).unwrap());
-    same(lookup(0.5, 0.0).unwrap(), lookup(0.5, t.alpha_min()).unwrap());
-    same(lookup(0.5, -1.0).unwrap(), lookup(0.5, t.alpha_min()).unwrap());
+    same(
+        lookup(0.5, f64::INFINITY).unwrap(),
+        lookup(0.5, 1.0).unwrap(),
+    );
+    same(
+        lookup(0.5, 0.0).unwrap(),
+        lookup(0.5, t.alpha_min()).unwrap(),
+    );
+    same(
+        lookup(0.5, -1.0).unwrap(),
+        lookup(0.5, t.alpha_min()).unwrap(),
+    );
 }
 
 #[test]
@@ -94,7 +128,12 @@ fn every_node_is_a_valid_ltc_with_sane_scalars() {
             assert!(l.ltc().is_ok(), "node ({j}, {k}) singular");
             assert!(l.albedo > 0.0 && l.albedo <= 1.0, "albedo {}", l.albedo);
             assert!((0.0..=1.0).contains(&l.fresnel), "fresnel {}", l.fresnel);
-            assert!(l.norm >= l.albedo * (1.0 - 1e-12), "norm {} < albedo {}", l.norm, l.albedo);
+            assert!(
+                l.norm >= l.albedo * (1.0 - 1e-12),
+                "norm {} < albedo {}",
+                l.norm,
+                l.albedo
+            );
         }
     }
 }
@@ -113,8 +152,16 @@ fn albedo_and_fresnel_match_quadrature() {
             ggx_brdf_cos(v, l, alpha) * (1.0 - v.dot(h).clamp(0.0, 1.0)).powi(5)
         }) / a;
         let l = lookup(c, alpha).unwrap();
-        assert!((l.albedo - a).abs() < 5e-3, "cos {c} alpha {alpha}: table {} quadrature {a}", l.albedo);
-        assert!((l.fresnel - f).abs() < 5e-3, "cos {c} alpha {alpha}: table {} quadrature {f}", l.fresnel);
+        assert!(
+            (l.albedo - a).abs() < 5e-3,
+            "cos {c} alpha {alpha}: table {} quadrature {a}",
+            l.albedo
+        );
+        assert!(
+            (l.fresnel - f).abs() < 5e-3,
+            "cos {c} alpha {alpha}: table {} quadrature {f}",
+            l.fresnel
+        );
     }
 }
 
@@ -127,9 +174,17 @@ fn relative_l1(l: &LtcLookup, c: f64, alpha: f64, n: usize, rng: &mut Rng) -> f6
     let (mut err, mut albedo) = (0.0, 0.0);
     for i in 0..n {
         for j in 0..n {
-            let mut u = || DVec2::new((i as f64 + rng.f64()) / n as f64, (j as f64 + rng.f64()) / n as f64);
+            let mut u = || {
+                DVec2::new(
+                    (i as f64 + rng.f64()) / n as f64,
+                    (j as f64 + rng.f64()) / n as f64,
+                )
+            };
             let (ub, ul) = (u(), u());
-            for (w, from_brdf) in [(ggx_sample_vndf(v, alpha, ub), true), (ltc.sample(ul), false)] {
+            for (w, from_brdf) in [
+                (ggx_sample_vndf(v, alpha, ub), true),
+                (ltc.sample(ul), false),
+            ] {
                 let fc = ggx_brdf_cos(v, w, alpha);
                 let d = ltc.density(w);
                 let pdf = ggx_vndf_pdf(v, w, alpha);
@@ -169,12 +224,18 @@ fn fitted_ltc_matches_the_brdf() {
     let mut e = fit_errors(1.0);
     let (median, p90) = (percentile(&mut e, 0.5), percentile(&mut e, 0.9));
     println!("relative L1 of the shipped table: median {median:.4}, p90 {p90:.4}");
-    assert!(median < MEDIAN_MAX && p90 < P90_MAX, "median {median}, p90 {p90}");
+    assert!(
+        median < MEDIAN_MAX && p90 < P90_MAX,
+        "median {median}, p90 {p90}"
+    );
     // The bounds discriminate: the table looked up at the wrong roughness (x 1.5) fails them.
     let mut bad = fit_errors(1.5);
     let (bm, bp) = (percentile(&mut bad, 0.5), percentile(&mut bad, 0.9));
     println!("relative L1 at 1.5 x alpha: median {bm:.4}, p90 {bp:.4}");
-    assert!(bm > MEDIAN_MAX || bp > P90_MAX, "a wrong lookup passed: {bm}, {bp}");
+    assert!(
+        bm > MEDIAN_MAX || bp > P90_MAX,
+        "a wrong lookup passed: {bm}, {bp}"
+    );
 }
 
 // Measured for the shipped table: median 0.039, p90 0.164 (fitter's own 64^2-sample estimate at

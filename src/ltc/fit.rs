@@ -1,17 +1,17 @@
 //! The LTC table fitter (feature `fit`): fits the GGX tables that `table_data.rs` ships.
 //!
 //! Run it with `cargo run --release --features fit --example fit_ltc`; it rewrites
-//! `src/ltc/table_data.rs`. The procedure follows [HDHN16] §4.2 with the refinements of the public
+//! `src/ltc/table_data.rs`. The procedure follows \[HDHN16\] §4.2 with the refinements of the public
 //! implementation, and one change of objective:
 //!
 //! 1. For each cell (view cosine, roughness) of the grid, estimate the directional albedo `A`, the
 //!    Fresnel weight and the average direction `Z` of the cosine-weighted BRDF `f cos` with
-//!    stratified visible-normal samples ([Hei18]). `Z` lies in the xz-plane; `X = Y x Z`, `Y = y`.
+//!    stratified visible-normal samples (\[Hei18\]). `Z` lies in the xz-plane; `X = Y x Z`, `Y = y`.
 //! 2. Parameterise the LTC in the frame of `Z`: `M = [X Y Z] S` with
 //!    `S = [[m11, 0, m13], [0, m22, 0], [m31, 0, 1]]`, optimised as `ln m11`, `ln m22`, `m13`
 //!    (and `m31`), so that the simplex adapts to lobes of any width down to `alpha = 1e-4`. The
 //!    reference fit keeps `m31 = 0` (three parameters); ours frees it, which is the fourth degree
-//!    of freedom of [HDHN16] §4.2 (`M = [[a, 0, b], [0, c, 0], [d, 0, 1]]`) expressed in the
+//!    of freedom of \[HDHN16\] §4.2 (`M = [[a, 0, b], [0, c, 0], [d, 0, 1]]`) expressed in the
 //!    frame of the average direction.
 //! 3. Minimise a sampled error between the LTC and `f cos / A` with Nelder–Mead, warm-started from
 //!    the neighbouring cell. The error is estimated by multiple importance sampling (balance
@@ -28,9 +28,9 @@
 //!   uniform in `sqrt(alpha)` from `alpha = 1e-4` and in `sqrt(1 - cos theta)` down to
 //!   `cos theta = 1e-3`.
 //! - [`FitMode::Reference`]: a straightforward reproduction of the public implementation's fit,
-//!    for comparison: the cubed error `integral |f cos - A D|^3 / (pdf_brdf + pdf_ltc)` of the
-//!    unclipped LTC scaled by `norm = A`, on the grid `alpha = max(r^2, 1e-4)` with `r` uniform
-//!    from 0 and `theta = min(acos(1 - x^2), 1.57)`.
+//!   for comparison: the cubed error `integral |f cos - A D|^3 / (pdf_brdf + pdf_ltc)` of the
+//!   unclipped LTC scaled by `norm = A`, on the grid `alpha = max(r^2, 1e-4)` with `r` uniform
+//!   from 0 and `theta = min(acos(1 - x^2), 1.57)`.
 //!
 //! After the warm-started sweep, two refinement passes re-start the optimiser in each cell from
 //! each neighbour's solution when that is better there, so that no cell (in particular at
@@ -38,10 +38,10 @@
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
-//! - [Hei18] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
-//! - [NM65] J. A. Nelder, R. Mead. *A simplex method for function minimization.* The Computer
+//! - \[Hei18\] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
+//! - \[NM65\] J. A. Nelder, R. Mead. *A simplex method for function minimization.* The Computer
 //!   Journal 7(4), 1965.
 
 use std::fmt::Write as _;
@@ -283,7 +283,7 @@ impl Cell {
         match mode {
             FitMode::Arealight => {
                 let h = ltc.upper_hemisphere_mass();
-                if !(h > 1e-6) {
+                if h.is_nan() || h <= 1e-6 {
                     return BAD;
                 }
                 let term = |fc: f64, d: f64, pdf: f64, up: bool| {
@@ -304,7 +304,12 @@ impl Cell {
                         continue;
                     }
                     let fc = ggx_brdf_cos(self.v, l, self.alpha);
-                    err += term(fc, ltc.density(l), ggx_vndf_pdf(self.v, l, self.alpha), true);
+                    err += term(
+                        fc,
+                        ltc.density(l),
+                        ggx_vndf_pdf(self.v, l, self.alpha),
+                        true,
+                    );
                 }
             }
             FitMode::Reference => {
@@ -327,7 +332,7 @@ impl Cell {
     }
 }
 
-/// Nelder–Mead [NM65] in `D` dimensions with the standard coefficients (reflection 1, expansion
+/// Nelder–Mead \[NM65\] in `D` dimensions with the standard coefficients (reflection 1, expansion
 /// 2, contraction 1/2, shrink 1/2); returns the best point and value.
 fn nelder_mead<const D: usize>(
     f: &dyn Fn(&[f64; D]) -> f64,
@@ -353,7 +358,8 @@ fn nelder_mead<const D: usize>(
             break;
         }
         // Centroid of all but the worst point.
-        let c: [f64; D] = core::array::from_fn(|i| pts[..D].iter().map(|p| p[i]).sum::<f64>() / D as f64);
+        let c: [f64; D] =
+            core::array::from_fn(|i| pts[..D].iter().map(|p| p[i]).sum::<f64>() / D as f64);
         let xr = lerp(&c, &pts[D], -1.0);
         let fr = f(&xr);
         evals += 1;
@@ -366,7 +372,11 @@ fn nelder_mead<const D: usize>(
             (pts[D], vals[D]) = (xr, fr);
         } else {
             // Outside contraction if the reflection beat the worst point, inside otherwise.
-            let xc = if fr < vals[D] { lerp(&c, &xr, 0.5) } else { lerp(&c, &pts[D], 0.5) };
+            let xc = if fr < vals[D] {
+                lerp(&c, &xr, 0.5)
+            } else {
+                lerp(&c, &pts[D], 0.5)
+            };
             let fc = f(&xc);
             evals += 1;
             if fc < vals[D].min(fr) {
@@ -380,7 +390,9 @@ fn nelder_mead<const D: usize>(
             }
         }
     }
-    let best = (0..=D).min_by(|&a, &b| vals[a].total_cmp(&vals[b])).unwrap_or(0);
+    let best = (0..=D)
+        .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
+        .unwrap_or(0);
     (pts[best], vals[best])
 }
 
@@ -621,7 +633,10 @@ pub fn shading_error(
                 (i as f64 + rng.next_f64()) / n as f64,
                 (j as f64 + rng.next_f64()) / n as f64,
             );
-            for (l, from_brdf) in [(ggx_sample_vndf(v, alpha, u1), true), (ltc.sample(u2), false)] {
+            for (l, from_brdf) in [
+                (ggx_sample_vndf(v, alpha, u1), true),
+                (ltc.sample(u2), false),
+            ] {
                 let fc = ggx_brdf_cos(v, l, alpha);
                 let d = ltc.density(l);
                 let pdf = ggx_vndf_pdf(v, l, alpha);
@@ -641,7 +656,7 @@ pub fn shading_error(
 
 /// Form factor of a polygon of directions (vertices need not be normalised; edges are the
 /// straight segments between them, i.e. great arcs on the sphere) after clipping to `z >= 0`:
-/// `(1 / pi) integral over the polygon of max(0, z) dw`, by Baum's formula ([HDHN16] eq. 11).
+/// `(1 / pi) integral over the polygon of max(0, z) dw`, by Baum's formula (\[HDHN16\] eq. 11).
 /// The absolute value is returned, so the orientation does not matter.
 fn clipped_form_factor(poly: &[DVec3]) -> f64 {
     let mut clipped: Vec<DVec3> = Vec::with_capacity(poly.len() + 2);

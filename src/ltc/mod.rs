@@ -2,8 +2,8 @@
 //!
 //! - [`ggx`]: the GGX BRDF (height-correlated Smith masking) and its visible-normal sampler, the
 //!   ground truth the tables approximate.
-//! - [`Ltc`]: the linearly transformed cosine distribution ([HDHN16] §3): density and sampling.
-//! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup ([HDHN16] §4).
+//! - [`Ltc`]: the linearly transformed cosine distribution (\[HDHN16\] §3): density and sampling.
+//! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup (\[HDHN16\] §4).
 //! - `fit` (feature `fit`): the fitter that generates the tables.
 //!
 //! # Examples
@@ -25,7 +25,7 @@
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
 mod distribution;

@@ -1,4 +1,4 @@
-//! Fitted LTC tables for GGX and their bilinear lookup ([HDHN16] §4).
+//! Fitted LTC tables for GGX and their bilinear lookup (\[HDHN16\] §4).
 //!
 //! For each (view angle, roughness) pair, the table holds the inverse LTC matrix `M^-1` that best
 //! approximates the cosine-weighted GGX BRDF (height-correlated Smith masking, see
@@ -18,9 +18,9 @@
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
-//! - [Sch94] C. Schlick. *An inexpensive BRDF model for physically-based rendering.* Computer
+//! - \[Sch94\] C. Schlick. *An inexpensive BRDF model for physically-based rendering.* Computer
 //!   Graphics Forum 13(3), 1994.
 
 use alloc::borrow::Cow;
@@ -117,12 +117,12 @@ pub(crate) const GGX_GRID: Grid = Grid {
 };
 
 /// One table lookup: the LTC approximating the cosine-weighted GGX BRDF for one view angle and
-/// roughness, and the scalars that scale its polygon integral ([HDHN16] §4).
+/// roughness, and the scalars that scale its polygon integral (\[HDHN16\] §4).
 ///
 /// With `P` a spherical polygon of light directions in the shading frame, the GGX reflectance
 /// (Fresnel-free) over `P` is approximately
 /// `norm * clamped_cosine_integral(M^-1 P)`, where the clamped-cosine integral is clipped to
-/// the upper hemisphere of the cosine space (Baum's formula, [HDHN16] eq. 11). With Schlick's
+/// the upper hemisphere of the cosine space (Baum's formula, \[HDHN16\] eq. 11). With Schlick's
 /// Fresnel and reflectance `f0` at normal incidence, multiply by
 /// [`specular_scale(f0)`](LtcLookup::specular_scale) instead of `norm`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -166,7 +166,7 @@ impl LtcLookup {
     }
 
     /// Scale of the clamped-cosine integral with Schlick's Fresnel
-    /// `F = f0 + (1 - f0) (1 - v.h)^5` ([Sch94]): `norm * (f0 + (1 - f0) * fresnel)`.
+    /// `F = f0 + (1 - f0) (1 - v.h)^5` (\[Sch94\]): `norm * (f0 + (1 - f0) * fresnel)`.
     ///
     /// # Examples
     ///
@@ -243,7 +243,8 @@ impl LtcTable {
     /// when an index is out of range. Looking up exactly these inputs returns the stored values.
     #[must_use]
     pub fn node(&self, j: usize, k: usize) -> Option<(f64, f64)> {
-        (j < self.grid.n && k < self.grid.n).then(|| (self.grid.node_cos(j), self.grid.node_alpha(k)))
+        (j < self.grid.n && k < self.grid.n)
+            .then(|| (self.grid.node_cos(j), self.grid.node_alpha(k)))
     }
 
     /// The values stored at view node `j`, roughness node `k` (see [`LtcTable::node`]), e.g. to

@@ -66,7 +66,11 @@ pub fn polar(pole: DVec3, p: f64, w: DVec3) -> (f64, f64) {
 
 /// View direction in the shading frame for `cos_theta`.
 pub fn view(cos_theta: f64) -> DVec3 {
-    DVec3::new((1.0 - cos_theta * cos_theta).max(0.0).sqrt(), 0.0, cos_theta)
+    DVec3::new(
+        (1.0 - cos_theta * cos_theta).max(0.0).sqrt(),
+        0.0,
+        cos_theta,
+    )
 }
 
 /// Per-bin histogram check: draws `n` samples, bins them in `bins_s` x `bins_phi` polar bins about
@@ -102,7 +106,8 @@ pub fn histogram_sigma(
                 let dtheta = PI * p * s.powf(p - 1.0) / (bins_s * sub) as f64;
                 let (st, ct) = theta.sin_cos();
                 for b in 0..sub {
-                    let phi = 2.0 * PI * (k as f64 + (b as f64 + 0.5) / sub as f64) / bins_phi as f64;
+                    let phi =
+                        2.0 * PI * (k as f64 + (b as f64 + 0.5) / sub as f64) / bins_phi as f64;
                     let (sp, cp) = phi.sin_cos();
                     let w = fr * DVec3::new(st * cp, st * sp, ct);
                     mass += pdf(w) * st * dtheta * 2.0 * PI / (bins_phi * sub) as f64;
