@@ -66,6 +66,10 @@ fn evaluate(name: &str, fitted: &FittedTable, count: usize) {
         }
         Err(e) => println!("{name}: quad evaluation failed: {e}"),
     }
+    println!(
+        "{name}: cells improved by each neighbour-restart pass: {:?}",
+        fitted.refinements()
+    );
     let mut cells: Vec<f64> = fitted.cell_errors().to_vec();
     cells.sort_by(f64::total_cmp);
     println!(
