@@ -10,7 +10,9 @@ use criterion::{Criterion, criterion_group, criterion_main};
 fn inputs(n: usize) -> Vec<(f64, f64, DVec3)> {
     let mut s = 0x2545_f491_4f6c_dd1du64;
     let mut next = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
     (0..n)
@@ -18,7 +20,7 @@ fn inputs(n: usize) -> Vec<(f64, f64, DVec3)> {
             let c = next();
             let a = 0.01 + next();
             let z = next();
-            let phi = 6.283 * next();
+            let phi = std::f64::consts::TAU * next();
             let r = (1.0 - z * z).sqrt();
             (c, a, DVec3::new(r * phi.cos(), r * phi.sin(), z))
         })
@@ -56,8 +58,7 @@ fn bench(c: &mut Criterion) {
             acc
         })
     });
-    let ltc = lookup(0.7, 0.2).and_then(|l| l.ltc()).map_or_else(|_| None, Some);
-    if let Some(ltc) = ltc {
+    if let Ok(ltc) = lookup(0.7, 0.2).and_then(|l| l.ltc()) {
         let ltc: Ltc = ltc;
         c.bench_function("ltc/density x1024", |b| {
             b.iter(|| {
