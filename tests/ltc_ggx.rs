@@ -98,7 +98,7 @@ fn brdf_is_reciprocal() {
 
 #[test]
 fn ndf_is_normalised_over_projected_area() {
-    // integral of D(h) cos(theta_h) over the hemisphere of normals is 1 ([WMLT07] eq. 4).
+    // integral of D(h) cos(theta_h) over the hemisphere of normals is 1 (Walter et al. 2007).
     for &alpha in &[0.01, 0.1, 0.5, 1.0] {
         let i = sphere_quad(DVec3::Z, 3.0, 1200, 8, |h| {
             if h.z > 0.0 {

@@ -2,14 +2,15 @@
 //!
 //! A linearly transformed cosine (LTC) is the distribution of `w = M w_o / |M w_o|` when `w_o` is
 //! drawn from the clamped cosine `D_o(w_o) = max(0, z_o) / pi`. Its density is
-//! (\[HDHN16\] eq. 1 with the Jacobian of eq. 18)
+//! (\[HDHN16\] §3, with the Jacobian of the normalised linear map)
 //!
 //! ```text
 //! D(w) = D_o(w_o) |det M^-1| / |M^-1 w|^3,   w_o = M^-1 w / |M^-1 w|
 //! ```
 //!
 //! and, because the transform maps spherical polygons to spherical polygons, its integral over a
-//! polygon `P` equals the clamped-cosine integral over `M^-1 P` (eq. 4), which has a closed form.
+//! polygon `P` equals the clamped-cosine integral over `M^-1 P` (\[HDHN16\] §3), which has a
+//! closed form.
 //!
 //! # References
 //!
@@ -83,7 +84,7 @@ impl Ltc {
     }
 
     /// Builds the LTC from the inverse transform `m_inv` (distribution space -> cosine space), the
-    /// matrix the tables store (\[HDHN16\] §4.3).
+    /// matrix the tables store (\[HDHN16\] §4).
     ///
     /// # Errors
     ///
@@ -111,7 +112,7 @@ impl Ltc {
         self.m_inv
     }
 
-    /// The density `D(w)` per unit solid angle at the unit direction `w` (\[HDHN16\] eq. 1/18).
+    /// The density `D(w)` per unit solid angle at the unit direction `w` (\[HDHN16\] §3).
     /// It integrates to one over the sphere. Returns NaN for non-finite `w`, `0.0` for `w = 0`.
     #[must_use]
     pub fn density(&self, w: DVec3) -> f64 {

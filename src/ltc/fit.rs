@@ -1,7 +1,7 @@
 //! The LTC table fitter (feature `fit`): fits the GGX tables that `table_data.rs` ships.
 //!
 //! Run it with `cargo run --release --features fit --example fit_ltc`; it rewrites
-//! `src/ltc/table_data.rs`. The procedure follows \[HDHN16\] §4.2 with the refinements of the public
+//! `src/ltc/table_data.rs`. The procedure follows \[HDHN16\] §4 with the refinements of the public
 //! implementation, and one change of objective:
 //!
 //! 1. For each cell (view cosine, roughness) of the grid, estimate the directional albedo `A`, the
@@ -11,7 +11,7 @@
 //!    `S = [[m11, 0, m13], [0, m22, 0], [m31, 0, 1]]`, optimised as `ln m11`, `ln m22`, `m13`
 //!    (and `m31`), so that the simplex adapts to lobes of any width down to `alpha = 1e-4`. The
 //!    reference fit keeps `m31 = 0` (three parameters); ours frees it, which is the fourth degree
-//!    of freedom of \[HDHN16\] §4.2 (`M = [[a, 0, b], [0, c, 0], [d, 0, 1]]`) expressed in the
+//!    of freedom of \[HDHN16\] §4 (`M = [[a, 0, b], [0, c, 0], [d, 0, 1]]`) expressed in the
 //!    frame of the average direction.
 //! 3. Minimise a sampled error between the LTC and `f cos / A` with Nelder–Mead, warm-started from
 //!    the neighbouring cell. The error is estimated by multiple importance sampling (balance
@@ -678,7 +678,7 @@ pub fn shading_error(
 
 /// Form factor of a polygon of directions (vertices need not be normalised; edges are the
 /// straight segments between them, i.e. great arcs on the sphere) after clipping to `z >= 0`:
-/// `(1 / pi) integral over the polygon of max(0, z) dw`, by Baum's formula (\[HDHN16\] eq. 11).
+/// `(1 / pi) integral over the polygon of max(0, z) dw`, by Baum's formula (as used in \[HDHN16\]).
 /// The absolute value is returned, so the orientation does not matter.
 fn clipped_form_factor(poly: &[DVec3]) -> f64 {
     let mut clipped: Vec<DVec3> = Vec::with_capacity(poly.len() + 2);

@@ -122,7 +122,7 @@ pub(crate) const GGX_GRID: Grid = Grid {
 /// With `P` a spherical polygon of light directions in the shading frame, the GGX reflectance
 /// (Fresnel-free) over `P` is approximately
 /// `norm * clamped_cosine_integral(M^-1 P)`, where the clamped-cosine integral is clipped to
-/// the upper hemisphere of the cosine space (Baum's formula, \[HDHN16\] eq. 11). With Schlick's
+/// the upper hemisphere of the cosine space (Baum's formula, as in \[HDHN16\]). With Schlick's
 /// Fresnel and reflectance `f0` at normal incidence, multiply by
 /// [`specular_scale(f0)`](LtcLookup::specular_scale) instead of `norm`.
 #[derive(Debug, Clone, Copy, PartialEq)]
