@@ -120,11 +120,18 @@ pub(crate) const GGX_GRID: Grid = Grid {
 /// roughness, and the scalars that scale its polygon integral (\[HDHN16\] §4).
 ///
 /// With `P` a spherical polygon of light directions in the shading frame, the GGX reflectance
-/// (Fresnel-free) over `P` is approximately
-/// `norm * clamped_cosine_integral(M^-1 P)`, where the clamped-cosine integral is clipped to
-/// the upper hemisphere of the cosine space (Baum's formula, as in \[HDHN16\]). With Schlick's
-/// Fresnel and reflectance `f0` at normal incidence, multiply by
-/// [`specular_scale(f0)`](LtcLookup::specular_scale) instead of `norm`.
+/// (Fresnel-free) `integral over P of f(v, l) cos(theta_l) dl` is approximately
+/// `norm * clamped_cosine_integral(M^-1 (P clipped to z >= 0))`:
+///
+/// 1. clip `P` to the shading horizon `z >= 0` first (the table's LTC is fitted as clipped there,
+///    see [`norm`](LtcLookup::norm); skipping this lets light from below the surface leak in);
+/// 2. map its vertices by `m_inv` (directions only; normalise if needed);
+/// 3. integrate the clamped cosine `(1 / pi) max(0, z)` over the result, which clips it again, to
+///    the cosine space's horizon (Baum's formula, as in \[HDHN16\]).
+///
+/// With Schlick's Fresnel and reflectance `f0` at normal incidence, multiply by
+/// [`specular_scale(f0)`](LtcLookup::specular_scale) instead of `norm`. The fitter's
+/// `quad_shading_errors` (feature `fit`) implements exactly these steps for quads.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LtcLookup {
     /// `M^-1`: maps directions in the shading frame (normal `+z`, view in the xz-plane with
