@@ -8,8 +8,8 @@
 //!   integral (horizon clip + Baum's edge sum), and its clip-free form (thesis 003, eq. 4.6/4.7).
 //! - [`ggx`]: the GGX BRDF (height-correlated Smith masking) and its visible-normal sampler, the
 //!   ground truth the tables approximate.
-//! - [`Ltc`]: the linearly transformed cosine distribution ([HDHN16] §3): density and sampling.
-//! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup ([HDHN16] §4).
+//! - [`Ltc`]: the linearly transformed cosine distribution (\[HDHN16\] §3): density and sampling.
+//! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup (\[HDHN16\] §4).
 //! - `fit` (feature `fit`): the fitter that generates the tables.
 //!
 //! # Examples
@@ -31,7 +31,7 @@
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
 mod distribution;
