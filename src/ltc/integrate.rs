@@ -112,8 +112,9 @@ pub fn ltc_integral_rational(
 ///
 /// `poly` is given in the shading frame (normal `+z`, view in the xz-plane with `x >= 0`) with
 /// the view at `cos_theta_v` from the normal; `alpha` is GGX's roughness parameter (`alpha =
-/// roughness^2` in the usual artist mapping). The table lookup, the transform by `M^-1`, the
-/// exact horizon clip and Baum's edge sum are all evaluated here.
+/// roughness^2` in the usual artist mapping). Evaluated here: the table lookup, the clip to the
+/// shading horizon (the tables are fitted for LTCs clipped there), the transform by `M^-1`, the
+/// horizon handling in cosine space and Baum's edge sum.
 ///
 /// # Errors
 ///
@@ -132,7 +133,15 @@ pub fn ggx_polygon_integral(
         });
     }
     let l = super::lookup(cos_theta_v, alpha)?;
-    Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * ltc_integral(poly, l.m_inv)?)
+    // The tables' LTCs are fitted as clipped to the shading horizon and renormalized (`norm`),
+    // so the light is clipped there first; the clip is skipped when nothing reaches below.
+    let above = poly.rings().flatten().all(|v| v.z > HORIZON_TOLERANCE) && !poly.is_full();
+    let integral = if above {
+        ltc_integral(poly, l.m_inv)?
+    } else {
+        ltc_integral(&poly.clip_to_hemisphere(DVec3::Z), l.m_inv)?
+    };
+    Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
 }
 
 /// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem

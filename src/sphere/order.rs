@@ -183,7 +183,7 @@ fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, Ge
                 Some(pick).filter(|&f| !used[f])
             } else {
                 let cand = out_of[at].iter().chain(into[at].iter()).copied();
-                cand.filter(|&f| !used[f]).next()
+                cand.into_iter().find(|&f| !used[f])
             };
             match next {
                 Some(f) => e = f,
