@@ -14,5 +14,6 @@ pub(crate) mod predicates;
 
 pub use clip::HORIZON_TOLERANCE;
 pub use gnomonic::{Gnomonic, enclosing_cap};
-pub use order::{order_directed_edges, order_edges};
+pub use boolean::MIN_CAP_COS;
+pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};
