@@ -52,16 +52,7 @@ pub const EDGE_FACTOR_RATIONAL_MAX_ERROR: f64 = 6.1e-7;
 /// convex polygon, whose perimeter inside a hemisphere is below `2 pi`).
 #[must_use]
 pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
-    let clipped = poly.clip_to_hemisphere(DVec3::Z);
-    let mut sum = 0.0;
-    for ring in clipped.rings() {
-        let n = ring.len();
-        for i in 0..n {
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            sum += edge_factor_rational(a.dot(b)) * a.cross(b).z;
-        }
-    }
-    (sum / (2.0 * PI)).clamp(0.0, 1.0)
+    clipped_sum(poly, rational_edge_term)
 }
 
 /// Integral of a linearly transformed cosine over a polygon in the shading frame: the polygon is
@@ -73,15 +64,7 @@ pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
 ///
 /// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
 pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
-    // The stack-only clip-free path (thesis 003 eq. 4.6/4.7) when the map keeps orientation;
-    // the exact clip otherwise. Both agree to rounding (tested).
-    if poly.is_full() || poly.is_empty() || !(m_inv.determinant() > 0.0) {
-        return Ok(clamped_cosine_integral(&poly.transformed(m_inv)?));
-    }
-    match transformed_clip_free(poly, m_inv, edge_term) {
-        Some(v) => Ok(v),
-        None => Ok(clamped_cosine_integral(&poly.transformed(m_inv)?)),
-    }
+    transformed_integral(poly, m_inv, edge_term)
 }
 
 /// [`ltc_integral`] with the rational edge factor ([`edge_factor_rational`]): one `atan2` in total
@@ -95,14 +78,23 @@ pub fn ltc_integral_rational(
     poly: &SphericalPolygon,
     m_inv: glam::DMat3,
 ) -> Result<f64, crate::GeomError> {
-    let rational = |a: DVec3, b: DVec3| edge_factor_rational(a.dot(b)) * a.cross(b).z;
-    if poly.is_full() || poly.is_empty() || !(m_inv.determinant() > 0.0) {
-        return Ok(clamped_cosine_integral_rational(&poly.transformed(m_inv)?));
+    transformed_integral(poly, m_inv, rational_edge_term)
+}
+
+/// The clamped-cosine integral of `m` applied to `poly`, with the given edge term: the stack-only
+/// clip-free path (thesis 003 eq. 4.6/4.7) when the map keeps orientation, the exact clip of the
+/// transformed polygon otherwise. Both agree to rounding (tested).
+fn transformed_integral(
+    poly: &SphericalPolygon,
+    m: glam::DMat3,
+    edge: fn(DVec3, DVec3) -> f64,
+) -> Result<f64, crate::GeomError> {
+    if !poly.is_full() && !poly.is_empty() && m.determinant() > 0.0 {
+        if let Some(v) = transformed_clip_free(poly, m, edge) {
+            return Ok(v);
+        }
     }
-    match transformed_clip_free(poly, m_inv, rational) {
-        Some(v) => Ok(v),
-        None => Ok(clamped_cosine_integral_rational(&poly.transformed(m_inv)?)),
-    }
+    Ok(clipped_sum(&poly.transformed(m)?, edge))
 }
 
 /// The GGX specular response to a uniform unit-radiance polygon light: approximately
@@ -144,17 +136,28 @@ pub fn ggx_polygon_integral(
     Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
 }
 
+/// The edge term with [`edge_factor_rational`] in place of `theta / sin(theta)`.
+#[inline]
+fn rational_edge_term(a: DVec3, b: DVec3) -> f64 {
+    edge_factor_rational(a.dot(b)) * a.cross(b).z
+}
+
 /// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem
 /// (Baum, Rushmeier and Winget 1989; HDHN16 eq. 11): `(1 / 2 pi) sum theta_e n_e . z`.
-fn boundary_sum(poly: &SphericalPolygon) -> f64 {
+fn boundary_sum(poly: &SphericalPolygon, edge: fn(DVec3, DVec3) -> f64) -> f64 {
     let mut sum = 0.0;
     for ring in poly.rings() {
         let n = ring.len();
         for i in 0..n {
-            sum += edge_term(ring[i], ring[(i + 1) % n]);
+            sum += edge(ring[i], ring[(i + 1) % n]);
         }
     }
     sum / (2.0 * PI)
+}
+
+/// The exact path: clip to the upper hemisphere, then the boundary sum.
+fn clipped_sum(poly: &SphericalPolygon, edge: fn(DVec3, DVec3) -> f64) -> f64 {
+    boundary_sum(&poly.clip_to_hemisphere(DVec3::Z), edge).clamp(0.0, 1.0)
 }
 
 /// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform
@@ -181,7 +184,7 @@ fn boundary_sum(poly: &SphericalPolygon) -> f64 {
 /// ```
 #[must_use]
 pub fn clamped_cosine_integral(poly: &SphericalPolygon) -> f64 {
-    boundary_sum(&poly.clip_to_hemisphere(DVec3::Z)).clamp(0.0, 1.0)
+    clipped_sum(poly, edge_term)
 }
 
 /// The same integral as [`clamped_cosine_integral`] without building the clipped polygon: the

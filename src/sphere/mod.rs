@@ -12,8 +12,8 @@ mod order;
 mod polygon;
 pub(crate) mod predicates;
 
+pub use boolean::MIN_CAP_COS;
 pub use clip::HORIZON_TOLERANCE;
 pub use gnomonic::{Gnomonic, enclosing_cap};
-pub use boolean::MIN_CAP_COS;
 pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};

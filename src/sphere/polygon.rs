@@ -5,7 +5,7 @@ use core::f64::consts::PI;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::predicates::{arcs_intersect, normalize_any, orient, triangle_solid_angle};
+use super::predicates::{AXES, arcs_intersect, normalize_any, orient, triangle_solid_angle};
 use crate::GeomError;
 use alloc::vec::Vec;
 
@@ -290,14 +290,7 @@ impl SphericalPolygon {
     /// A direction well away from the boundary: the best of the six axis directions.
     fn far_point(&self) -> DVec3 {
         let mut best = (f64::NEG_INFINITY, DVec3::Z);
-        for c in [
-            DVec3::X,
-            DVec3::Y,
-            DVec3::Z,
-            DVec3::NEG_X,
-            DVec3::NEG_Y,
-            DVec3::NEG_Z,
-        ] {
+        for c in AXES {
             if let Some((d, _)) = nearest_feature(self.rings(), c)
                 && d > best.0
             {
@@ -488,16 +481,8 @@ fn fan_apex(ring: &[DVec3]) -> DVec3 {
     if clearance(ring[0]) >= 0.5 {
         return ring[0];
     }
-    let axes = [
-        DVec3::X,
-        DVec3::Y,
-        DVec3::Z,
-        DVec3::NEG_X,
-        DVec3::NEG_Y,
-        DVec3::NEG_Z,
-    ];
     let mut best = (clearance(ring[0]), ring[0]);
-    for &c in ring.iter().chain(axes.iter()) {
+    for &c in ring.iter().chain(AXES.iter()) {
         let d = clearance(c);
         if d > best.0 {
             best = (d, c);
