@@ -1,7 +1,11 @@
 //! Spherical primitives: solid angle of an 8-gon, hemisphere clip of an 8-gon, ordering of 12
 //! silhouette edges. Fixed inputs; results in BENCHMARKS.md.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use arealight::glam::DVec3;
+use arealight::planar::BoolOp;
 use arealight::sphere::{SphericalPolygon, order_edges};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::f64::consts::PI;
@@ -48,5 +52,63 @@ fn primitives(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, primitives);
+/// Visible part of a quad light: minus a cube's silhouette (one difference), and minus every
+/// triangle of an 80-face icosphere (the seed's per-triangle workflow, 80 chained differences).
+fn visibility(c: &mut Criterion) {
+    let light = SphericalPolygon::new(vec![vec![
+        DVec3::new(-1.0, -1.0, 3.0),
+        DVec3::new(1.0, -1.0, 3.0),
+        DVec3::new(1.0, 1.0, 3.0),
+        DVec3::new(-1.0, 1.0, 3.0),
+    ]])
+    .unwrap();
+    // A cube of half-size 0.3 at (0.2, 0.1, 1.5) seen from the origin: its silhouette hexagon.
+    let center = DVec3::new(0.2, 0.1, 1.5);
+    let corner = |sx: f64, sy: f64, sz: f64| center + DVec3::new(sx, sy, sz) * 0.3;
+    let hexagon: Vec<DVec3> = [
+        (1.0, -1.0, -1.0),
+        (1.0, 1.0, -1.0),
+        (-1.0, 1.0, -1.0),
+        (-1.0, 1.0, 1.0),
+        (-1.0, -1.0, 1.0),
+        (1.0, -1.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| corner(x, y, z))
+    .collect();
+    let mut sil = SphericalPolygon::new(vec![hexagon]).unwrap();
+    if sil.solid_angle() > 2.0 * PI {
+        sil = sil.complement();
+    }
+    c.bench_function("sphere/boolean/quad light - cube silhouette", |b| {
+        b.iter(|| {
+            black_box(&light)
+                .boolean(black_box(&sil), BoolOp::Difference)
+                .unwrap()
+        })
+    });
+    let (v, faces) = common::icosphere(DVec3::new(0.3, 0.2, 1.5), 0.4);
+    let tris: Vec<SphericalPolygon> = faces
+        .iter()
+        .map(|f| {
+            let t = SphericalPolygon::new(vec![f.iter().map(|&i| v[i]).collect()]).unwrap();
+            if t.solid_angle() > 2.0 * PI {
+                t.complement()
+            } else {
+                t
+            }
+        })
+        .collect();
+    c.bench_function("sphere/boolean/quad light - 80 icosphere triangles", |b| {
+        b.iter(|| {
+            let mut vis = light.clone();
+            for t in &tris {
+                vis = vis.boolean(t, BoolOp::Difference).unwrap();
+            }
+            vis
+        })
+    });
+}
+
+criterion_group!(benches, primitives, visibility);
 criterion_main!(benches);

@@ -4,8 +4,11 @@
 //! cargo run --release --features fit --example fit_ltc [-- --no-reference] [--out PATH] [--size N]
 //! ```
 //!
-//! Also fits a reproduction of the public reference fit (unless `--no-reference`) and prints the
-//! shading error of both tables at random (view, roughness) points.
+//! Also fits a reproduction of the public reference fit (unless `--no-reference`) and prints, for
+//! both tables, the shading error at random (view, roughness) points, the error of LTC shading of
+//! random quad lights against brute force, and per-cell diagnostics. `--size N` fits an N x N grid
+//! (for experiments; write it elsewhere with `--out`). With `FIT_LTC_MAP=1` it also prints the
+//! per-cell error map (rows: roughness nodes, smooth at the bottom; columns: view nodes).
 
 use std::time::Instant;
 
@@ -66,6 +69,27 @@ fn evaluate(name: &str, fitted: &FittedTable, count: usize) {
         }
         Err(e) => println!("{name}: quad evaluation failed: {e}"),
     }
+    println!(
+        "{name}: cells improved by each neighbour-restart pass: {:?}",
+        fitted.refinements()
+    );
+    // Spikes: cells whose error exceeds 1.5 x the worst of their 4 neighbours (plus 1e-3).
+    let n = fitted.table().size();
+    let e = fitted.cell_errors();
+    let spikes = (0..n * n)
+        .filter(|&i| {
+            let (k, j) = (i / n, i % n);
+            let mut worst: f64 = 0.0;
+            for (dk, dj) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                let (kk, jj) = (k as i64 + dk, j as i64 + dj);
+                if (0..n as i64).contains(&kk) && (0..n as i64).contains(&jj) {
+                    worst = worst.max(e[kk as usize * n + jj as usize]);
+                }
+            }
+            e[i] > 1.5 * worst + 1e-3
+        })
+        .count();
+    println!("{name}: cells with error > 1.5 x their worst neighbour's: {spikes}");
     let mut cells: Vec<f64> = fitted.cell_errors().to_vec();
     cells.sort_by(f64::total_cmp);
     println!(

@@ -21,6 +21,8 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
+// Comparisons are written `!(x > t)` on purpose where NaN must fail the test.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 #[cfg(feature = "std")]
@@ -30,10 +32,14 @@ pub use glam;
 
 mod error;
 pub mod ltc;
-#[allow(dead_code)] // a shim: each layer uses its own subset of the functions
 pub(crate) mod math;
 pub mod planar;
 pub mod shade;
 pub mod sphere;
 
 pub use error::GeomError;
+
+// The README's example is compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

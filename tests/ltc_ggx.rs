@@ -70,8 +70,8 @@ fn albedo_tends_to_one_for_smooth_surfaces_at_normal_incidence() {
         prev > 0.995 && prev <= 1.0 + 1e-6,
         "albedo at alpha 0.01: {prev}"
     );
-    // At grazing view the height-correlated masking removes a large part of the energy.
-    assert!(albedo_quad(view(0.05), 0.5) < 0.7);
+    // Rougher surfaces lose more energy at normal incidence (single scattering only).
+    assert!(albedo_quad(DVec3::Z, 1.0) < albedo_quad(DVec3::Z, 0.5));
 }
 
 #[test]
@@ -98,7 +98,7 @@ fn brdf_is_reciprocal() {
 
 #[test]
 fn ndf_is_normalised_over_projected_area() {
-    // integral of D(h) cos(theta_h) over the hemisphere of normals is 1 ([WMLT07] eq. 4).
+    // integral of D(h) cos(theta_h) over the hemisphere of normals is 1 (Walter et al. 2007).
     for &alpha in &[0.01, 0.1, 0.5, 1.0] {
         let i = sphere_quad(DVec3::Z, 3.0, 1200, 8, |h| {
             if h.z > 0.0 {
@@ -116,7 +116,9 @@ fn vndf_pdf_integrates_to_one() {
     for &alpha in &[0.01, 0.1, 0.4, 1.0] {
         for &c in &[1.0, 0.7, 0.3, 0.02] {
             let v = view(c);
-            let i = sphere_quad(mirror(v), 3.0, 1200, 256, |l| ggx_vndf_pdf(v, l, alpha));
+            // At grazing view the lobe of reflected directions is strongly anisotropic: resolve
+            // the azimuth finely.
+            let i = sphere_quad(mirror(v), 3.0, 1200, 2048, |l| ggx_vndf_pdf(v, l, alpha));
             assert!((i - 1.0).abs() < 2e-3, "alpha {alpha} cos {c}: {i}");
         }
     }
@@ -148,7 +150,7 @@ fn vndf_samples_follow_the_pdf() {
 #[test]
 fn bad_input_does_not_panic() {
     assert!(ggx_brdf_cos(DVec3::new(f64::NAN, 0.0, 0.5), DVec3::Z, 0.2).is_nan());
-    assert_eq!(ggx_brdf_cos(DVec3::Z, DVec3::Z, 0.0).is_finite(), true);
+    assert!(ggx_brdf_cos(DVec3::Z, DVec3::Z, 0.0).is_finite());
     assert_eq!(ggx_brdf_cos(-DVec3::Z, DVec3::Z, 0.2), 0.0);
     assert_eq!(ggx_vndf_pdf(DVec3::Z, -DVec3::Z, 0.2), 0.0);
     let l = ggx_sample_vndf(DVec3::Z, 0.0, DVec2::new(0.5, 0.5));

@@ -7,7 +7,10 @@ mod common;
 use arealight::glam::DVec3;
 use arealight::ltc::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
 use arealight::sphere::SphericalPolygon;
-use common::{Rng, assert_mc_agrees, mc_integral, star_ring, triangle_quadrature};
+use common::{
+    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_integral, star_ring,
+    triangle_quadrature,
+};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -79,9 +82,11 @@ fn lambert_matches_monte_carlo_across_the_horizon() {
                 0.0
             }
         });
+        let cells = crossed_cells(boundary_edges(&p).chain(great_circle(DVec3::Z)), 96, 192);
         assert_mc_agrees(
             clamped_cosine_integral(&p),
             mc,
+            cells,
             "clamped cosine vs Monte Carlo",
         );
         done += 1;
@@ -146,5 +151,97 @@ proptest! {
         signed /= 2.0 * PI;
         let diff = clamped_cosine_integral(&p) - clamped_cosine_integral(&mirrored);
         prop_assert!((diff - signed).abs() <= 1e-12, "{} vs {}", diff, signed);
+    }
+}
+
+#[test]
+fn rational_edge_factor_error_is_as_documented() {
+    use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, edge_factor_rational};
+    let mut worst: f64 = 0.0;
+    let n = 400_000;
+    for i in 0..=n {
+        // Dense in cos(theta), including the ends; x -> -1 approached to 1e-9.
+        let x = -1.0 + 1e-9 + (2.0 - 1e-9) * i as f64 / n as f64;
+        let exact = if x >= 1.0 {
+            1.0
+        } else {
+            x.acos() / (1.0 - x * x).sqrt()
+        };
+        worst = worst.max((edge_factor_rational(x) / exact - 1.0).abs());
+    }
+    assert!(
+        worst <= EDGE_FACTOR_RATIONAL_MAX_ERROR,
+        "max relative error {worst}"
+    );
+    assert!(
+        worst > 0.5 * EDGE_FACTOR_RATIONAL_MAX_ERROR,
+        "documented bound is loose: {worst}"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+
+    /// The rational variant stays within its documented error of the exact integral.
+    #[test]
+    fn rational_integral_within_bound(seed in any::<u64>()) {
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let clipped = p.clip_to_hemisphere(DVec3::Z);
+        let perimeter: f64 = boundary_edges(&clipped).map(|(a, b)| a.cross(b).length().atan2(a.dot(b))).sum();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-14;
+        let (a, b) = (clamped_cosine_integral(&p), clamped_cosine_integral_rational(&p));
+        prop_assert!((a - b).abs() <= bound, "{} vs {} (bound {})", a, b, bound);
+    }
+
+    /// Integrating an LTC over a polygon (transform + clamped cosine) equals quadrature of the
+    /// LTC density over the polygon (HDHN16 eq. 14).
+    #[test]
+    fn ltc_integral_matches_density_quadrature(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{Ltc, ltc_integral};
+        let mut rng = Rng::new(seed);
+        let m_inv = DMat3::from_cols(
+            DVec3::new(rng.range(0.3, 2.0), 0.0, rng.range(-0.8, 0.8)),
+            DVec3::new(0.0, rng.range(0.3, 2.0), 0.0),
+            DVec3::new(rng.range(-0.5, 0.5), 0.0, 1.0),
+        );
+        prop_assume!(m_inv.determinant() > 0.05);
+        let c = DVec3::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), 1.0).normalize();
+        let n = 3 + (rng.next_u64() % 6) as usize;
+        let rho = rng.range(0.05, 0.5);
+        let ring = star_ring(&mut rng, c, n, rho, 0.7);
+        let poly = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+        let ltc = Ltc::from_inverse(m_inv).unwrap();
+        let quad: f64 = (0..n)
+            .map(|i| triangle_quadrature(c, ring[i], ring[(i + 1) % n], 24, |d| ltc.density(d)))
+            .sum();
+        let exact = ltc_integral(&poly, m_inv).unwrap();
+        prop_assert!((exact - quad).abs() <= 1e-8, "{} vs quadrature {}", exact, quad);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(512), ..ProptestConfig::default() })]
+
+    /// The stack-only clip-free LTC path agrees with transform + exact clip, for any matrix
+    /// (mirroring ones included), and the rational path stays within its bound.
+    #[test]
+    fn fast_ltc_paths_agree_with_exact(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let mut rng = Rng::new(seed ^ 0x17C);
+        let m = DMat3::from_cols(rng.dir() * rng.range(0.2, 3.0), rng.dir(), rng.dir() * rng.range(0.2, 3.0));
+        let Ok(t) = p.transformed(m) else { return Ok(()); };
+        let exact = clamped_cosine_integral(&t);
+        let fast = ltc_integral(&p, m).unwrap();
+        prop_assert!((exact - fast).abs() <= 1e-12, "{} vs {}", exact, fast);
+        let perimeter: f64 = boundary_edges(&t.clip_to_hemisphere(DVec3::Z))
+            .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
+            .sum();
+        let rational = ltc_integral_rational(&p, m).unwrap();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+        prop_assert!((exact - rational).abs() <= bound, "{} vs {} (bound {})", exact, rational, bound);
     }
 }

@@ -238,5 +238,8 @@ fn fitted_ltc_matches_the_brdf() {
     );
 }
 
-const MEDIAN_MAX: f64 = 0.5;
-const P90_MAX: f64 = 1.0;
+// Measured for the shipped table: median 0.039, p90 0.164 (fitter's own 64^2-sample estimate at
+// 400 points: 0.040 / 0.162). The reference-parameterisation reproduction (3 parameters, cubed
+// error, unclipped; see BENCHMARKS.md) reaches 0.062 / 0.256 and would fail both bounds.
+const MEDIAN_MAX: f64 = 0.05;
+const P90_MAX: f64 = 0.2;

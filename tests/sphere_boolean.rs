@@ -6,7 +6,9 @@ mod common;
 use arealight::glam::DVec3;
 use arealight::planar::BoolOp;
 use arealight::sphere::{SphericalPolygon, order_directed_edges};
-use common::{Rng, assert_mc_agrees, mc_solid_angle, star_ring};
+use common::{
+    Rng, assert_mc_agrees, boundary_edges, crossed_cells, icosphere, mc_solid_angle, star_ring,
+};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -37,7 +39,7 @@ fn pair(seed: u64) -> Option<(SphericalPolygon, SphericalPolygon)> {
     let mut rng = Rng::new(seed);
     let c = rng.dir();
     let a = polygon_about(&mut rng, c)?;
-    let b = match rng.next_u64() % 5 {
+    let b = match rng.next_u64() % 6 {
         0 => a.clone(),
         1 => a.complement(),
         2 => {
@@ -52,8 +54,14 @@ fn pair(seed: u64) -> Option<(SphericalPolygon, SphericalPolygon)> {
                 .collect();
             SphericalPolygon::new(vec![keep]).ok()?
         }
-        _ => {
+        3 => {
             let d = (c + rng.dir() * rng.range(0.0, 0.8)).normalize();
+            polygon_about(&mut rng, d)?
+        }
+        _ => {
+            // Far apart: the operands' vertices span more than a hemisphere, which sends the
+            // operation through the octant split.
+            let d = (-c + rng.dir() * rng.range(0.0, 0.5)).normalize();
             polygon_about(&mut rng, d)?
         }
     };
@@ -173,67 +181,11 @@ fn larger_than_hemisphere_matches_monte_carlo() {
                 };
                 let mut mrng = Rng::new(k as u64 * 31 + op as u64);
                 let mc = mc_solid_angle(&mut mrng, 64, 128, f);
-                assert_mc_agrees(r.solid_angle(), mc, &format!("case {k} {op:?}"));
+                let cells = crossed_cells(boundary_edges(a).chain(boundary_edges(b)), 64, 128);
+                assert_mc_agrees(r.solid_angle(), mc, cells, &format!("case {k} {op:?}"));
             }
         }
     }
-}
-
-/// The icosahedron subdivided once: 42 vertices, 80 faces, counter-clockwise from outside.
-fn icosphere(center: DVec3, radius: f64) -> (Vec<DVec3>, Vec<[usize; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let f0 = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let mut mid = std::collections::HashMap::new();
-    let mut faces = Vec::new();
-    for [a, b, c] in f0 {
-        let mut m = |i: usize, j: usize| {
-            *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                v.push((v[i] + v[j]).normalize());
-                v.len() - 1
-            })
-        };
-        let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-        faces.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-    }
-    (v.into_iter().map(|p| center + p * radius).collect(), faces)
 }
 
 #[test]
@@ -311,11 +263,115 @@ fn per_triangle_chain_equals_silhouette_difference() {
     }
 }
 
-/// Minimized proptest failures, kept as named regressions.
+/// Minimized failures, kept as named regressions.
 #[test]
 fn regression_hole_pinched_at_all_its_vertices() {
-    // The difference produced a hole touching the outer ring at all four of its vertices; the
-    // validity check then probed a shared vertex and misjudged the nesting.
-    let (a, b) = pair(9528998366313849765).unwrap();
-    check_identities(&a, &b).unwrap();
+    // A difference produced this valid result: ring 2 is a hole touching ring 1 at all four of its
+    // vertices. Validation probed a shared vertex to decide nesting and rejected it as
+    // inconsistently oriented (proptest seed 9528998366313849765 of the first generator).
+    let v: Vec<DVec3> = [
+        [0.8805346722913457, -0.4722894962975242, -0.0400165288325119],
+        [0.9924724683883259, -0.0786389200278272, 0.09388460868555967],
+        [0.9361830267711194, 0.07291149209648706, 0.3438680774743845],
+        [0.4255883721496805, 0.28191631485901264, 0.8598823924859138],
+        [0.19846204268946735, 0.0478470059744847, 0.9789399785639575],
+        [
+            -0.14954229638130762,
+            -0.28350314118493286,
+            0.9472397112300989,
+        ],
+        [-0.6056135022243624, -0.5929388413426258, 0.5307125552978811],
+        [
+            -0.34189444626618454,
+            -0.9241232940894043,
+            0.17059989722648516,
+        ],
+        [
+            0.13750115425897727,
+            -0.9861716896054175,
+            -0.0925139513708341,
+        ],
+        [0.45650157389783674, -0.8869909583839704, -0.069666008740877],
+        [0.3384933543995443, -0.8108789802150641, 0.4773861418942971],
+        [0.4538319640554113, -0.6210286583727801, 0.6390304796183925],
+        [0.4325667033032154, -0.6173080161196025, 0.6571277352447303],
+        [0.4970250646577318, -0.5135046899765584, 0.6994848236195379],
+        [0.5340502584703976, -0.38786487927981667, 0.7512330908905405],
+        [0.5454022656463088, -0.4182637225147756, 0.7263551659181311],
+        [0.5853235416977843, -0.3228426490322618, 0.7437533028499397],
+        [0.803787863709287, -0.44528545964403266, 0.39451987222859014],
+        [0.7528420075593608, -0.6059536516879346, 0.257000162762689],
+        [0.6022318519117558, -0.6330605777798392, 0.48636519345445917],
+        [0.6070259857120942, -0.6945099893290099, 0.3862322195162894],
+        [0.4970250646577318, -0.5135046899765584, 0.6994848236195379],
+        [0.4538319640554113, -0.6210286583727801, 0.6390304796183925],
+        [0.6022318519117558, -0.6330605777798392, 0.48636519345445917],
+        [0.5454022656463088, -0.4182637225147756, 0.7263551659181311],
+    ]
+    .iter()
+    .map(|c: &[f64; 3]| DVec3::from_array(*c))
+    .collect();
+    let p = SphericalPolygon::new(vec![v[..10].to_vec(), v[10..21].to_vec(), v[21..].to_vec()]);
+    assert!(p.is_ok(), "{p:?}");
+    let p = p.unwrap();
+    let outer = SphericalPolygon::new(vec![v[..10].to_vec()])
+        .unwrap()
+        .solid_angle();
+    let inner = SphericalPolygon::new(vec![v[10..21].to_vec()])
+        .unwrap()
+        .solid_angle();
+    let hole = SphericalPolygon::new(vec![v[21..].to_vec()])
+        .unwrap()
+        .solid_angle();
+    // Each single ring measures its left side; the region is their sum modulo 4 pi, and with
+    // the pinched hole it must be smaller than the outer ring alone.
+    let w = p.solid_angle();
+    assert!((w - (outer + inner + hole).rem_euclid(4.0 * PI)).abs() < 1e-12);
+    assert!(w < outer && w > 0.0);
+}
+
+#[test]
+fn near_antipodal_operands() {
+    // Lunes from the north pole to within 1e-6 of the south pole (edges nearly pi long), against
+    // a band around the equator and against each other.
+    let lune = |phi0: f64, phi1: f64| {
+        let eq = |phi: f64| DVec3::new(phi.cos(), phi.sin(), 0.0);
+        let south = DVec3::new(1e-6, 0.0, -1.0).normalize();
+        SphericalPolygon::new(vec![vec![DVec3::Z, eq(phi0), south, eq(phi1)]]).unwrap()
+    };
+    let band = SphericalPolygon::new(vec![vec![
+        DVec3::new(1.0, -0.5, -0.2),
+        DVec3::new(1.0, 0.5, -0.2),
+        DVec3::new(1.0, 0.5, 0.2),
+        DVec3::new(1.0, -0.5, 0.2),
+    ]])
+    .unwrap();
+    let cases = [
+        (lune(-0.3, 0.3), band.clone()),
+        (lune(-0.3, 0.3), lune(0.0, 0.6)),
+        (lune(-0.3, 0.3).complement(), band.clone()),
+        (lune(0.2, 2.8), lune(2.7, 4.0)),
+    ];
+    for (k, (a, b)) in cases.iter().enumerate() {
+        check_identities(a, b).unwrap();
+        for op in [BoolOp::Difference, BoolOp::Intersection] {
+            let r = a.boolean(b, op).unwrap();
+            let mut rng = Rng::new(k as u64);
+            let mc = mc_solid_angle(&mut rng, 64, 128, |d| {
+                let (x, y) = (a.contains(d), b.contains(d));
+                if op == BoolOp::Difference {
+                    x && !y
+                } else {
+                    x && y
+                }
+            });
+            let cells = crossed_cells(boundary_edges(a).chain(boundary_edges(b)), 64, 128);
+            assert_mc_agrees(
+                r.solid_angle(),
+                mc,
+                cells,
+                &format!("near-antipodal case {k} {op:?}"),
+            );
+        }
+    }
 }

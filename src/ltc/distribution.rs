@@ -1,19 +1,20 @@
-//! The linearly transformed cosine distribution itself ([HDHN16] §3).
+//! The linearly transformed cosine distribution itself (\[HDHN16\] §3).
 //!
 //! A linearly transformed cosine (LTC) is the distribution of `w = M w_o / |M w_o|` when `w_o` is
 //! drawn from the clamped cosine `D_o(w_o) = max(0, z_o) / pi`. Its density is
-//! ([HDHN16] eq. 1 with the Jacobian of eq. 18)
+//! (\[HDHN16\] §3, with the Jacobian of the normalised linear map)
 //!
 //! ```text
 //! D(w) = D_o(w_o) |det M^-1| / |M^-1 w|^3,   w_o = M^-1 w / |M^-1 w|
 //! ```
 //!
 //! and, because the transform maps spherical polygons to spherical polygons, its integral over a
-//! polygon `P` equals the clamped-cosine integral over `M^-1 P` (eq. 4), which has a closed form.
+//! polygon `P` equals the clamped-cosine integral over `M^-1 P` (\[HDHN16\] §3), which has a
+//! closed form.
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
 use glam::{DMat3, DVec2, DVec3};
@@ -21,7 +22,7 @@ use glam::{DMat3, DVec2, DVec3};
 use crate::GeomError;
 use crate::math::{sin_cos, sqrt};
 
-/// A linearly transformed cosine distribution on the unit sphere ([HDHN16] §3).
+/// A linearly transformed cosine distribution on the unit sphere (\[HDHN16\] §3).
 ///
 /// Holds the matrix `M` (cosine space -> distribution space) and its inverse. Scaling `M` by a
 /// positive factor does not change the distribution.
@@ -54,7 +55,9 @@ fn check_matrix(m: DMat3) -> Result<(), GeomError> {
     }
     let frob2: f64 = cols.iter().map(|c| c * c).sum();
     let scale = frob2 * sqrt(frob2);
-    if !(m.determinant().abs() > SINGULAR_EPS * scale) {
+    // Written so that a NaN or infinite determinant (overflowing entries) also counts as singular.
+    let regular = m.determinant().abs() > SINGULAR_EPS * scale && scale.is_finite();
+    if !regular {
         return Err(GeomError::Degenerate(
             "LTC matrix is singular (or nearly so); it must map the sphere onto itself",
         ));
@@ -81,7 +84,7 @@ impl Ltc {
     }
 
     /// Builds the LTC from the inverse transform `m_inv` (distribution space -> cosine space), the
-    /// matrix the tables store ([HDHN16] §4.3).
+    /// matrix the tables store (\[HDHN16\] §4).
     ///
     /// # Errors
     ///
@@ -109,14 +112,17 @@ impl Ltc {
         self.m_inv
     }
 
-    /// The density `D(w)` per unit solid angle at the unit direction `w` ([HDHN16] eq. 1/18).
+    /// The density `D(w)` per unit solid angle at the unit direction `w` (\[HDHN16\] §3).
     /// It integrates to one over the sphere. Returns NaN for non-finite `w`, `0.0` for `w = 0`.
     #[must_use]
     pub fn density(&self, w: DVec3) -> f64 {
         let wo = self.m_inv * w;
         let len2 = wo.length_squared();
-        if !(len2 > 0.0) {
-            return if len2 == 0.0 { 0.0 } else { f64::NAN };
+        if len2.is_nan() {
+            return f64::NAN;
+        }
+        if len2 == 0.0 {
+            return 0.0;
         }
         let len = sqrt(len2);
         let cos_o = wo.z / len;

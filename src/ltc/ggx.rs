@@ -1,7 +1,7 @@
 //! The GGX microfacet BRDF with height-correlated Smith masking, and its visible-normal sampler.
 //!
-//! This is the BRDF that the LTC tables approximate ([HDHN16] §4.1 fits "GGX"; we use the
-//! height-correlated form of the Smith masking-shadowing term, [Hei14] eq. 99). Everything here is
+//! This is the BRDF that the LTC tables approximate (\[HDHN16\] §4 fits GGX; we use the
+//! height-correlated form of the Smith masking-shadowing term from \[Hei14\]). Everything here is
 //! expressed in the shading frame: the surface normal is `+z`, and directions are unit vectors
 //! pointing away from the surface. The Fresnel factor is left out (it is handled by the tables'
 //! Schlick weights, see [`LtcLookup::specular_scale`](super::LtcLookup::specular_scale)).
@@ -12,12 +12,12 @@
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
-//! - [Hei14] E. Heitz. *Understanding the masking-shadowing function in microfacet-based BRDFs.*
+//! - \[Hei14\] E. Heitz. *Understanding the masking-shadowing function in microfacet-based BRDFs.*
 //!   JCGT 3(2), 2014.
-//! - [Hei18] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
-//! - [WMLT07] B. Walter, S. Marschner, H. Li, K. Torrance. *Microfacet models for refraction through
+//! - \[Hei18\] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
+//! - \[WMLT07\] B. Walter, S. Marschner, H. Li, K. Torrance. *Microfacet models for refraction through
 //!   rough surfaces.* EGSR 2007.
 
 use glam::{DVec2, DVec3};
@@ -38,7 +38,7 @@ fn clamp_alpha(alpha: f64) -> f64 {
     }
 }
 
-/// The GGX normal distribution `D(h)` ([WMLT07] eq. 33) for a unit half vector `h`.
+/// The GGX normal distribution `D(h)` (\[WMLT07\] eq. 33) for a unit half vector `h`.
 ///
 /// Written as `alpha^2 / (pi (h_x^2 + h_y^2 + alpha^2 h_z^2)^2)`, which equals the textbook
 /// `alpha^2 / (pi ((alpha^2 - 1) cos^2 + 1)^2)` for unit `h` but does not cancel catastrophically
@@ -61,14 +61,14 @@ pub fn ggx_ndf(h: DVec3, alpha: f64) -> f64 {
 }
 
 /// `sqrt(c^2 (1 - alpha^2) + alpha^2)` = `c (1 + 2 Lambda(c))`, the building block of the Smith
-/// terms ([Hei14] eq. 72 for GGX), finite and well-behaved at grazing `c -> 0`.
+/// terms (the GGX `Lambda` of \[Hei14\]), finite and well-behaved at grazing `c -> 0`.
 #[inline]
 fn smith_s(c: f64, a2: f64) -> f64 {
     sqrt(c * c * (1.0 - a2) + a2)
 }
 
 /// The cosine-weighted GGX BRDF `f(v, l) cos(theta_l)` without Fresnel, with height-correlated
-/// Smith masking-shadowing `G2 = 1 / (1 + Lambda(v) + Lambda(l))` ([Hei14] eq. 99).
+/// Smith masking-shadowing `G2 = 1 / (1 + Lambda(v) + Lambda(l))` (\[Hei14\]).
 ///
 /// `v` (towards the viewer) and `l` (towards the light) are unit vectors in the shading frame
 /// (normal `+z`). Returns `0.0` when either lies on or below the horizon. The value is computed as
@@ -106,7 +106,7 @@ pub fn ggx_brdf_cos(v: DVec3, l: DVec3, alpha: f64) -> f64 {
 }
 
 /// Samples a light direction `l` for view `v` by reflecting `v` about a GGX visible normal
-/// ([Hei18], with the sampled normal distribution `D_v(h) = G1(v) max(0, v.h) D(h) / cos_v`).
+/// (\[Hei18\], with the sampled normal distribution `D_v(h) = G1(v) max(0, v.h) D(h) / cos_v`).
 ///
 /// `v` must be a unit vector above the horizon (`v.z > 0`); `u` holds two uniform numbers in
 /// `[0, 1)`. The result is a unit vector; it can lie below the horizon (where the BRDF is zero),
@@ -159,8 +159,8 @@ pub fn ggx_sample_vndf(v: DVec3, alpha: f64, u: DVec2) -> DVec3 {
 }
 
 /// The density (per unit solid angle, over the whole sphere) with which [`ggx_sample_vndf`]
-/// produces `l` for view `v`: `G1(v) D(h) / (4 cos_v)` ([Hei18] eq. 17 with the reflection
-/// Jacobian `1 / (4 v.h)`), evaluated as `D(h) / (2 (cos_v + S(cos_v)))`.
+/// produces `l` for view `v`: `G1(v) D(h) / (4 cos_v)` (the visible-normal density of \[Hei18\]
+/// times the reflection Jacobian `1 / (4 v.h)`), evaluated as `D(h) / (2 (cos_v + S(cos_v)))`.
 ///
 /// Returns `0.0` when `v` is not above the horizon or `l` is not in the sampled set (`v.h <= 0`).
 ///

@@ -8,8 +8,8 @@
 //!   integral (horizon clip + Baum's edge sum), and its clip-free form (thesis 003, eq. 4.6/4.7).
 //! - [`ggx`]: the GGX BRDF (height-correlated Smith masking) and its visible-normal sampler, the
 //!   ground truth the tables approximate.
-//! - [`Ltc`]: the linearly transformed cosine distribution ([HDHN16] §3): density and sampling.
-//! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup ([HDHN16] §4).
+//! - [`Ltc`]: the linearly transformed cosine distribution (\[HDHN16\] §3): density and sampling.
+//! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup (\[HDHN16\] §4).
 //! - `fit` (feature `fit`): the fitter that generates the tables.
 //!
 //! # Examples
@@ -31,7 +31,7 @@
 //!
 //! # References
 //!
-//! - [HDHN16] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
+//! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
 mod distribution;
@@ -45,5 +45,9 @@ mod table_data;
 
 pub use distribution::Ltc;
 pub use ggx::{GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf};
-pub use integrate::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
+pub use integrate::{
+    EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral, clamped_cosine_integral_clip_free,
+    clamped_cosine_integral_rational, edge_factor_rational, ggx_polygon_integral, ltc_integral,
+    ltc_integral_rational,
+};
 pub use table::{LtcLookup, LtcTable, lookup};

@@ -19,7 +19,7 @@ use crate::planar::{BoolOp, Shape, boolean};
 /// coordinates stay below `1 / MIN_CAP_COS` (here 1e3), well inside the range where the planar
 /// operations' relative tolerances and the unprojection keep full precision. Wider operands are
 /// split into octants.
-const MIN_CAP_COS: f64 = 1e-3;
+pub const MIN_CAP_COS: f64 = 1e-3;
 
 impl SphericalPolygon {
     /// Intersection, union, difference (`self - other`) or symmetric difference of two regions.

@@ -254,7 +254,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
 /// region (join at once), a reflex one has the whole circle inside (go all the way round).
 fn circle_gap(from: &Chain, to: &Chain) -> f64 {
     let gap = (to.entry_angle - from.exit_angle).rem_euclid(2.0 * PI);
-    if gap < 1e-12 || gap > 2.0 * PI - 1e-12 {
+    if !(1e-12..=2.0 * PI - 1e-12).contains(&gap) {
         if from.exit_open_ccw { 2.0 * PI } else { 0.0 }
     } else {
         gap

@@ -13,8 +13,9 @@ mod polygon;
 pub(crate) mod predicates;
 mod sample; // [shade] solid-angle sampling of spherical triangles
 
+pub use boolean::MIN_CAP_COS;
 pub use clip::HORIZON_TOLERANCE;
 pub use gnomonic::{Gnomonic, enclosing_cap};
-pub use order::{order_directed_edges, order_edges};
+pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};
 pub use sample::SphericalTriangle; // [shade]

@@ -6,7 +6,7 @@ use core::f64::consts::PI;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::polygon::{SphericalPolygon, nearest_feature};
+use super::polygon::{SphericalPolygon, nearest_feature, ring_left_area};
 use super::predicates::normalize_any;
 use crate::GeomError;
 
@@ -58,8 +58,7 @@ pub fn order_edges(edges: &[(DVec3, DVec3)]) -> Result<SphericalPolygon, GeomErr
     let mut rings = chain(edges, false)?;
     // Orient each loop around its smaller side.
     for ring in rings.iter_mut() {
-        let single = SphericalPolygon::new(alloc::vec![ring.clone()])?;
-        if single.solid_angle() > 2.0 * PI {
+        if ring_left_area(ring) > 2.0 * PI {
             ring.reverse();
         }
     }
@@ -184,7 +183,7 @@ fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, Ge
                 Some(pick).filter(|&f| !used[f])
             } else {
                 let cand = out_of[at].iter().chain(into[at].iter()).copied();
-                cand.filter(|&f| !used[f]).next()
+                cand.into_iter().find(|&f| !used[f])
             };
             match next {
                 Some(f) => e = f,

@@ -5,7 +5,7 @@ use core::f64::consts::PI;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::predicates::{arcs_intersect, normalize_any, orient, triangle_solid_angle};
+use super::predicates::{AXES, arcs_intersect, normalize_any, orient, triangle_solid_angle};
 use crate::GeomError;
 use alloc::vec::Vec;
 
@@ -194,6 +194,44 @@ impl SphericalPolygon {
         out
     }
 
+    /// The image of the region under the linear map `m` applied to directions: each vertex `v`
+    /// becomes `m v / |m v|`. Great circles map to great circles, so the rings stay valid; a map
+    /// with negative determinant mirrors the sphere, and the rings are reversed to keep the
+    /// interior on the left. This is how a polygon enters the space of a linearly transformed
+    /// cosine (HDHN16 section 3).
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::Degenerate`] when `m` is singular (or nearly so: `|det m|` below `1e-12`
+    /// times the product of its column lengths) or not finite.
+    pub fn transformed(&self, m: glam::DMat3) -> Result<SphericalPolygon, GeomError> {
+        let det = m.determinant();
+        let scale = m.x_axis.length() * m.y_axis.length() * m.z_axis.length();
+        if !det.is_finite() || !(det.abs() > 1e-12 * scale) {
+            return Err(GeomError::Degenerate(
+                "the linear map is singular or not finite",
+            ));
+        }
+        if self.full || self.ends.is_empty() {
+            return Ok(self.clone());
+        }
+        let mut out = self.clone();
+        for v in out.verts.iter_mut() {
+            *v = normalize_any(m * *v)
+                .ok_or(GeomError::Degenerate("a vertex maps to the zero vector"))?;
+        }
+        Ok(if det < 0.0 {
+            let mut start = 0usize;
+            for &e in &self.ends {
+                out.verts[start..e as usize].reverse();
+                start = e as usize;
+            }
+            out
+        } else {
+            out
+        })
+    }
+
     /// Solid angle of the region in steradians, in `[0, 4 pi]`.
     ///
     /// Each ring's left region is measured as a fan of Van Oosterom–Strackee triangles from one of
@@ -252,14 +290,7 @@ impl SphericalPolygon {
     /// A direction well away from the boundary: the best of the six axis directions.
     fn far_point(&self) -> DVec3 {
         let mut best = (f64::NEG_INFINITY, DVec3::Z);
-        for c in [
-            DVec3::X,
-            DVec3::Y,
-            DVec3::Z,
-            DVec3::NEG_X,
-            DVec3::NEG_Y,
-            DVec3::NEG_Z,
-        ] {
+        for c in AXES {
             if let Some((d, _)) = nearest_feature(self.rings(), c)
                 && d > best.0
             {
@@ -420,7 +451,7 @@ impl SphericalPolygon {
 }
 
 /// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
-fn ring_left_area(ring: &[DVec3]) -> f64 {
+pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
     let n = ring.len();
     let apex = fan_apex(ring);
     let mut sum = 0.0;
@@ -450,16 +481,8 @@ fn fan_apex(ring: &[DVec3]) -> DVec3 {
     if clearance(ring[0]) >= 0.5 {
         return ring[0];
     }
-    let axes = [
-        DVec3::X,
-        DVec3::Y,
-        DVec3::Z,
-        DVec3::NEG_X,
-        DVec3::NEG_Y,
-        DVec3::NEG_Z,
-    ];
     let mut best = (clearance(ring[0]), ring[0]);
-    for &c in ring.iter().chain(axes.iter()) {
+    for &c in ring.iter().chain(AXES.iter()) {
         let d = clearance(c);
         if d > best.0 {
             best = (d, c);

@@ -3,6 +3,17 @@
 use glam::DVec3;
 use robust::{Coord3D, orient3d};
 
+/// The six coordinate axis directions: candidate probe points and fan apexes that are far from
+/// any given small set of directions.
+pub(crate) const AXES: [DVec3; 6] = [
+    DVec3::X,
+    DVec3::Y,
+    DVec3::Z,
+    DVec3::NEG_X,
+    DVec3::NEG_Y,
+    DVec3::NEG_Z,
+];
+
 #[inline]
 fn c3(p: DVec3) -> Coord3D<f64> {
     Coord3D {
