@@ -3,14 +3,13 @@
 use alloc::vec::Vec;
 
 use glam::{DMat3, DVec3};
-use smallvec::SmallVec;
 
 use super::brdf::Material;
 use super::cull::{BoundingSphere, above_horizon, may_occlude};
 use super::mesh::{ConvexPolyhedron, TriangleMesh};
 use super::silhouette::{ShadingFrame, TriangleRole, convex_silhouette, triangle_polygon};
 use crate::GeomError;
-use crate::ltc::{clamped_cosine_integral, lookup};
+use crate::ltc::{clamped_cosine_integral, lookup, ltc_integral};
 use crate::planar::BoolOp;
 use crate::sphere::SphericalPolygon;
 
@@ -289,7 +288,7 @@ impl Scene {
         for vis in self.visible_region(i, frame)? {
             diffuse += clamped_cosine_integral(&vis);
             if let Some((m_inv, _)) = spec {
-                specular += clamped_cosine_integral(&transform(&vis, m_inv));
+                specular += ltc_integral(&vis, m_inv)?;
             }
         }
         let mut out = material.albedo() * diffuse;
@@ -443,26 +442,4 @@ impl Scene {
         }
         Ok(vis)
     }
-}
-
-/// The polygon mapped by the linear transform `m` (directions `w -> m w / |m w|`), e.g. the LTC
-/// inverse matrix (HDHN16 eq. 4). Great circles map to great circles and an invertible map
-/// keeps rings simple and disjoint; a map with negative determinant mirrors, so the rings are
-/// reversed to keep the interior on the left.
-pub(crate) fn transform(p: &SphericalPolygon, m: DMat3) -> SphericalPolygon {
-    if p.is_full() || p.is_empty() {
-        return p.clone();
-    }
-    let flip = m.determinant() < 0.0;
-    let mut verts = SmallVec::<[DVec3; 12]>::new();
-    let mut ends = SmallVec::<[u32; 2]>::new();
-    for ring in p.rings() {
-        let start = verts.len();
-        verts.extend(ring.iter().map(|&w| (m * w).normalize()));
-        if flip {
-            verts[start..].reverse();
-        }
-        ends.push(verts.len() as u32);
-    }
-    SphericalPolygon::from_parts(verts, ends)
 }
