@@ -285,3 +285,26 @@ fn scene_is_send_and_sync() {
     send_sync::<Scene>();
     send_sync::<ConvexPolyhedron>();
 }
+
+#[test]
+fn bad_light_index_is_an_error() {
+    let quad = TriangleMesh::quad(DVec3::Z * 2.0, DVec3::Y, DVec3::X).unwrap();
+    let scene = Scene::new(vec![Light::new(quad, DVec3::ONE).unwrap()], vec![]).unwrap();
+    let f = ShadingFrame::new(DVec3::ZERO, DVec3::Z, DVec3::Z).unwrap();
+    let m = Material::diffuse(DVec3::ONE).unwrap();
+    assert!(scene.light_region(1, &f).is_err());
+    assert!(scene.visible_region(7, &f).is_err());
+    assert!(
+        scene
+            .shade_light(1, DVec3::ZERO, DVec3::Z, DVec3::Z, &m)
+            .is_err()
+    );
+    assert_eq!(scene.occluders_between(3, &f).count(), 0);
+    assert!(
+        scene
+            .shade_light(0, DVec3::ZERO, DVec3::Z, DVec3::Z, &m)
+            .unwrap()
+            .x
+            > 0.0
+    );
+}

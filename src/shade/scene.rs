@@ -179,6 +179,15 @@ impl Scene {
         &self.lights
     }
 
+    /// Light `i`, or [`GeomError::OutOfRange`] past the end.
+    fn light(&self, i: usize) -> Result<&Light, GeomError> {
+        self.lights.get(i).ok_or(GeomError::OutOfRange {
+            what: "light index",
+            value: i as f64,
+            limit: self.lights.len() as f64,
+        })
+    }
+
     /// The occluders.
     #[must_use]
     pub fn occluders(&self) -> &[Shape] {
@@ -193,8 +202,18 @@ impl Scene {
         frame: &ShadingFrame,
     ) -> impl Iterator<Item = usize> + '_ {
         let (x, n) = (frame.origin(), frame.normal());
-        let lb = self.light_bounds[light];
-        (0..self.occluders.len()).filter(move |&o| may_occlude(x, n, lb, self.occluder_bounds[o]))
+        // An invalid light index has no occluders in between (and no region either).
+        let lb = self.light_bounds.get(light).copied();
+        let count = if lb.is_some() {
+            self.occluders.len()
+        } else {
+            0
+        };
+        let lb = lb.unwrap_or(BoundingSphere {
+            center: DVec3::ZERO,
+            radius: 0.0,
+        });
+        (0..count).filter(move |&o| may_occlude(x, n, lb, self.occluder_bounds[o]))
     }
 
     /// The outgoing radiance (RGB) at `point` towards `view`, for a surface with normal
@@ -250,13 +269,7 @@ impl Scene {
         view: DVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
-        if light >= self.lights.len() {
-            return Err(GeomError::OutOfRange {
-                what: "light index",
-                value: light as f64,
-                limit: self.lights.len() as f64,
-            });
-        }
+        self.light(light)?;
         let frame = ShadingFrame::new(point, normal, view)?;
         let spec = if material.has_specular() {
             let look = lookup(frame.view().z, material.alpha())?;
@@ -305,7 +318,7 @@ impl Scene {
     ///
     /// # Errors
     ///
-    /// As [`Scene::shade`].
+    /// As [`Scene::light_region`] and [`Scene::subtract_occluders`].
     pub fn visible_region(
         &self,
         light: usize,
@@ -333,14 +346,15 @@ impl Scene {
     ///
     /// # Errors
     ///
-    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`].
+    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`];
+    /// [`GeomError::OutOfRange`] for a light index past the end.
     pub fn light_region(
         &self,
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
         let up = DVec3::Z;
-        let shape = &self.lights[light].shape;
+        let shape = &self.light(light)?.shape;
         if let (Shape::Convex(p), Method::Silhouette) = (shape, self.method) {
             let s = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
             return Ok(if s.is_empty() {
@@ -384,7 +398,8 @@ impl Scene {
     ///
     /// # Errors
     ///
-    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`].
+    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`];
+    /// [`GeomError::OutOfRange`] for a light index past the end.
     pub fn subtract_occluders(
         &self,
         light: usize,
@@ -392,6 +407,7 @@ impl Scene {
         region: SphericalPolygon,
     ) -> Result<SphericalPolygon, GeomError> {
         let up = DVec3::Z;
+        self.light(light)?;
         let mut vis = region;
         if vis.is_empty() {
             return Ok(vis);
