@@ -334,9 +334,10 @@ fn run(args: &Args) -> Result<(), String> {
                 })
                 .collect()
         });
+    let ref_note;
     let reference = match cached {
         Some(r) => {
-            println!("reference: cached {}", cache.display());
+            ref_note = format!("reference: cached {}", cache.display());
             r
         }
         None => {
@@ -356,7 +357,7 @@ fn run(args: &Args) -> Result<(), String> {
                 .flat_map(f64::to_le_bytes)
                 .collect();
             std::fs::write(&cache, bytes).map_err(|e| e.to_string())?;
-            println!(
+            ref_note = format!(
                 "reference: computed in {:.1} s ({} samples per light per pixel), cached in {}",
                 t.elapsed().as_secs_f64(),
                 args.ref_spp,
@@ -401,6 +402,7 @@ fn run(args: &Args) -> Result<(), String> {
     println!(
         "monte-carlo: time {t_mc:.2} s, MAE {mae_m:.4}, RMSE {rmse_m:.4} ({passes} samples per light per pixel)"
     );
+    println!("{ref_note}");
     let fails = failures.load(std::sync::atomic::Ordering::Relaxed);
     if fails > 0 || nan > 0 {
         println!("warning: {fails} pixels failed to shade, {nan} non-finite pixels");
