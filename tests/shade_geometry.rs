@@ -308,3 +308,45 @@ fn bad_light_index_is_an_error() {
             > 0.0
     );
 }
+
+#[test]
+fn points_in_face_planes_see_the_same_region_both_ways() {
+    // Shading points in the plane of a face (outside the polyhedron): that face is edge-on. The
+    // silhouette path treats it as back-facing; the per-triangle path skips it. Both must cover
+    // the same solid angle. Also points on the lines through edges, where two faces are edge-on.
+    let mut rng = Pcg32::new(17, 8);
+    let shapes = [
+        ConvexPolyhedron::cuboid(DVec3::new(0.1, -0.2, 0.5), DVec3::new(0.5, 0.3, 0.5)).unwrap(),
+        ConvexPolyhedron::icosphere(DVec3::ZERO, 0.7, 1).unwrap(),
+        ConvexPolyhedron::frustum(DVec3::ZERO, DVec3::new(0.1, 0.2, 1.0), 0.5, 0.2, 10).unwrap(),
+    ];
+    let mut checked = 0;
+    for poly in &shapes {
+        let mesh = poly.mesh();
+        for t in 0..mesh.triangle_count() {
+            let [a, b, c] = mesh.triangle(t);
+            let n = mesh.triangle_normal(t);
+            let centroid = (a + b + c) / 3.0;
+            let (u, _) = n.any_orthonormal_pair();
+            let d = u * (1.5 + 2.0 * rng.next_f64());
+            for x in [centroid + d, a + (b - a) * (2.0 + rng.next_f64())] {
+                // Only points outside (behind no face by more than the tolerance).
+                let frame = ShadingFrame::new(x, rand_dir(&mut rng), DVec3::Z).unwrap();
+                let sil = convex_silhouette(poly, &frame).unwrap();
+                let sum: f64 = (0..mesh.triangle_count())
+                    .filter_map(|k| {
+                        triangle_polygon(mesh, k, &frame, TriangleRole::Emitter).unwrap()
+                    })
+                    .map(|p| p.solid_angle())
+                    .sum();
+                assert!(
+                    (sil.solid_angle() - sum).abs() <= 1e-9,
+                    "face {t}: silhouette {} per-triangle {sum}",
+                    sil.solid_angle()
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 100);
+}
