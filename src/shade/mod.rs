@@ -13,6 +13,25 @@
 //!   lights' triangles, exact ray-triangle visibility), with its standard error, for tests and
 //!   comparisons.
 //!
+//! # Examples
+//!
+//! ```
+//! use arealight::glam::DVec3;
+//! use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
+//! // A quad light facing down, 3 above the floor, and a cube half-way, slightly off-axis.
+//! let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+//! let cube = ConvexPolyhedron::cuboid(DVec3::new(0.3, 0.0, 1.5), DVec3::splat(0.25))?;
+//! let lit = Scene::new(vec![Light::new(quad.clone(), DVec3::ONE)?], vec![])?;
+//! let shadowed = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![cube.into()])?;
+//! let floor = Material::new(DVec3::splat(0.8), DVec3::splat(0.04), 0.5)?;
+//! let (x, n, v) = (DVec3::ZERO, DVec3::Z, DVec3::new(0.3, 0.0, 1.0));
+//! let full = lit.shade(x, n, v, &floor)?;
+//! let penumbra = shadowed.shade(x, n, v, &floor)?;
+//! // The cube hides part of the light: a soft shadow, neither black nor fully lit.
+//! assert!(penumbra.x > 0.1 * full.x && penumbra.x < 0.9 * full.x);
+//! # Ok::<(), arealight::GeomError>(())
+//! ```
+//!
 //! # References
 //!
 //! - Seed 000: *Fast analytic soft shadows from area lights* (Alg. 1 overview, Alg. 2 silhouettes,
