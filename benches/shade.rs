@@ -13,11 +13,25 @@ fn occluders(c: &mut Criterion) {
     let cone = demo.scene.lights()[2].clone();
     // A ground point in the penumbra of the icosphere under the cone light.
     let (x, n, v) = (
-        DVec3::new(0.9, -0.25, 0.0),
+        DVec3::new(1.4, -0.25, 0.0),
         DVec3::Z,
         DVec3::new(0.2, -0.7, 0.7),
     );
     let m = demo.ground;
+    // Check once that the point is in a penumbra: the icosphere hides part of the light.
+    let lit = Scene::new(vec![cone.clone()], vec![])
+        .unwrap()
+        .shade(x, n, v, &m)
+        .unwrap();
+    let ico = vec![demo.scene.occluders()[1].clone()];
+    let half = Scene::new(vec![cone.clone()], ico)
+        .unwrap()
+        .shade(x, n, v, &m)
+        .unwrap();
+    assert!(
+        half.y > 0.05 * lit.y && half.y < 0.95 * lit.y,
+        "not a penumbra: {half} of {lit}"
+    );
     let mut group = c.benchmark_group("shade/one point, 1 light");
     for k in [0usize, 1, 3] {
         let occ = match k {
