@@ -149,3 +149,58 @@ fn occluded_analytic_matches_monte_carlo_with_ltc_brdf() {
     let worst = check_against_mc(DemoConfig::default(), 1000, 1024, 2);
     eprintln!("largest |z| = {worst:.2}");
 }
+
+#[test]
+fn silhouette_path_never_fails_on_random_points() {
+    // Points anywhere in the scene's box (inside occluders and lights too), on occluder
+    // surfaces, edges and vertices, with random normals and views: the silhouette path must
+    // return a finite, non-negative radiance every time.
+    let demo = demo_scene(DemoConfig::default()).unwrap();
+    let scene = &demo.scene;
+    let mut rng = Pcg32::new(99, 5);
+    let dir = |rng: &mut Pcg32| {
+        let z = 2.0 * rng.next_f64() - 1.0;
+        let phi = 2.0 * PI * rng.next_f64();
+        let r = (1.0 - z * z).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let mut failures = Vec::new();
+    for i in 0..6000 {
+        let x = match i % 3 {
+            0 => DVec3::new(
+                6.0 * rng.next_f64() - 3.0,
+                6.0 * rng.next_f64() - 3.0,
+                3.5 * rng.next_f64(),
+            ),
+            1 => {
+                // A vertex or an edge midpoint of an occluder or light mesh.
+                let shapes: Vec<_> = scene
+                    .occluders()
+                    .iter()
+                    .chain(scene.lights().iter().map(|l| l.shape()))
+                    .collect();
+                let mesh = shapes[i % shapes.len()].mesh();
+                let t = (rng.next_u32() as usize) % mesh.triangle_count();
+                let [a, b, _] = mesh.triangle(t);
+                if rng.next_f64() < 0.5 {
+                    a
+                } else {
+                    (a + b) / 2.0
+                }
+            }
+            _ => DVec3::new(6.0 * rng.next_f64() - 3.0, 6.0 * rng.next_f64() - 3.0, 0.0),
+        };
+        let n = if i % 3 == 2 { DVec3::Z } else { dir(&mut rng) };
+        let v = dir(&mut rng);
+        match scene.shade(x, n, v, &demo.ground) {
+            Ok(c) if c.is_finite() && c.min_element() >= 0.0 => {}
+            other => failures.push(format!("point {i} x {x} n {n} v {v}: {other:?}")),
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
