@@ -68,6 +68,7 @@ fn check_against_mc(cfg: DemoConfig, count: usize, samples: u32, seed: u64) -> f
     let per_tri = scene.clone().with_method(Method::PerTriangle);
     let mc = MonteCarlo::new(samples, ReferenceBrdf::Ltc);
     let mut worst: f64 = 0.0;
+    let (mut zsum, mut zcount) = (0.0, 0usize);
     let mut failures = Vec::new();
     let mut per_tri_errors = Vec::new();
     for (i, p) in pts.iter().enumerate() {
@@ -89,6 +90,10 @@ fn check_against_mc(cfg: DemoConfig, count: usize, samples: u32, seed: u64) -> f
             let tol = 4.0 * s + 1e-6;
             if s > 0.0 {
                 worst = worst.max((av - mv).abs() / s);
+                if c == 1 {
+                    zsum += (av - mv) / s;
+                    zcount += 1;
+                }
             }
             if (av - mv).abs() > tol {
                 failures.push(format!("point {i} ch {c}: analytic {av} mc {mv} +- {s}"));
@@ -100,6 +105,27 @@ fn check_against_mc(cfg: DemoConfig, count: usize, samples: u32, seed: u64) -> f
         "{} failures:\n{}",
         failures.len(),
         failures.join("\n")
+    );
+    // A bias too small to show at any one point shows in the mean z-score (green channel, one per
+    // point; independent estimates, so the mean is about N(0, 1 / count)).
+    let zmean = zsum / zcount as f64;
+    eprintln!("mean z = {zmean:.3} over {zcount} points");
+    assert!(
+        zmean.abs() <= 4.0 / (zcount as f64).sqrt(),
+        "mean z-score {zmean}: a bias"
+    );
+    // KNOWN WEAKNESS (sphere layer): the per-triangle path runs hundreds of spherical differences
+    // of triangles sharing edges with each other, and `SphericalPolygon::boolean` still reports
+    // `Degenerate` on a few near-degenerate configurations (about 7e-6 of the differences, see
+    // tests/shade_known_failures.rs). The silhouette path must never fail; the per-triangle path
+    // may fail on at most 1% of the points, and every failure is printed.
+    if !per_tri_errors.is_empty() {
+        eprintln!("per-triangle path errors:\n{}", per_tri_errors.join("\n"));
+    }
+    assert!(
+        per_tri_errors.len() * 100 <= count,
+        "{} per-triangle errors",
+        per_tri_errors.len()
     );
     worst
 }
