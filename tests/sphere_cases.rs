@@ -369,3 +369,17 @@ fn fuzz_regression_clip_twice_through_a_pinch() {
     let tri = p.complement().solid_angle();
     assert!(close(once.solid_angle(), 2.0 * PI - tri, 1e-12));
 }
+
+#[test]
+fn fuzz_regression_sliver_is_rejected() {
+    // Three directions on one great circle to within rounding (area 9e-18 sr over a perimeter
+    // of 3 rad): validation used to accept it, and the horizon clip then had no reliable side.
+    let r = SphericalPolygon::new(vec![vec![
+        DVec3::new(-1.0, -1.0, 10.0),
+        DVec3::new(-1.0, 96.0, 10.0),
+        DVec3::new(0.0, 1.0, 0.0),
+    ]]);
+    assert_eq!(r, Err(GeomError::ZeroArea { ring: 0 }));
+    // A tiny but well-shaped polygon is fine.
+    assert!(SphericalPolygon::new(vec![cap_ring(DVec3::Z, 1e-7, 4)]).is_ok());
+}
