@@ -55,6 +55,12 @@ pub enum GeomError {
         /// Index of the second ring involved (equal to `ring` for a self-crossing contour).
         other_ring: usize,
     },
+    /// A ring encloses no area: its vertices lie on one great circle to within rounding, so
+    /// neither of its sides is a meaningful region.
+    ZeroArea {
+        /// Index of the ring in the input.
+        ring: usize,
+    },
     /// Two rings that bound the same face disagree about which side of it is inside (for example
     /// two nested rings both counter-clockwise): the region is ambiguous.
     InconsistentOrientation {
@@ -150,6 +156,11 @@ impl fmt::Display for GeomError {
             GeomError::SelfIntersecting { ring, other_ring } => write!(
                 f,
                 "rings {ring} and {other_ring} cross each other; rings must only nest or be disjoint"
+            ),
+            GeomError::ZeroArea { ring } => write!(
+                f,
+                "ring {ring} encloses no area (its vertices lie on one great circle within \
+                 rounding); drop it"
             ),
             GeomError::InconsistentOrientation { ring, other_ring } => write!(
                 f,

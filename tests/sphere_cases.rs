@@ -337,3 +337,49 @@ fn order_edges_of_a_box_silhouette() {
         1e-12
     ));
 }
+
+/// Minimized fuzz failures (`fuzz/fuzz_targets/sphere_clip.rs`), kept as regressions.
+#[test]
+fn fuzz_regression_clip_twice_through_a_pinch() {
+    // A large region (the outside of a triangle touching the clip circle at one vertex) clips to
+    // a ring that passes through that vertex twice and then runs once round the circle. Clipping
+    // that again used to drop the circle lobe: at the second visit the ring continues exactly
+    // along the circle, and the corner test decided "closed" by rounding.
+    let p = poly(vec![vec![
+        DVec3::new(-1.0, -1.0, -63.0),
+        DVec3::new(0.0, 4.0, -1.0),
+        DVec3::new(-46.0, -3.0, 46.0),
+    ]]);
+    let n = DVec3::new(-1.0, 0.0, -1.0);
+    let once = p.clip_to_hemisphere(n);
+    let twice = once.clip_to_hemisphere(n);
+    assert!(
+        close(twice.solid_angle(), once.solid_angle(), 1e-12),
+        "{} vs {}",
+        twice.solid_angle(),
+        once.solid_angle()
+    );
+    let down = p.clip_to_hemisphere(-n);
+    assert!(close(
+        once.solid_angle() + down.solid_angle(),
+        p.solid_angle(),
+        1e-12
+    ));
+    // The triangle lies in the clip hemisphere: the clipped region is the hemisphere minus it.
+    let tri = p.complement().solid_angle();
+    assert!(close(once.solid_angle(), 2.0 * PI - tri, 1e-12));
+}
+
+#[test]
+fn fuzz_regression_sliver_is_rejected() {
+    // Three directions on one great circle to within rounding (area 9e-18 sr over a perimeter
+    // of 3 rad): validation used to accept it, and the horizon clip then had no reliable side.
+    let r = SphericalPolygon::new(vec![vec![
+        DVec3::new(-1.0, -1.0, 10.0),
+        DVec3::new(-1.0, 96.0, 10.0),
+        DVec3::new(0.0, 1.0, 0.0),
+    ]]);
+    assert_eq!(r, Err(GeomError::ZeroArea { ring: 0 }));
+    // A tiny but well-shaped polygon is fine.
+    assert!(SphericalPolygon::new(vec![cap_ring(DVec3::Z, 1e-7, 4)]).is_ok());
+}

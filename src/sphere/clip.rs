@@ -267,6 +267,12 @@ fn circle_gap(from: &Chain, to: &Chain) -> f64 {
 fn corner_contains(a: DVec3, b: DVec3, c: DVec3, t: DVec3) -> bool {
     let da = a - b * a.dot(b);
     let dc = c - b * c.dot(b);
+    // The next edge runs along `t` itself (the ring continues counter-clockwise on the circle):
+    // the region lies on its left, the hemisphere's side, so it does continue past the exit.
+    // Decided here because the angle below would be 0 or a full turn by rounding alone.
+    if dc.cross(t).length() <= 1e-12 * dc.length() * t.length() && dc.dot(t) > 0.0 {
+        return true;
+    }
     let sweep = |x: DVec3| crate::math::atan2(dc.cross(x).dot(b), dc.dot(x)).rem_euclid(2.0 * PI);
     sweep(t) < sweep(da)
 }

@@ -78,6 +78,8 @@ impl SphericalPolygon {
     /// - [`GeomError::TooFewVertices`] for a ring of fewer than three vertices;
     /// - [`GeomError::SelfIntersecting`] when a ring crosses or touches itself or another ring
     ///   (checked exactly, with Shewchuk's `orient3d`; the check is quadratic in the vertex count);
+    /// - [`GeomError::ZeroArea`] for a ring whose vertices lie on one great circle to within
+    ///   rounding (its smaller side is below `1e-12` times its squared perimeter);
     /// - [`GeomError::InconsistentOrientation`] when two rings bounding the same face disagree on
     ///   which side is inside (for example two nested rings both counter-clockwise).
     pub fn new(rings: Vec<Vec<DVec3>>) -> Result<Self, GeomError> {
@@ -108,6 +110,7 @@ impl SphericalPolygon {
             poly.ends.push(poly.verts.len() as u32);
         }
         poly.check_simple()?;
+        poly.check_area()?;
         poly.check_consistent()?;
         Ok(poly)
     }
@@ -402,6 +405,28 @@ impl SphericalPolygon {
     fn ring_len(&self, r: usize) -> usize {
         let s = if r == 0 { 0 } else { self.ends[r - 1] as usize };
         self.ends[r] as usize - s
+    }
+
+    /// Rejects rings whose smaller side is negligible against their extent: a ring of width below
+    /// about `1e-12` of its length is a sliver whose two sides cannot be told apart reliably
+    /// (every side test near it is decided by rounding). The threshold is relative, so tiny but
+    /// well-shaped rings (a square `1e-7` rad across) are accepted.
+    fn check_area(&self) -> Result<(), GeomError> {
+        for (r, ring) in self.rings().enumerate() {
+            let left = ring_left_area(ring);
+            let area = left.min(4.0 * PI - left);
+            let n = ring.len();
+            let perimeter: f64 = (0..n)
+                .map(|i| {
+                    let (a, b) = (ring[i], ring[(i + 1) % n]);
+                    crate::math::atan2(a.cross(b).length(), a.dot(b))
+                })
+                .sum();
+            if !(area > 1e-12 * perimeter * perimeter) {
+                return Err(GeomError::ZeroArea { ring: r });
+            }
+        }
+        Ok(())
     }
 
     /// Rejects rings that disagree about which side of a shared face is inside.
