@@ -252,8 +252,9 @@ pub enum TriangleRole {
 }
 
 /// The spherical triangle that mesh triangle `i` covers, seen from the frame's origin, in the
-/// local frame; `None` when it covers nothing (seen edge-on within [`FACE_TOLERANCE`], or from
-/// behind for an [`TriangleRole::Emitter`]).
+/// local frame; `None` when it covers nothing (seen edge-on within [`FACE_TOLERANCE`] or so
+/// nearly edge-on that its projection has no area within rounding, or from behind for an
+/// [`TriangleRole::Emitter`]).
 ///
 /// # Errors
 ///
@@ -275,12 +276,19 @@ pub fn triangle_polygon(
     let (a, b, c) = (frame.to_local(a), frame.to_local(b), frame.to_local(c));
     // A front-facing triangle runs counter-clockwise seen from x: clockwise on the sphere seen
     // from outside, so its covered region is the reversed ring (see `convex_silhouette`).
-    if s > tol {
-        SphericalPolygon::new(vec![vec![a, c, b]]).map(Some)
+    let ring = if s > tol {
+        vec![a, c, b]
     } else if s < -tol && role == TriangleRole::Blocker {
-        SphericalPolygon::new(vec![vec![a, b, c]]).map(Some)
+        vec![a, b, c]
     } else {
-        Ok(None)
+        return Ok(None);
+    };
+    match SphericalPolygon::new(vec![ring]) {
+        Ok(p) => Ok(Some(p)),
+        // Seen so nearly edge-on that its projection has no area within rounding (its corners
+        // on one great circle, or two of them in one direction): it covers nothing.
+        Err(GeomError::ZeroArea { .. } | GeomError::CoincidentVertices { .. }) => Ok(None),
+        Err(e) => Err(e),
     }
 }
 
