@@ -7,6 +7,11 @@
 //! triangle of every occluder (no culling, so the analytic path's culling is checked too), and of
 //! the light's own mesh for non-convex lights (self-occlusion). The estimator returns its mean and
 //! standard error, so tests can state a confidence bound.
+//!
+//! Like the analytic path, lights do not block each other, and only the outer (front) side of a
+//! light emits: a shading point inside a closed light sees none of its triangles from the front
+//! and gets nothing here, where the analytic path counts the whole sphere (the one configuration
+//! where the two differ; no scene meant for rendering has it).
 
 use alloc::vec::Vec;
 
