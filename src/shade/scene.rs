@@ -228,7 +228,8 @@ impl Scene {
     /// # Errors
     ///
     /// Invalid point, normal or view ([`ShadingFrame::new`]); a degenerate silhouette (the point
-    /// within rounding distance of a light's or occluder's edge line).
+    /// within rounding distance of a light's or occluder's edge line); an error of the spherical
+    /// set operations ([`SphericalPolygon::boolean`]) on a near-degenerate configuration.
     pub fn shade(
         &self,
         point: DVec3,
@@ -238,18 +239,7 @@ impl Scene {
     ) -> Result<DVec3, GeomError> {
         let frame = ShadingFrame::new(point, normal, view)?;
         let mut total = DVec3::ZERO;
-        let spec = if material.has_specular() {
-            let look = lookup(frame.view().z, material.alpha())?;
-            let f0 = material.f0();
-            let scale = DVec3::new(
-                look.specular_scale(f0.x),
-                look.specular_scale(f0.y),
-                look.specular_scale(f0.z),
-            );
-            Some((look.m_inv, scale))
-        } else {
-            None
-        };
+        let spec = specular_setup(&frame, material)?;
         for i in 0..self.lights.len() {
             total += self.shade_light_in(i, &frame, material, spec)?;
         }
@@ -271,18 +261,7 @@ impl Scene {
     ) -> Result<DVec3, GeomError> {
         self.light(light)?;
         let frame = ShadingFrame::new(point, normal, view)?;
-        let spec = if material.has_specular() {
-            let look = lookup(frame.view().z, material.alpha())?;
-            let f0 = material.f0();
-            let scale = DVec3::new(
-                look.specular_scale(f0.x),
-                look.specular_scale(f0.y),
-                look.specular_scale(f0.z),
-            );
-            Some((look.m_inv, scale))
-        } else {
-            None
-        };
+        let spec = specular_setup(&frame, material)?;
         self.shade_light_in(light, &frame, material, spec)
     }
 
@@ -458,4 +437,24 @@ impl Scene {
         }
         Ok(vis)
     }
+}
+
+/// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,
+/// [`crate::ltc::LtcLookup::specular_scale`]) for the frame's view angle and the material's
+/// roughness; `None` for a material without a specular lobe. One table lookup per shading point.
+fn specular_setup(
+    frame: &ShadingFrame,
+    material: &Material,
+) -> Result<Option<(DMat3, DVec3)>, GeomError> {
+    if !material.has_specular() {
+        return Ok(None);
+    }
+    let look = lookup(frame.view().z, material.alpha())?;
+    let f0 = material.f0();
+    let scale = DVec3::new(
+        look.specular_scale(f0.x),
+        look.specular_scale(f0.y),
+        look.specular_scale(f0.z),
+    );
+    Ok(Some((look.m_inv, scale)))
 }
