@@ -375,3 +375,26 @@ fn near_antipodal_operands() {
         }
     }
 }
+
+#[test]
+fn fuzz_regression_union_touching_at_a_vertex_inside_an_edge() {
+    // B touches the boundary circle of the hemisphere A at one of B's vertices, which lies
+    // inside an edge of A. The planar union returned the touching point as a T-junction, which
+    // is not a valid spherical ring set; it is now inserted into the touched edge.
+    let a = SphericalPolygon::new(vec![vec![
+        DVec3::new(48.0, 48.0, 37.0),
+        DVec3::new(-1.0, -1.0, -1.0),
+        DVec3::new(-1.0, -1.0, 46.0),
+    ]])
+    .unwrap()
+    .complement();
+    let b = SphericalPolygon::new(vec![vec![
+        DVec3::new(37.0, 48.0, -1.0),
+        DVec3::new(-1.0, -1.0, -17.0),
+        DVec3::new(-1.0, 48.0, 48.0),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    let u = a.boolean(&b, BoolOp::Union).unwrap();
+    assert!((u.solid_angle() - (a.solid_angle() + b.solid_angle())).abs() < 1e-12);
+}

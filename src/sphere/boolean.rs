@@ -171,14 +171,50 @@ fn projected(
     };
     let mut verts = Verts::new();
     let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
-    for contour in shape.contours() {
-        for &q in contour {
+    let contours: Vec<&[DVec2]> = shape.contours().collect();
+    for contour in &contours {
+        let n = contour.len();
+        for (i, &q) in contour.iter().enumerate() {
             verts.push(g.unproject(q));
+            // Planar results may touch at a vertex lying inside another contour's edge; spherical
+            // rings may touch only at shared vertices, so the vertex is inserted into that edge.
+            let next = contour[(i + 1) % n];
+            for p in touching_vertices(&contours, q, next) {
+                verts.push(g.unproject(p));
+            }
         }
         ends.push(verts.len() as u32);
     }
     let r = SphericalPolygon::from_parts(verts, ends);
     Ok(if complemented { r.complement() } else { r })
+}
+
+/// Vertices of any contour lying exactly inside the segment `a-b` (not at its ends), in order
+/// from `a`. Exact: collinearity by `orient2d`, betweenness along the segment.
+fn touching_vertices(contours: &[&[DVec2]], a: DVec2, b: DVec2) -> SmallVec<[DVec2; 2]> {
+    let mut hits: SmallVec<[(f64, DVec2); 2]> = SmallVec::new();
+    let d = b - a;
+    for c in contours {
+        for &p in c.iter() {
+            if p == a || p == b {
+                continue;
+            }
+            let o = robust::orient2d(
+                robust::Coord { x: a.x, y: a.y },
+                robust::Coord { x: b.x, y: b.y },
+                robust::Coord { x: p.x, y: p.y },
+            );
+            if o != 0.0 {
+                continue;
+            }
+            let t = (p - a).dot(d) / d.length_squared();
+            if t > 0.0 && t < 1.0 && !hits.iter().any(|h| h.1 == p) {
+                hits.push((t, p));
+            }
+        }
+    }
+    hits.sort_by(|x, y| x.0.total_cmp(&y.0));
+    hits.into_iter().map(|h| h.1).collect()
 }
 
 /// The operation on operands no narrow cap holds: solved per octant and merged.

@@ -340,8 +340,14 @@ impl SphericalPolygon {
                 };
                 match shared {
                     Some((x, p, q)) => {
+                        // Within rounding of the same direction counts as overlapping: a spike
+                        // narrower than 1e-12 rad has no side any later operation can resolve
+                        // (an exactly collinear spike in the caller's coordinates is no longer
+                        // exactly collinear once normalized).
                         let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
-                        if orient(x, p, q) == 0 && tp.dot(tq) > 0.0 {
+                        let parallel = orient(x, p, q) == 0
+                            || tp.cross(tq).length() <= 1e-12 * tp.length() * tq.length();
+                        if parallel && tp.dot(tq) > 0.0 {
                             return Err(err(r, s));
                         }
                         // The far ends may still meet the other edge (two edges sharing both
