@@ -10,7 +10,7 @@ use smallvec::SmallVec;
 use super::clip::HORIZON_TOLERANCE;
 use super::gnomonic::{Gnomonic, enclosing_cap};
 use super::order::order_directed_edges;
-use super::polygon::{SphericalPolygon, Verts};
+use super::polygon::{SphericalPolygon, Verts, close_ring};
 use super::predicates::tangent_frame;
 use crate::GeomError;
 use crate::planar::{BoolOp, Shape, boolean};
@@ -174,6 +174,7 @@ fn projected(
     let contours: Vec<&[DVec2]> = shape.contours().collect();
     for contour in &contours {
         let n = contour.len();
+        let start = verts.len();
         for (i, &q) in contour.iter().enumerate() {
             verts.push(g.unproject(q));
             // Planar results may touch at a vertex lying inside another contour's edge; spherical
@@ -183,7 +184,9 @@ fn projected(
                 verts.push(g.unproject(p));
             }
         }
-        ends.push(verts.len() as u32);
+        // Distinct planar points can unproject to the same direction (or one a few ulps away);
+        // such repeats are dropped, and a ring left with fewer than three vertices with them.
+        close_ring(&mut verts, &mut ends, start);
     }
     let r = SphericalPolygon::from_parts(verts, ends);
     Ok(if complemented { r.complement() } else { r })

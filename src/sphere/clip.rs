@@ -5,7 +5,7 @@ use core::f64::consts::PI;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::polygon::{COINCIDENT_TOLERANCE, SphericalPolygon, Verts, nearest_feature};
+use super::polygon::{SphericalPolygon, Verts, close_ring, nearest_feature};
 use super::predicates::{normalize_any, tangent_frame};
 use crate::GeomError;
 
@@ -328,29 +328,6 @@ fn hemisphere(n: DVec3) -> SphericalPolygon {
 fn push_circle(verts: &mut Verts, ends: &mut SmallVec<[u32; 2]>, _n: DVec3, u: DVec3, v: DVec3) {
     verts.extend_from_slice(&[u, v, -u, -v]);
     ends.push(verts.len() as u32);
-}
-
-/// Ends the ring begun at `start`: drops vertices that coincide with their predecessor, and the
-/// whole ring if fewer than three vertices remain (a zero-area remnant of a touching contact).
-fn close_ring(verts: &mut Verts, ends: &mut SmallVec<[u32; 2]>, start: usize) {
-    let mut w = start;
-    for r in start..verts.len() {
-        let p = verts[r];
-        if w > start && (p - verts[w - 1]).length() <= COINCIDENT_TOLERANCE {
-            continue;
-        }
-        verts[w] = p;
-        w += 1;
-    }
-    while w - start >= 2 && (verts[w - 1] - verts[start]).length() <= COINCIDENT_TOLERANCE {
-        w -= 1;
-    }
-    verts.truncate(w);
-    if w - start < 3 {
-        verts.truncate(start);
-    } else {
-        ends.push(w as u32);
-    }
 }
 
 fn finish(verts: Verts, ends: SmallVec<[u32; 2]>) -> SphericalPolygon {

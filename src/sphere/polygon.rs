@@ -481,6 +481,29 @@ impl SphericalPolygon {
     }
 }
 
+/// Ends the ring begun at `start`: drops vertices that coincide with their predecessor, and the
+/// whole ring if fewer than three vertices remain (a zero-area remnant of a touching contact).
+pub(crate) fn close_ring(verts: &mut Verts, ends: &mut SmallVec<[u32; 2]>, start: usize) {
+    let mut w = start;
+    for r in start..verts.len() {
+        let p = verts[r];
+        if w > start && (p - verts[w - 1]).length() <= COINCIDENT_TOLERANCE {
+            continue;
+        }
+        verts[w] = p;
+        w += 1;
+    }
+    while w - start >= 2 && (verts[w - 1] - verts[start]).length() <= COINCIDENT_TOLERANCE {
+        w -= 1;
+    }
+    verts.truncate(w);
+    if w - start < 3 {
+        verts.truncate(start);
+    } else {
+        ends.push(w as u32);
+    }
+}
+
 /// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
 pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
     let n = ring.len();
