@@ -398,3 +398,31 @@ fn fuzz_regression_union_touching_at_a_vertex_inside_an_edge() {
     let u = a.boolean(&b, BoolOp::Union).unwrap();
     assert!((u.solid_angle() - (a.solid_angle() + b.solid_angle())).abs() < 1e-12);
 }
+
+#[test]
+fn fuzz_regression_pinch_vertex_containment() {
+    // An octant piece of B touches itself at the pole (two lobes either side of a triangle's
+    // corner). `contains` judged points near such a pinch from one visit's corner only, and the
+    // projection took the piece for the complement of itself.
+    let a = SphericalPolygon::new(vec![vec![
+        DVec3::new(33.0, 48.0, -1.0),
+        DVec3::new(-1.0, -1.0, -1.0),
+        DVec3::new(-1.0, 3.0, 46.0),
+    ]])
+    .unwrap()
+    .complement();
+    let b = SphericalPolygon::new(vec![vec![
+        DVec3::new(0.0, 0.0, 37.0),
+        DVec3::new(77.0, -1.0, -1.0),
+        DVec3::new(1.0, -1.0, 49.0),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    // A and B together exceed the sphere: their union is all of it.
+    let u = a.boolean(&b, BoolOp::Union).unwrap();
+    assert!(
+        (u.solid_angle() - 4.0 * PI).abs() < 1e-12,
+        "{}",
+        u.solid_angle()
+    );
+}

@@ -132,12 +132,37 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
                 "a vertex left the projection hemisphere",
             ))?);
         }
-        contours.push(c);
+        split_pinches(c, &mut contours);
     }
     Ok(Planar {
         shape: Shape::new(contours)?,
         complemented,
     })
+}
+
+/// Splits a ring that visits a vertex more than once (a pinch, valid on the sphere) into simple
+/// rings, as planar shapes require: the loop between two visits becomes a ring of its own.
+fn split_pinches(mut ring: Vec<DVec2>, out: &mut Vec<Vec<DVec2>>) {
+    // Each split removes at least two vertices from `ring`, so this terminates.
+    'again: loop {
+        let n = ring.len();
+        for i in 0..n {
+            for j in i + 1..n {
+                if ring[i] == ring[j] {
+                    let inner: Vec<DVec2> = ring[i..j].to_vec();
+                    ring.drain(i..j);
+                    if inner.len() >= 3 {
+                        out.push(inner);
+                    }
+                    continue 'again;
+                }
+            }
+        }
+        break;
+    }
+    if ring.len() >= 3 {
+        out.push(ring);
+    }
 }
 
 /// The operation in one gnomonic projection about `c`, with every vertex of both operands in

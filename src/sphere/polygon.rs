@@ -158,7 +158,7 @@ impl SphericalPolygon {
     }
 
     /// The rings, each a slice of unit vectors (the closing edge from last to first is implied).
-    pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + '_ {
+    pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + Clone + '_ {
         let mut start = 0usize;
         self.ends.iter().map(move |&e| {
             let s = start;
@@ -548,19 +548,20 @@ fn fan_apex(ring: &[DVec3]) -> DVec3 {
 /// The boundary feature nearest to the unit vector `p`, as (squared chord distance, whether `p`
 /// is on the inside of it), or `None` when there are no rings.
 pub(crate) fn nearest_feature<'a>(
-    rings: impl Iterator<Item = &'a [DVec3]>,
+    rings: impl Iterator<Item = &'a [DVec3]> + Clone,
     p: DVec3,
 ) -> Option<(f64, bool)> {
-    let mut best: Option<(f64, bool)> = None;
-    let mut consider = |d: f64, inside: bool| {
+    // The nearest feature so far: its squared chord distance, and either the side of an edge or
+    // the vertex itself (whose side is decided after the scan, from all its visits).
+    let mut best: Option<(f64, Result<bool, DVec3>)> = None;
+    let mut consider = |d: f64, what: Result<bool, DVec3>| {
         if best.is_none_or(|(bd, _)| d < bd) {
-            best = Some((d, inside));
+            best = Some((d, what));
         }
     };
-    for ring in rings {
+    for ring in rings.clone() {
         let n = ring.len();
         for i in 0..n {
-            let prev = ring[(i + n - 1) % n];
             let a = ring[i];
             let b = ring[(i + 1) % n];
             let nrm = a.cross(b);
@@ -571,22 +572,40 @@ pub(crate) fn nearest_feature<'a>(
                 let s2 = (s * s).min(1.0);
                 // Squared chord to the nearest point, 2 - 2 cos(d), without cancellation.
                 let d = 2.0 * s2 / (1.0 + crate::math::sqrt(1.0 - s2));
-                consider(d, s > 0.0);
+                consider(d, Ok(s > 0.0));
             }
-            // The vertex a, with the wedge between its two edges: inside iff left of both edges'
-            // great circles at a convex vertex, left of either at a reflex one.
-            let left_in = prev.cross(a).dot(p) > 0.0;
-            let left_out = nrm.dot(p) > 0.0;
-            let convex = prev.cross(a).dot(b) > 0.0;
-            let inside = if convex {
-                left_in && left_out
-            } else {
-                left_in || left_out
-            };
-            consider((p - a).length_squared(), inside);
+            consider((p - a).length_squared(), Err(a));
         }
     }
-    best
+    let (d, what) = best?;
+    Some((d, what.unwrap_or_else(|v| vertex_side(rings, v, p))))
+}
+
+/// Whether `p` lies inside the region near the vertex `v`, from every visit of the rings to `v`
+/// (a pinch vertex is visited more than once). Around `v`, the sector just counter-clockwise of
+/// an edge direction is inside iff that edge leaves `v` (the interior is on the left of every
+/// edge); so the answer is the kind of the edge met first turning clockwise from `p`.
+fn vertex_side<'a>(rings: impl Iterator<Item = &'a [DVec3]>, v: DVec3, p: DVec3) -> bool {
+    let (u, w) = super::predicates::tangent_frame(v);
+    let ang = |q: DVec3| crate::math::atan2(q.dot(w), q.dot(u));
+    let target = ang(p);
+    // (clockwise turn from p's direction to the edge's, edge leaves v)
+    let mut best = (f64::INFINITY, false);
+    for ring in rings {
+        let n = ring.len();
+        for i in 0..n {
+            if ring[i] != v {
+                continue;
+            }
+            for (q, leaves) in [(ring[(i + n - 1) % n], false), (ring[(i + 1) % n], true)] {
+                let turn = (target - ang(q)).rem_euclid(2.0 * PI);
+                if turn < best.0 {
+                    best = (turn, leaves);
+                }
+            }
+        }
+    }
+    best.1
 }
 
 #[cfg(test)]
