@@ -426,3 +426,25 @@ fn fuzz_regression_pinch_vertex_containment() {
         u.solid_angle()
     );
 }
+
+#[test]
+fn fuzz_regression_touching_a_boundary_that_lies_on_a_cut() {
+    // B is the hemisphere bounded by the great circle y = 0, one of the octant cuts; A touches
+    // it at one of its vertices. After the cut edges cancelled, A's vertex lay inside one of B's
+    // surviving circle edges; the circle is now split there.
+    let a = SphericalPolygon::new(vec![vec![
+        DVec3::new(0.0, -1.0, 1.0),
+        DVec3::new(0.0, -1.0, 64.0),
+        DVec3::new(-1.0, 0.0, 85.0),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        DVec3::new(1.0, 0.0, -1.0),
+        DVec3::new(-65.0, 0.0, -1.0),
+        DVec3::new(-1.0, 0.0, 85.0),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    let u = a.boolean(&b, BoolOp::Union).unwrap();
+    assert!((u.solid_angle() - (a.solid_angle() + b.solid_angle())).abs() < 1e-12);
+}

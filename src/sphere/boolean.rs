@@ -333,6 +333,16 @@ fn cancel_cut_edges(edges: Vec<(DVec3, DVec3)>) -> Result<Vec<(DVec3, DVec3)>, G
                 events.push((tt, t, -w));
             }
         }
+        // Vertices of the other edges lying on this circle split its intervals there, so that a
+        // piece touching the circle at a vertex meets a vertex of the circle's edges, never the
+        // inside of one (rings may touch only at shared vertices).
+        for &(a, b) in &out {
+            for p in [a, b] {
+                if p[axis].abs() <= HORIZON_TOLERANCE {
+                    events.push((ang(p), p, 0));
+                }
+            }
+        }
         events.sort_by(|x, y| x.0.total_cmp(&y.0));
         let mut net = 0i32;
         let mut i = 0;
