@@ -448,3 +448,40 @@ fn fuzz_regression_touching_a_boundary_that_lies_on_a_cut() {
     let u = a.boolean(&b, BoolOp::Union).unwrap();
     assert!((u.solid_angle() - (a.solid_angle() + b.solid_angle())).abs() < 1e-12);
 }
+
+#[test]
+fn fuzz_regression_pinch_on_the_cut_circle() {
+    // B's two rings share a vertex on two of the octant cuts. Clipping the pinched piece joined
+    // the coincident exits and entries there by one visit's corner only, adding a whole circle.
+    let v = DVec3::new;
+    let a = SphericalPolygon::new(vec![vec![
+        v(9.0, 16.0, -10.0),
+        v(-9.0, 37.0, -1.0),
+        v(-1.0, -56.0, -1.0),
+        v(117.0, -1.0, 43.0),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![
+        vec![
+            v(-1.0, 37.0, 11.0),
+            v(31.0, 0.0, 0.0),
+            v(71.0, 71.0, 71.0),
+            v(-71.0, -1.0, 2.0),
+            v(-103.0, -103.0, -42.0),
+        ],
+        vec![
+            v(-1.0, 9.0, -103.0),
+            v(-1.0, 51.0, -109.0),
+            v(-109.0, -109.0, -109.0),
+            v(52.0, 0.0, 0.0),
+        ],
+    ])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    let mut p = b.clone();
+    for n in [DVec3::X, DVec3::Y, DVec3::Z] {
+        let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+        assert!((up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < 1e-12);
+        p = up;
+    }
+}

@@ -81,9 +81,6 @@ struct Chain {
     /// Polar angles on the circle of the entry and exit points.
     entry_angle: f64,
     exit_angle: f64,
-    /// Whether the region continues along the circle just counter-clockwise of the exit point.
-    /// True for a transversal exit; at a vertex on the circle it depends on the corner there.
-    exit_open_ccw: bool,
 }
 
 /// Seed paper 000, Alg. 3, generalized from the z-up horizon of one convex ring to any
@@ -163,7 +160,6 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                     } else {
                         onto_circle(b * sa - a * sb)
                     };
-                    let exit_open_ccw = !on || corner_contains(a, b, ring[(j + 1) % m], n.cross(b));
                     scratch.push(p);
                     if let Some((start, entry_angle)) = open.take() {
                         chains.push(Chain {
@@ -171,7 +167,6 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                             end: scratch.len(),
                             entry_angle,
                             exit_angle: angle(p),
-                            exit_open_ccw,
                         });
                     }
                 }
@@ -198,14 +193,14 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     let mut next: SmallVec<[usize; 4]> = SmallVec::from_elem(usize::MAX, k);
     let mut taken: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
     for (c, chain) in chains.iter().enumerate() {
-        let mut best = (f64::INFINITY, usize::MAX);
+        let mut best = ((f64::INFINITY, f64::INFINITY), usize::MAX);
         for (d, other) in chains.iter().enumerate() {
             if taken[d] {
                 continue;
             }
-            let gap = circle_gap(chain, other);
-            if gap < best.0 {
-                best = (gap, d);
+            let key = circle_gap(&scratch, n, chain, other);
+            if key < best.0 {
+                best = (key, d);
             }
         }
         if best.1 != usize::MAX {
@@ -231,7 +226,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             if d == usize::MAX {
                 break;
             }
-            let gap = circle_gap(ch, &chains[d]);
+            let gap = circle_gap(&scratch, n, ch, &chains[d]).0;
             // Intermediate vertices keep every circle edge a minor arc.
             let steps = crate::math::floor(gap / MAX_CIRCLE_STEP) as usize + 1;
             for t in 1..steps {
@@ -246,35 +241,36 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     finish(out_verts, out_ends)
 }
 
-/// Counter-clockwise angle along the circle from the exit of `from` to the entry of `to`.
+/// Counter-clockwise angle along the circle from the exit of `from` to the entry of `to`, with a
+/// tie-break for when the two points coincide.
 ///
-/// When the two points coincide (a ring touching the circle at a vertex, or two rings touching
-/// there) the angle is 0 or a full turn, decided by whether the region continues along the circle
-/// past the exit: a convex corner touching the circle from inside leaves the circle outside the
-/// region (join at once), a reflex one has the whole circle inside (go all the way round).
-fn circle_gap(from: &Chain, to: &Chain) -> f64 {
+/// Coincident points occur at a ring touching the circle at a vertex, and at pinch vertices on
+/// the circle. There the boundary of the clipped region continues along whichever is met first
+/// turning clockwise (about the point) from the edge the exit arrived on: the entry's first edge
+/// (join at once: angle 0, ordered by that turn) or the circle itself in its counter-clockwise
+/// direction (go round: the entry is a full turn away). This is the corner rule of a region
+/// whose interior lies on the left of every edge, and it sees every visit of a pinch at once.
+fn circle_gap(scratch: &[DVec3], n: DVec3, from: &Chain, to: &Chain) -> (f64, f64) {
     let gap = (to.entry_angle - from.exit_angle).rem_euclid(2.0 * PI);
-    if !(1e-12..=2.0 * PI - 1e-12).contains(&gap) {
-        if from.exit_open_ccw { 2.0 * PI } else { 0.0 }
+    if (1e-12..=2.0 * PI - 1e-12).contains(&gap) {
+        return (gap, 0.0);
+    }
+    let x = scratch[from.end - 1];
+    let (u, v) = tangent_frame(x);
+    let ang = |q: DVec3| crate::math::atan2(q.dot(v), q.dot(u));
+    let arrived = ang(scratch[from.end - 2]);
+    let cw = |q: DVec3| {
+        let t = (arrived - ang(q)).rem_euclid(2.0 * PI);
+        if t <= 0.0 { 2.0 * PI } else { t }
+    };
+    let along_entry = cw(scratch[to.start + 1]);
+    // The circle's counter-clockwise direction at x, as a point just along it.
+    let along_circle = cw(x + n.cross(x));
+    if along_entry < along_circle {
+        (0.0, along_entry)
     } else {
-        gap
+        (2.0 * PI, along_entry)
     }
-}
-
-/// Whether the tangent direction `t` at the vertex `b` of the path `a -> b -> c` points into the
-/// region, which lies on the left: the corner's interior is swept counter-clockwise (about `b`)
-/// from the direction toward `c` to the direction toward `a`.
-fn corner_contains(a: DVec3, b: DVec3, c: DVec3, t: DVec3) -> bool {
-    let da = a - b * a.dot(b);
-    let dc = c - b * c.dot(b);
-    // The next edge runs along `t` itself (the ring continues counter-clockwise on the circle):
-    // the region lies on its left, the hemisphere's side, so it does continue past the exit.
-    // Decided here because the angle below would be 0 or a full turn by rounding alone.
-    if dc.cross(t).length() <= 1e-12 * dc.length() * t.length() && dc.dot(t) > 0.0 {
-        return true;
-    }
-    let sweep = |x: DVec3| crate::math::atan2(dc.cross(x).dot(b), dc.dot(x)).rem_euclid(2.0 * PI);
-    sweep(t) < sweep(da)
 }
 
 /// When every vertex lies strictly inside the open hemisphere about `c`: whether the circle

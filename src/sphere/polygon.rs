@@ -581,11 +581,15 @@ pub(crate) fn nearest_feature<'a>(
     Some((d, what.unwrap_or_else(|v| vertex_side(rings, v, p))))
 }
 
-/// Whether `p` lies inside the region near the vertex `v`, from every visit of the rings to `v`
-/// (a pinch vertex is visited more than once). Around `v`, the sector just counter-clockwise of
+/// Whether `p` (a point, or a tangent direction at `v`) lies inside the region near the vertex
+/// `v`, from every visit of the rings to `v` (a pinch vertex is visited more than once). Around `v`, the sector just counter-clockwise of
 /// an edge direction is inside iff that edge leaves `v` (the interior is on the left of every
 /// edge); so the answer is the kind of the edge met first turning clockwise from `p`.
-fn vertex_side<'a>(rings: impl Iterator<Item = &'a [DVec3]>, v: DVec3, p: DVec3) -> bool {
+pub(crate) fn vertex_side<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    v: DVec3,
+    p: DVec3,
+) -> bool {
     let (u, w) = super::predicates::tangent_frame(v);
     let ang = |q: DVec3| crate::math::atan2(q.dot(w), q.dot(u));
     let target = ang(p);
