@@ -407,3 +407,22 @@ fn fuzz_regression_spike_within_rounding_is_rejected() {
         "{r:?}"
     );
 }
+
+#[test]
+fn fuzz_regression_vertex_exactly_on_own_edge_is_rejected() {
+    // (32, -5, -1) lies exactly on the great circle through (46, 0, 0) and (-1, -5, -1), between
+    // them: the ring touches itself. Normalization made the contact inexact, so validation now
+    // runs its exact predicates on the caller's coordinates (scaled by powers of two only).
+    let r = SphericalPolygon::new(vec![vec![
+        DVec3::new(-65.0, -1.0, -1.0),
+        DVec3::new(32.0, -5.0, -1.0),
+        DVec3::new(-1.0, 58.0, -1.0),
+        DVec3::new(46.0, 0.0, 0.0),
+        DVec3::new(-1.0, -5.0, -1.0),
+        DVec3::new(32.0, 32.0, 32.0),
+    ]]);
+    assert!(
+        matches!(r, Err(GeomError::SelfIntersecting { .. })),
+        "{r:?}"
+    );
+}

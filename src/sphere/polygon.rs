@@ -84,6 +84,10 @@ impl SphericalPolygon {
     ///   which side is inside (for example two nested rings both counter-clockwise).
     pub fn new(rings: Vec<Vec<DVec3>>) -> Result<Self, GeomError> {
         let mut poly = SphericalPolygon::empty();
+        // The caller's vertices scaled by powers of two only (exact), for the exact predicates:
+        // an exact degeneracy in the input (a vertex exactly on another edge, a spike) is no
+        // longer exact once normalized, but the sign of det(a, b, c) survives positive scaling.
+        let mut raw: Vec<DVec3> = Vec::new();
         for (r, ring) in rings.iter().enumerate() {
             let start = poly.verts.len();
             for (i, &p) in ring.iter().enumerate() {
@@ -92,6 +96,7 @@ impl SphericalPolygon {
                 }
                 let u = normalize_any(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?;
                 poly.verts.push(u);
+                raw.push(scale_pow2(p));
             }
             let n = ring.len();
             if n < 3 {
@@ -109,7 +114,7 @@ impl SphericalPolygon {
             }
             poly.ends.push(poly.verts.len() as u32);
         }
-        poly.check_simple()?;
+        poly.check_simple(&raw)?;
         poly.check_area()?;
         poly.check_consistent()?;
         Ok(poly)
@@ -308,44 +313,50 @@ impl SphericalPolygon {
     /// Rings may touch at a shared vertex (the same `DVec3` in both places), as the results of
     /// clipping and set operations do where a hole touches an outer boundary; they may not cross
     /// there, nor touch anywhere else.
-    fn check_simple(&self) -> Result<(), GeomError> {
-        // Every edge as (ring, index in ring, start, end).
-        let mut edges: Vec<(usize, usize, DVec3, DVec3)> = Vec::with_capacity(self.verts.len());
-        for (r, ring) in self.rings().enumerate() {
-            let n = ring.len();
+    fn check_simple(&self, raw: &[DVec3]) -> Result<(), GeomError> {
+        // Every edge as (ring, index in ring, start, end), with start and end as indices into
+        // `verts` (unit vectors) and `raw` (exactly scaled input).
+        let mut edges: Vec<(usize, usize, usize, usize)> = Vec::with_capacity(self.verts.len());
+        let mut start = 0usize;
+        for (r, &end) in self.ends.iter().enumerate() {
+            let end = end as usize;
+            let n = end - start;
             for i in 0..n {
-                edges.push((r, i, ring[i], ring[(i + 1) % n]));
+                edges.push((r, i, start + i, start + (i + 1) % n));
             }
+            start = end;
         }
         let err = |r: usize, s: usize| GeomError::SelfIntersecting {
             ring: r,
             other_ring: s,
         };
+        let v = &self.verts;
         for (k, &(r, i, a, b)) in edges.iter().enumerate() {
             for &(s, j, c, d) in &edges[k + 1..] {
                 let n = self.ring_len(r);
                 let consecutive = r == s && (j == (i + 1) % n || i == (j + 1) % n);
-                // A shared endpoint is allowed; the two edges may not leave it along the same
-                // direction (that would be an overlap, or a fold for consecutive edges).
-                let shared = if b == c {
+                // A shared endpoint (the same direction) is allowed; the two edges may not leave
+                // it along the same direction (an overlap, or a fold for consecutive edges).
+                let shared = if v[b] == v[c] {
                     Some((b, a, d))
-                } else if a == d {
+                } else if v[a] == v[d] {
                     Some((a, b, c))
-                } else if a == c {
+                } else if v[a] == v[c] {
                     Some((a, b, d))
-                } else if b == d {
+                } else if v[b] == v[d] {
                     Some((b, a, c))
                 } else {
                     None
                 };
                 match shared {
-                    Some((x, p, q)) => {
+                    Some((xi, pi, qi)) => {
+                        let (x, p, q) = (v[xi], v[pi], v[qi]);
                         // Within rounding of the same direction counts as overlapping: a spike
                         // narrower than 1e-12 rad has no side any later operation can resolve
                         // (an exactly collinear spike in the caller's coordinates is no longer
                         // exactly collinear once normalized).
                         let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
-                        let parallel = orient(x, p, q) == 0
+                        let parallel = orient(raw[xi], raw[pi], raw[qi]) == 0
                             || tp.cross(tq).length() <= 1e-12 * tp.length() * tq.length();
                         if parallel && tp.dot(tq) > 0.0 {
                             return Err(err(r, s));
@@ -355,7 +366,7 @@ impl SphericalPolygon {
                     }
                     None if consecutive => {}
                     None => {
-                        if arcs_intersect(a, b, c, d) {
+                        if arcs_intersect(raw[a], raw[b], raw[c], raw[d]) {
                             return Err(err(r, s));
                         }
                     }
@@ -504,6 +515,30 @@ pub(crate) fn close_ring(verts: &mut Verts, ends: &mut SmallVec<[u32; 2]>, start
     }
 }
 
+/// `p` times a power of two that brings its largest component into `[0.5, 1)`: exact, so every
+/// sign of a determinant of such vectors is that of the caller's vectors, and no product in the
+/// exact predicates can overflow or underflow.
+fn scale_pow2(p: DVec3) -> DVec3 {
+    let m = p.abs().max_element();
+    if m == 0.0 || !m.is_finite() {
+        return p;
+    }
+    // Subnormal magnitudes are first lifted by an exact 2^600, huge ones lowered by 2^-600, so
+    // that the final power of two below is a normal number.
+    let (p, m) = if m < f64::MIN_POSITIVE {
+        let k = f64::from_bits((1023u64 + 600) << 52);
+        (p * k, m * k)
+    } else if m >= f64::from_bits((1023u64 + 1000) << 52) {
+        let k = f64::from_bits((1023u64 - 600) << 52);
+        (p * k, m * k)
+    } else {
+        (p, m)
+    };
+    let e = ((m.to_bits() >> 52) & 0x7ff) as i64 - 1023; // m in [2^e, 2^(e+1))
+    let scale = f64::from_bits(((1023 - e - 1) as u64) << 52); // 2^-(e+1)
+    p * scale
+}
+
 /// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
 pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
     let n = ring.len();
@@ -624,6 +659,27 @@ mod tests {
         assert!((up.solid_angle() - 2.0 * PI).abs() < 1e-14);
         assert!(up.contains(DVec3::Z));
         assert!(!up.contains(-DVec3::Z));
+    }
+
+    #[test]
+    fn power_of_two_scaling_is_exact_and_bounded() {
+        for p in [
+            DVec3::new(3.0, -7.0, 0.5),
+            DVec3::new(1e-310, 0.0, -3e-312),
+            DVec3::new(1e308, -1.7e308, 2.0),
+            DVec3::new(0.0, 0.0, 1.0),
+        ] {
+            let q = scale_pow2(p);
+            let m = q.abs().max_element();
+            assert!((0.5..1.0).contains(&m), "{p} -> {q}");
+            // Exact: normal components keep their significand bits (only the exponent moves).
+            let mask = (1u64 << 52) - 1;
+            for (a, b) in p.to_array().into_iter().zip(q.to_array()) {
+                if a.is_normal() && b.is_normal() {
+                    assert_eq!(a.to_bits() & mask, b.to_bits() & mask, "{a} -> {b}");
+                }
+            }
+        }
     }
 
     #[test]
