@@ -24,14 +24,14 @@
 //!
 //! The FHP vertex classes then follow from the statuses of the two edges around each vertex (see
 //! [`VertexClass`] and [`classify`]); the tracing phase selects edges by status (GH's entry/exit
-//! walk, section 3.3, amounts to following exactly the selected edges), and the classification
-//! doubles as a consistency check: a status may only change at a vertex on the other boundary.
+//! walk, section 3.3, amounts to following exactly the selected edges).
 
 use glam::DVec2;
 use smallvec::SmallVec;
 
+use alloc::vec::Vec;
+
 use super::Rings;
-use crate::GeomError;
 use crate::planar::predicates::orient;
 
 /// Where a split edge of one operand lies relative to the other operand.
@@ -54,10 +54,10 @@ impl Status {
     }
 }
 
-/// Classification of an intersection vertex after Foster, Hormann and Popa (2019, section 3.1,
+/// Classification of a vertex after Foster, Hormann and Popa (2019, section 3.1,
 /// Table 1, and section 3.2 for the delayed cases).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum VertexClass {
+pub enum VertexClass {
     /// Not on the other boundary.
     Plain,
     /// The boundary passes from inside to outside of the other operand or back here.
@@ -72,33 +72,90 @@ pub(crate) enum VertexClass {
     OnChain,
 }
 
-/// Per-vertex lookup of identical vertices in the other operand, by sorting its points.
-pub(crate) struct Twins {
-    order: SmallVec<[u32; 64]>,
+/// Coincident vertices of both operands, found with one sort.
+///
+/// The vertices of A and B are numbered together (A's first, then B's). Sorting them by
+/// coordinates groups identical points into runs; a run is a *node* of the overlay, named by the
+/// position where it starts in the sorted order. Phase 1 made every contact an identical vertex
+/// in both operands, so "is this vertex on the other boundary" and "which edges of the other
+/// operand meet here" are lookups in the vertex's run.
+pub(crate) struct Nodes {
+    /// Vertex numbers sorted by point.
+    sorted: SmallVec<[u32; 128]>,
+    /// For each vertex number, its node (the start of its run in `sorted`).
+    node: SmallVec<[u32; 128]>,
+    /// For each run start, the end of the run in `sorted`.
+    end: SmallVec<[u32; 128]>,
+    /// Number of vertices of A.
+    na: u32,
 }
 
 fn cmp_pt(a: DVec2, b: DVec2) -> core::cmp::Ordering {
     a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y))
 }
 
-impl Twins {
-    pub(crate) fn new(r: &Rings) -> Twins {
-        let mut order: SmallVec<[u32; 64]> = (0..r.pts.len() as u32).collect();
-        order.sort_unstable_by(|&x, &y| cmp_pt(r.pts[x as usize], r.pts[y as usize]));
-        Twins { order }
+impl Nodes {
+    pub(crate) fn new(a: &Rings, b: &Rings) -> Nodes {
+        let na = a.pts.len();
+        let n = na + b.pts.len();
+        let pt = |k: u32| {
+            let k = k as usize;
+            if k < na { a.pts[k] } else { b.pts[k - na] }
+        };
+        let mut sorted: SmallVec<[u32; 128]> = (0..n as u32).collect();
+        sorted.sort_unstable_by(|&x, &y| cmp_pt(pt(x), pt(y)));
+        let mut node: SmallVec<[u32; 128]> = SmallVec::from_elem(0, n);
+        let mut end: SmallVec<[u32; 128]> = SmallVec::from_elem(0, n);
+        let mut start = 0usize;
+        while start < n {
+            let p = pt(sorted[start]);
+            let mut e = start + 1;
+            while e < n && pt(sorted[e]) == p {
+                e += 1;
+            }
+            for &k in &sorted[start..e] {
+                node[k as usize] = start as u32;
+            }
+            end[start] = e as u32;
+            start = e;
+        }
+        Nodes {
+            sorted,
+            node,
+            end,
+            na: na as u32,
+        }
     }
 
-    /// Indices of the vertices of `r` equal to `p` (usually none or one).
-    pub(crate) fn of<'a>(&'a self, r: &Rings, p: DVec2) -> &'a [u32] {
-        let lo = self
-            .order
-            .partition_point(|&k| cmp_pt(r.pts[k as usize], p) == core::cmp::Ordering::Less);
-        let hi = lo
-            + self.order[lo..]
-                .iter()
-                .take_while(|&&k| r.pts[k as usize] == p)
-                .count();
-        &self.order[lo..hi]
+    /// The node of vertex `i` of A (`side_b == false`) or of B.
+    #[inline]
+    pub(crate) fn of(&self, i: usize, side_b: bool) -> u32 {
+        let k = if side_b { i + self.na as usize } else { i };
+        self.node.get(k).copied().unwrap_or(0)
+    }
+
+    /// All vertex numbers at a node.
+    #[inline]
+    fn members(&self, node: u32) -> &[u32] {
+        let s = node as usize;
+        let e = self.end.get(s).copied().unwrap_or(0) as usize;
+        self.sorted.get(s..e).unwrap_or(&[])
+    }
+
+    /// Vertices of the *other* operand at the node of vertex `i` (indices into that operand).
+    #[inline]
+    pub(crate) fn twins(&self, i: usize, side_b: bool) -> impl Iterator<Item = usize> + '_ {
+        let na = self.na;
+        self.members(self.of(i, side_b))
+            .iter()
+            .filter(move |&&k| (k >= na) != side_b)
+            .map(move |&k| if side_b { k as usize } else { (k - na) as usize })
+    }
+
+    /// Whether vertex `i` lies on the other operand's boundary.
+    #[inline]
+    pub(crate) fn on_other(&self, i: usize, side_b: bool) -> bool {
+        self.twins(i, side_b).next().is_some()
     }
 }
 
@@ -163,90 +220,113 @@ fn inside_at(v: DVec2, x: DVec2, rays: &[(DVec2, bool)]) -> bool {
 }
 
 /// Labels every split edge of `r` (edge `i` runs from vertex `i` to `r_nxt[i]`) against `o`.
+///
+/// A status can only change at a vertex on the other boundary, so it is computed there, with the
+/// exact local test [`inside_at`], and copied along the run of edges up to the next such vertex.
+/// Only a contour that never meets the other boundary needs a winding number (one per contour).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn label(
     r: &Rings,
     r_nxt: &[u32],
+    side_b: bool,
+    nodes: &Nodes,
     o: &Rings,
     o_nxt: &[u32],
     o_prv: &[u32],
-    o_twins: &Twins,
     out: &mut SmallVec<[Status; 64]>,
 ) {
     out.clear();
-    for (i, &n) in r_nxt.iter().enumerate() {
-        let u = r.pts[i];
-        let w = r.pts[n as usize];
-        let tu = o_twins.of(o, u);
-        let mut status = None;
-        for &k in tu {
-            let k = k as usize;
-            if o.pts[o_nxt[k] as usize] == w {
-                status = Some(Status::SharedSame);
-                break;
-            }
-            if o.pts[o_prv[k] as usize] == w {
-                status = Some(Status::SharedOpposite);
-                break;
-            }
-        }
-        let status = status.unwrap_or_else(|| {
-            let inside = if tu.is_empty() {
-                winding(o, o_nxt, u) != 0
-            } else if o_twins.of(o, w).is_empty() {
-                winding(o, o_nxt, w) != 0
-            } else {
-                // Both ends on the other boundary: the other operand's edges around `u` decide
-                // (several twins when its contours touch at `u`).
-                let rays: SmallVec<[(DVec2, bool); 8]> = tu
-                    .iter()
-                    .flat_map(|&k| {
-                        let k = k as usize;
-                        [(o.pts[o_nxt[k] as usize], false), (o.pts[o_prv[k] as usize], true)]
-                    })
-                    .collect();
-                inside_at(u, w, &rays)
-            };
-            if inside {
+    out.resize(r.pts.len(), Status::Outside);
+    let mut start = 0usize;
+    for &end in &r.ends {
+        let end = end as usize;
+        let len = end - start;
+        let first_on = (start..end).find(|&i| nodes.on_other(i, side_b));
+        let Some(f) = first_on else {
+            let inside = r
+                .pts
+                .get(start)
+                .is_some_and(|&p| winding(o, o_nxt, p) != 0);
+            let s = if inside {
                 Status::Inside
             } else {
                 Status::Outside
-            }
-        });
-        out.push(status);
+            };
+            out[start..end].iter_mut().for_each(|x| *x = s);
+            start = end;
+            continue;
+        };
+        let mut prev = Status::Outside;
+        let mut i = f;
+        for _ in 0..len {
+            let status = if nodes.on_other(i, side_b) {
+                edge_status(r, r_nxt, i, side_b, nodes, o, o_nxt, o_prv)
+            } else {
+                prev
+            };
+            out[i] = status;
+            prev = status;
+            i = r_nxt[i] as usize;
+        }
+        start = end;
     }
 }
 
-/// FHP vertex classes for the vertices of `r`, given its edge statuses and whether each vertex
-/// is also a vertex of the other operand.
+/// Status of edge `i` of `r`, whose first vertex lies on the other boundary.
+#[allow(clippy::too_many_arguments)]
+fn edge_status(
+    r: &Rings,
+    r_nxt: &[u32],
+    i: usize,
+    side_b: bool,
+    nodes: &Nodes,
+    o: &Rings,
+    o_nxt: &[u32],
+    o_prv: &[u32],
+) -> Status {
+    let u = r.pts[i];
+    let w = r.pts[r_nxt[i] as usize];
+    for k in nodes.twins(i, side_b) {
+        if o.pts[o_nxt[k] as usize] == w {
+            return Status::SharedSame;
+        }
+        if o.pts[o_prv[k] as usize] == w {
+            return Status::SharedOpposite;
+        }
+    }
+    // The other operand's edges around `u` decide (several twins when its contours touch at
+    // `u`).
+    let rays: SmallVec<[(DVec2, bool); 8]> = nodes
+        .twins(i, side_b)
+        .flat_map(|k| [(o.pts[o_nxt[k] as usize], false), (o.pts[o_prv[k] as usize], true)])
+        .collect();
+    if inside_at(u, w, &rays) {
+        Status::Inside
+    } else {
+        Status::Outside
+    }
+}
+
+/// FHP vertex classes for the vertices of `r`, given its edge statuses.
 ///
-/// # Errors
-///
-/// [`GeomError::Degenerate`] when the status changes at a vertex that is not on the other
-/// boundary: a boundary can only pass from inside to outside through the other boundary, so this
-/// means phase 1 missed a contact (which exact predicates on the split edges rule out, so it is a
-/// consistency check against numerically pathological input).
+/// Tracing needs only the edge statuses, so this runs only for diagnostics and tests
+/// ([`crate::planar::contact_classes`]), which check the classes against FHP's definitions on known
+/// configurations.
 pub(crate) fn classify(
     r_nxt: &[u32],
     r_prv: &[u32],
-    on_other: &[bool],
+    side_b: bool,
+    nodes: &Nodes,
     status: &[Status],
-    out: &mut SmallVec<[VertexClass; 64]>,
-) -> Result<(), GeomError> {
+    out: &mut Vec<VertexClass>,
+) {
     out.clear();
     let n = r_nxt.len();
     for i in 0..n {
         let s_in = status[r_prv[i] as usize];
         let s_out = status[i];
         let class = match (s_in.is_on(), s_out.is_on()) {
-            _ if !on_other[i] => {
-                if s_in != s_out {
-                    return Err(GeomError::Degenerate(
-                        "a contour changes sides away from the other boundary; \
-                         the operands are too close to degenerate for f64",
-                    ));
-                }
-                VertexClass::Plain
-            }
+            _ if !nodes.on_other(i, side_b) => VertexClass::Plain,
             (false, false) if s_in == s_out => VertexClass::Bouncing,
             (false, false) => VertexClass::Crossing,
             (true, _) => VertexClass::OnChain,
@@ -267,5 +347,4 @@ pub(crate) fn classify(
         };
         out.push(class);
     }
-    Ok(())
 }

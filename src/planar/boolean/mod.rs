@@ -175,22 +175,15 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
 
     let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
     let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
-    let a_twins = label::Twins::new(&ra);
-    let b_twins = label::Twins::new(&rb);
+    let nodes = label::Nodes::new(&ra, &rb);
     let mut sa = SmallVec::new();
     let mut sb = SmallVec::new();
-    label::label(&ra, &a_nxt, &rb, &b_nxt, &b_prv, &b_twins, &mut sa);
-    label::label(&rb, &b_nxt, &ra, &a_nxt, &a_prv, &a_twins, &mut sb);
-
-    let mut classes = SmallVec::new();
-    let on_b: SmallVec<[bool; 64]> = ra.pts.iter().map(|&p| !b_twins.of(&rb, p).is_empty()).collect();
-    label::classify(&a_nxt, &a_prv, &on_b, &sa, &mut classes)?;
-    let on_a: SmallVec<[bool; 64]> = rb.pts.iter().map(|&p| !a_twins.of(&ra, p).is_empty()).collect();
-    label::classify(&b_nxt, &b_prv, &on_a, &sb, &mut classes)?;
+    label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
+    label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
 
     let mut edges = SmallVec::new();
-    trace::select(&ra, &a_nxt, &sa, &rb, &b_nxt, &sb, op, &mut edges);
-    let contours = trace::trace(&edges, scale)?;
+    trace::select(&ra, &a_nxt, &sa, &rb, &b_nxt, &sb, &nodes, op, &mut edges);
+    let contours = trace::trace(&edges, ra.pts.len() + rb.pts.len(), scale)?;
     Ok(Shape::from_contours(contours))
 }
 
@@ -208,3 +201,38 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
     ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
 }
 
+
+/// The Foster–Hormann–Popa classification of every vertex of both operands after phase 1 (the
+/// split contours), for diagnostics and tests: `(point, class)` for A's vertices, then for B's.
+///
+/// # Errors
+///
+/// As [`boolean`].
+#[doc(hidden)]
+pub fn contact_classes(
+    a: &Shape,
+    b: &Shape,
+) -> Result<(Vec<(DVec2, label::VertexClass)>, Vec<(DVec2, label::VertexClass)>), GeomError> {
+    let mut ra = Rings::from_shape(a);
+    let mut rb = Rings::from_shape(b);
+    let scale = ra.scale().max(rb.scale());
+    intersect::snap_vertices(&ra, &mut rb, scale);
+    intersect::split_self_contacts(&mut ra);
+    intersect::split_self_contacts(&mut rb);
+    intersect::split(&mut ra, &mut rb, scale)?;
+    let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
+    let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
+    let nodes = label::Nodes::new(&ra, &rb);
+    let mut sa = SmallVec::new();
+    let mut sb = SmallVec::new();
+    label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
+    label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
+    let mut ca = Vec::new();
+    let mut cb = Vec::new();
+    label::classify(&a_nxt, &a_prv, false, &nodes, &sa, &mut ca);
+    label::classify(&b_nxt, &b_prv, true, &nodes, &sb, &mut cb);
+    Ok((
+        ra.pts.iter().copied().zip(ca).collect(),
+        rb.pts.iter().copied().zip(cb).collect(),
+    ))
+}
