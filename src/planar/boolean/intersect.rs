@@ -58,14 +58,14 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
         let s = SNAP_REL * scale;
         s * s
     };
-    let mut dirty_a: SmallVec<[bool; 64]> = SmallVec::from_elem(true, a.pts.len());
-    let mut dirty_b: SmallVec<[bool; 64]> = SmallVec::from_elem(true, b.pts.len());
+    let mut dirty_a: SmallVec<[bool; 64]> = SmallVec::new();
+    let mut dirty_b: SmallVec<[bool; 64]> = SmallVec::new();
     let mut ins_a = Inserts::new();
     let mut ins_b = Inserts::new();
-    for _ in 0..MAX_PASSES {
+    for pass in 0..MAX_PASSES {
         ins_a.clear();
         ins_b.clear();
-        find(a, b, &dirty_a, &dirty_b, snap2, &mut ins_a, &mut ins_b);
+        find(a, b, &dirty_a, &dirty_b, pass == 0, snap2, &mut ins_a, &mut ins_b);
         if ins_a.is_empty() && ins_b.is_empty() {
             return Ok(());
         }
@@ -86,10 +86,14 @@ pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
     let snap = SNAP_REL * scale;
     let snap2 = snap * snap;
     let mut changed = false;
+    // A's points sorted by x; each of B's points looks only at the x-window around it.
+    let mut by_x: SmallVec<[DVec2; 64]> = a.pts.iter().copied().collect();
+    by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
     for q in b.pts.iter_mut() {
-        if let Some(&p) = a
-            .pts
+        let lo = by_x.partition_point(|p| p.x < q.x - snap);
+        if let Some(&p) = by_x[lo..]
             .iter()
+            .take_while(|p| p.x <= q.x + snap)
             .find(|&&p| p != *q && (p - *q).length_squared() <= snap2)
         {
             *q = p;
@@ -169,43 +173,102 @@ pub(crate) fn split_self_contacts(r: &mut Rings) {
     }
 }
 
-/// One pass over all edge pairs in which at least one edge is new.
+/// Bounding boxes `[min x, max x, min y, max y]` of all edges of `r`, with the edge ends.
+fn edge_boxes(r: &Rings) -> SmallVec<[([f64; 4], DVec2, DVec2); 64]> {
+    let mut out = SmallVec::with_capacity(r.pts.len());
+    let mut start = 0usize;
+    for &end in &r.ends {
+        let end = end as usize;
+        for i in start..end {
+            let p0 = r.pts[i];
+            let p1 = r.pts[if i + 1 == end { start } else { i + 1 }];
+            out.push((
+                [p0.x.min(p1.x), p0.x.max(p1.x), p0.y.min(p1.y), p0.y.max(p1.y)],
+                p0,
+                p1,
+            ));
+        }
+        start = end;
+    }
+    out
+}
+
+#[inline]
+fn boxes_overlap(a: &[f64; 4], b: &[f64; 4]) -> bool {
+    a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3]
+}
+
+/// One pass over the edge pairs in which at least one edge is new.
+///
+/// The first pass (everything new) sweeps the edges of both operands in order of their left
+/// ends, so only pairs whose x-ranges overlap are examined: `O((n + m) log(n + m) + k)` instead
+/// of all `n * m` pairs. Later passes see only the few edges next to inserted points, and test
+/// each of them against all edges of the other operand.
+#[allow(clippy::too_many_arguments)]
 fn find(
     a: &Rings,
     b: &Rings,
     dirty_a: &[bool],
     dirty_b: &[bool],
+    first_pass: bool,
     snap2: f64,
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
-    let na = a.next_table();
-    let nb = b.next_table();
-    for (i, &ni) in na.iter().enumerate() {
-        let (p0, p1) = (a.pts[i], a.pts[ni as usize]);
-        let (pminx, pmaxx) = (p0.x.min(p1.x), p0.x.max(p1.x));
-        let (pminy, pmaxy) = (p0.y.min(p1.y), p0.y.max(p1.y));
-        let da = dirty_a.get(i).copied().unwrap_or(true);
-        for (j, &nj) in nb.iter().enumerate() {
-            if !da && !dirty_b.get(j).copied().unwrap_or(true) {
-                continue;
-            }
-            let (q0, q1) = (b.pts[j], b.pts[nj as usize]);
-            if q0.x.max(q1.x) < pminx
-                || q0.x.min(q1.x) > pmaxx
-                || q0.y.max(q1.y) < pminy
-                || q0.y.min(q1.y) > pmaxy
-            {
-                continue;
-            }
+    let ba = edge_boxes(a);
+    let bb = edge_boxes(b);
+    let mut test = |i: usize, j: usize| {
+        let (boxa, p0, p1) = &ba[i];
+        let (boxb, q0, q1) = &bb[j];
+        if boxes_overlap(boxa, boxb) {
             pair(
-                [p0, p1, q0, q1],
+                [*p0, *p1, *q0, *q1],
                 (i as u32, j as u32),
                 (&a.pts, &b.pts),
                 snap2,
                 ins_a,
                 ins_b,
             );
+        }
+    };
+    if !first_pass {
+        for (i, _) in dirty_a.iter().enumerate().filter(|x| *x.1) {
+            for j in 0..bb.len() {
+                test(i, j);
+            }
+        }
+        for (j, _) in dirty_b.iter().enumerate().filter(|x| *x.1) {
+            for i in 0..ba.len() {
+                if !dirty_a.get(i).copied().unwrap_or(false) {
+                    test(i, j);
+                }
+            }
+        }
+        return;
+    }
+    // Sweep: events are edges keyed by their left end; the high bit of the id marks B's edges.
+    const B_BIT: u32 = 1 << 31;
+    let mut events: SmallVec<[(f64, u32); 128]> = SmallVec::with_capacity(ba.len() + bb.len());
+    events.extend(ba.iter().enumerate().map(|(i, e)| (e.0[0], i as u32)));
+    events.extend(bb.iter().enumerate().map(|(j, e)| (e.0[0], j as u32 | B_BIT)));
+    events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let mut active_a: SmallVec<[u32; 32]> = SmallVec::new();
+    let mut active_b: SmallVec<[u32; 32]> = SmallVec::new();
+    for &(x, id) in &events {
+        if id & B_BIT == 0 {
+            let i = id as usize;
+            active_b.retain(|j| bb[*j as usize].0[1] >= x);
+            for &j in &active_b {
+                test(i, j as usize);
+            }
+            active_a.push(id);
+        } else {
+            let j = (id & !B_BIT) as usize;
+            active_a.retain(|i| ba[*i as usize].0[1] >= x);
+            for &i in &active_a {
+                test(i as usize, j);
+            }
+            active_b.push(j as u32);
         }
     }
 }
@@ -223,19 +286,23 @@ fn pair(
     // inserted into that edge (bending it by at most the tolerance), exactly as FHP's
     // vertex-on-edge case. Without this, a vertex a few ulps off an edge survives as a
     // near-touch that the next operation in a chain sees as either a crossing or a gap.
+    //
+    // `|orient| / |edge|` is the distance from the line; `|dx| + |dy|` bounds `|edge|` from above,
+    // so the square root is only taken for the rare candidates that pass the cheap test.
     let snap = sqrt(snap2);
-    let near = |o: f64, len: f64| o == 0.0 || o.abs() <= snap * len;
-    let lp = sqrt((p1 - p0).length_squared());
+    let near = |o: f64, e0: DVec2, e1: DVec2| {
+        let d = (e1 - e0).abs();
+        o == 0.0 || (o.abs() <= snap * (d.x + d.y) && o.abs() <= snap * sqrt(d.length_squared()))
+    };
     let oq0 = orient(p0, p1, q0);
     let oq1 = orient(p0, p1, q1);
-    let (zq0, zq1) = (near(oq0, lp), near(oq1, lp));
+    let (zq0, zq1) = (near(oq0, p0, p1), near(oq1, p0, p1));
     if !zq0 && !zq1 && ((oq0 > 0.0 && oq1 > 0.0) || (oq0 < 0.0 && oq1 < 0.0)) {
         return;
     }
-    let lq = sqrt((q1 - q0).length_squared());
     let op0 = orient(q0, q1, p0);
     let op1 = orient(q0, q1, p1);
-    let (zp0, zp1) = (near(op0, lq), near(op1, lq));
+    let (zp0, zp1) = (near(op0, q0, q1), near(op1, q0, q1));
     if !zp0 && !zp1 && ((op0 > 0.0 && op1 > 0.0) || (op0 < 0.0 && op1 < 0.0)) {
         return;
     }
