@@ -87,7 +87,7 @@ pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
     let snap2 = snap * snap;
     let mut changed = false;
     // A's points sorted by x; each of B's points looks only at the x-window around it.
-    let mut by_x: SmallVec<[DVec2; 64]> = a.pts.iter().copied().collect();
+    let mut by_x: SmallVec<[DVec2; 32]> = a.pts.iter().copied().collect();
     by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
     for q in b.pts.iter_mut() {
         let lo = by_x.partition_point(|p| p.x < q.x - snap);
@@ -173,9 +173,13 @@ pub(crate) fn split_self_contacts(r: &mut Rings) {
     }
 }
 
-/// Bounding boxes `[min x, max x, min y, max y]` of all edges of `r`, with the edge ends.
-fn edge_boxes(r: &Rings) -> SmallVec<[([f64; 4], DVec2, DVec2); 64]> {
-    let mut out = SmallVec::with_capacity(r.pts.len());
+/// One edge for the pair search: bounding box `[min x, max x, min y, max y]` and its ends.
+type EdgeBox = ([f64; 4], DVec2, DVec2);
+
+/// Fills `out` with the edges of `r` (kept in the caller's frame: these buffers are large and
+/// moving them would cost more than filling them).
+fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
+    out.clear();
     let mut start = 0usize;
     for &end in &r.ends {
         let end = end as usize;
@@ -190,7 +194,6 @@ fn edge_boxes(r: &Rings) -> SmallVec<[([f64; 4], DVec2, DVec2); 64]> {
         }
         start = end;
     }
-    out
 }
 
 #[inline]
@@ -215,8 +218,13 @@ fn find(
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
-    let ba = edge_boxes(a);
-    let bb = edge_boxes(b);
+    let mut ba: SmallVec<[EdgeBox; 32]> = SmallVec::new();
+    let mut bb: SmallVec<[EdgeBox; 32]> = SmallVec::new();
+    edge_boxes(a, &mut ba);
+    edge_boxes(b, &mut bb);
+    // Plain slices: indexing a SmallVec re-checks whether it spilled on every access.
+    let (ba, bb): (&[EdgeBox], &[EdgeBox]) = (&ba, &bb);
+    let (all_a, all_b): (&[DVec2], &[DVec2]) = (&a.pts, &b.pts);
     let mut test = |i: usize, j: usize| {
         let (boxa, p0, p1) = &ba[i];
         let (boxb, q0, q1) = &bb[j];
@@ -224,7 +232,7 @@ fn find(
             pair(
                 [*p0, *p1, *q0, *q1],
                 (i as u32, j as u32),
-                (&a.pts, &b.pts),
+                (all_a, all_b),
                 snap2,
                 ins_a,
                 ins_b,
@@ -248,7 +256,7 @@ fn find(
     }
     // Sweep: events are edges keyed by their left end; the high bit of the id marks B's edges.
     const B_BIT: u32 = 1 << 31;
-    let mut events: SmallVec<[(f64, u32); 128]> = SmallVec::with_capacity(ba.len() + bb.len());
+    let mut events: SmallVec<[(f64, u32); 64]> = SmallVec::with_capacity(ba.len() + bb.len());
     events.extend(ba.iter().enumerate().map(|(i, e)| (e.0[0], i as u32)));
     events.extend(bb.iter().enumerate().map(|(j, e)| (e.0[0], j as u32 | B_BIT)));
     events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
@@ -282,6 +290,27 @@ fn pair(
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
+    // Edges with a common endpoint (the normal case after splitting, and between adjacent mesh
+    // triangles) can meet anywhere else only if they are (nearly) collinear: one orientation
+    // test, instead of four, settles the common case.
+    let common = if p0 == q0 {
+        Some((p0, p1, q1))
+    } else if p0 == q1 {
+        Some((p0, p1, q0))
+    } else if p1 == q0 {
+        Some((p1, p0, q1))
+    } else if p1 == q1 {
+        Some((p1, p0, q0))
+    } else {
+        None
+    };
+    if let Some((v, pa, qa)) = common {
+        let o = orient(v, pa, qa);
+        let d = (pa - v).abs() + (qa - v).abs();
+        if o.abs() > sqrt(snap2) * (d.x + d.y) {
+            return;
+        }
+    }
     // A vertex within the snapping distance of the other edge's line counts as on it: it is
     // inserted into that edge (bending it by at most the tolerance), exactly as FHP's
     // vertex-on-edge case. Without this, a vertex a few ulps off an edge survives as a

@@ -72,57 +72,71 @@ pub enum VertexClass {
     OnChain,
 }
 
-/// Coincident vertices of both operands, found with one sort.
+/// Coincident vertices of both operands, grouped with one hash pass.
 ///
-/// The vertices of A and B are numbered together (A's first, then B's). Sorting them by
-/// coordinates groups identical points into runs; a run is a *node* of the overlay, named by the
-/// position where it starts in the sorted order. Phase 1 made every contact an identical vertex
-/// in both operands, so "is this vertex on the other boundary" and "which edges of the other
-/// operand meet here" are lookups in the vertex's run.
+/// The vertices of A and B are numbered together (A's first, then B's). Identical points are
+/// grouped by an open-addressing hash table on their bit patterns (zeros are canonical, so equal
+/// points have equal bits); a group is a *node* of the overlay, named by its first member. Phase 1
+/// made every contact an identical vertex in both operands, so "is this vertex on the other
+/// boundary" and "which edges of the other operand meet here" are walks along the vertex's group.
 pub(crate) struct Nodes {
-    /// Vertex numbers sorted by point.
-    sorted: SmallVec<[u32; 128]>,
-    /// For each vertex number, its node (the start of its run in `sorted`).
-    node: SmallVec<[u32; 128]>,
-    /// For each run start, the end of the run in `sorted`.
-    end: SmallVec<[u32; 128]>,
+    /// For each vertex number, its node (the first vertex number with the same point).
+    node: SmallVec<[u32; 64]>,
+    /// For each vertex number, the next vertex number at the same node (`NONE` at the end).
+    next_same: SmallVec<[u32; 64]>,
     /// Number of vertices of A.
     na: u32,
 }
 
-fn cmp_pt(a: DVec2, b: DVec2) -> core::cmp::Ordering {
-    a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y))
+const NONE: u32 = u32::MAX;
+
+#[inline]
+fn hash_pt(p: DVec2) -> u64 {
+    let h = p.x.to_bits().wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ p.y.to_bits().rotate_left(29);
+    h.wrapping_mul(0xD6E8_FEB8_6659_FD93) >> 32
 }
 
 impl Nodes {
     pub(crate) fn new(a: &Rings, b: &Rings) -> Nodes {
-        let na = a.pts.len();
-        let n = na + b.pts.len();
-        let pt = |k: u32| {
-            let k = k as usize;
-            if k < na { a.pts[k] } else { b.pts[k - na] }
-        };
-        let mut sorted: SmallVec<[u32; 128]> = (0..n as u32).collect();
-        sorted.sort_unstable_by(|&x, &y| cmp_pt(pt(x), pt(y)));
-        let mut node: SmallVec<[u32; 128]> = SmallVec::from_elem(0, n);
-        let mut end: SmallVec<[u32; 128]> = SmallVec::from_elem(0, n);
-        let mut start = 0usize;
-        while start < n {
-            let p = pt(sorted[start]);
-            let mut e = start + 1;
-            while e < n && pt(sorted[e]) == p {
-                e += 1;
+        let (pa, pb): (&[DVec2], &[DVec2]) = (&a.pts, &b.pts);
+        let na = pa.len();
+        let n = na + pb.len();
+        let size = (2 * n).next_power_of_two().max(8);
+        let mask = size - 1;
+        let mut table: SmallVec<[u32; 128]> = SmallVec::from_elem(NONE, size);
+        let mut node: SmallVec<[u32; 64]> = SmallVec::from_elem(0, n);
+        let mut next_same: SmallVec<[u32; 64]> = SmallVec::from_elem(NONE, n);
+        // Last member of each node's list, to append in vertex order.
+        let mut tail: SmallVec<[u32; 64]> = SmallVec::from_elem(NONE, n);
+        for (k, &p) in pa.iter().chain(pb.iter()).enumerate() {
+            let mut h = hash_pt(p) as usize & mask;
+            // At most `size > n` probes: the table is never full.
+            for _ in 0..size {
+                let slot = table[h];
+                if slot == NONE {
+                    table[h] = k as u32;
+                    node[k] = k as u32;
+                    tail[k] = k as u32;
+                    break;
+                }
+                let q = if (slot as usize) < na {
+                    pa[slot as usize]
+                } else {
+                    pb[slot as usize - na]
+                };
+                if q == p {
+                    node[k] = slot;
+                    let t = tail[slot as usize] as usize;
+                    next_same[t] = k as u32;
+                    tail[slot as usize] = k as u32;
+                    break;
+                }
+                h = (h + 1) & mask;
             }
-            for &k in &sorted[start..e] {
-                node[k as usize] = start as u32;
-            }
-            end[start] = e as u32;
-            start = e;
         }
         Nodes {
-            sorted,
             node,
-            end,
+            next_same,
             na: na as u32,
         }
     }
@@ -134,22 +148,26 @@ impl Nodes {
         self.node.get(k).copied().unwrap_or(0)
     }
 
-    /// All vertex numbers at a node.
-    #[inline]
-    fn members(&self, node: u32) -> &[u32] {
-        let s = node as usize;
-        let e = self.end.get(s).copied().unwrap_or(0) as usize;
-        self.sorted.get(s..e).unwrap_or(&[])
-    }
-
     /// Vertices of the *other* operand at the node of vertex `i` (indices into that operand).
     #[inline]
     pub(crate) fn twins(&self, i: usize, side_b: bool) -> impl Iterator<Item = usize> + '_ {
         let na = self.na;
-        self.members(self.of(i, side_b))
-            .iter()
-            .filter(move |&&k| (k >= na) != side_b)
-            .map(move |&k| if side_b { k as usize } else { (k - na) as usize })
+        let mut k = self.of(i, side_b);
+        // Each step follows the list forward, so it visits each vertex once.
+        core::iter::from_fn(move || {
+            while k != NONE {
+                let cur = k;
+                k = self.next_same.get(cur as usize).copied().unwrap_or(NONE);
+                if (cur >= na) != side_b {
+                    return Some(if side_b {
+                        cur as usize
+                    } else {
+                        (cur - na) as usize
+                    });
+                }
+            }
+            None
+        })
     }
 
     /// Whether vertex `i` lies on the other operand's boundary.
@@ -161,10 +179,11 @@ impl Nodes {
 
 /// Exact winding number of `p` (not on the boundary) with respect to all rings of `r`.
 fn winding(r: &Rings, nxt: &[u32], p: DVec2) -> i32 {
+    let pts: &[DVec2] = &r.pts;
     let mut w = 0;
     for (i, &n) in nxt.iter().enumerate() {
-        let a = r.pts[i];
-        let b = r.pts[n as usize];
+        let a = pts[i];
+        let b = pts[n as usize];
         if a.y <= p.y {
             if b.y > p.y && orient(a, b, p) > 0.0 {
                 w += 1;
@@ -286,20 +305,22 @@ fn edge_status(
 ) -> Status {
     let u = r.pts[i];
     let w = r.pts[r_nxt[i] as usize];
+    let opts: &[DVec2] = &o.pts;
     for k in nodes.twins(i, side_b) {
-        if o.pts[o_nxt[k] as usize] == w {
+        if opts[o_nxt[k] as usize] == w {
             return Status::SharedSame;
         }
-        if o.pts[o_prv[k] as usize] == w {
+        if opts[o_prv[k] as usize] == w {
             return Status::SharedOpposite;
         }
     }
     // The other operand's edges around `u` decide (several twins when its contours touch at
     // `u`).
-    let rays: SmallVec<[(DVec2, bool); 8]> = nodes
-        .twins(i, side_b)
-        .flat_map(|k| [(o.pts[o_nxt[k] as usize], false), (o.pts[o_prv[k] as usize], true)])
-        .collect();
+    let mut rays: SmallVec<[(DVec2, bool); 8]> = SmallVec::new();
+    for k in nodes.twins(i, side_b) {
+        rays.push((opts[o_nxt[k] as usize], false));
+        rays.push((opts[o_prv[k] as usize], true));
+    }
     if inside_at(u, w, &rays) {
         Status::Inside
     } else {

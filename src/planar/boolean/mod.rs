@@ -41,7 +41,7 @@ pub enum BoolOp {
 }
 
 /// Point storage of the split contours of one operand.
-pub(crate) type Split = SmallVec<[DVec2; 64]>;
+pub(crate) type Split = SmallVec<[DVec2; 32]>;
 
 /// The contours of one operand as one flat point list: ring `k` occupies
 /// `ends[k - 1]..ends[k]`.
