@@ -55,6 +55,14 @@ pub enum GeomError {
         /// Index of the second ring involved (equal to `ring` for a self-crossing contour).
         other_ring: usize,
     },
+    /// Two rings that bound the same face disagree about which side of it is inside (for example
+    /// two nested rings both counter-clockwise): the region is ambiguous.
+    InconsistentOrientation {
+        /// Index of the first ring.
+        ring: usize,
+        /// Index of the second ring.
+        other_ring: usize,
+    },
     /// A value lies outside the range the algorithm supports; the message names the range.
     OutOfRange {
         /// Which input is out of range.
@@ -116,6 +124,11 @@ impl fmt::Display for GeomError {
             GeomError::SelfIntersecting { ring, other_ring } => write!(
                 f,
                 "rings {ring} and {other_ring} cross each other; rings must only nest or be disjoint"
+            ),
+            GeomError::InconsistentOrientation { ring, other_ring } => write!(
+                f,
+                "rings {ring} and {other_ring} border the same face but disagree on which side is \
+                 inside; reverse one of them (outer rings counter-clockwise, holes clockwise)"
             ),
             GeomError::OutOfRange { what, value, limit } => write!(
                 f,

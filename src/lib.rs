@@ -20,6 +20,8 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
+// Comparisons are written `!(x > t)` on purpose where NaN must fail the test.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 extern crate alloc;
 #[cfg(feature = "std")]
@@ -34,3 +36,8 @@ pub mod planar;
 pub mod sphere;
 
 pub use error::GeomError;
+
+// The README's example is compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

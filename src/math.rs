@@ -5,6 +5,8 @@
 //! choice in one place and the results identical across the crate. When both features are on,
 //! libm wins, which makes results bit-identical across platforms.
 
+#![allow(dead_code)] // The shim offers the whole set of float functions; each layer uses a subset.
+
 #[cfg(all(not(feature = "std"), not(feature = "libm")))]
 compile_error!("arealight needs a float backend: enable the `std` feature (default) or `libm`");
 

@@ -48,7 +48,11 @@ fn sub_polygon_sharing_two_edges() {
 fn adjacent_squares_share_full_edge() {
     expect(SQ, "4:0, 8:0, 8:4, 4:4", [0.0, 32.0, 16.0, 32.0]);
     let u = boolean(&shape(SQ), &shape("4:0, 8:0, 8:4, 4:4"), BoolOp::Union).unwrap();
-    assert_eq!(u.vertex_count(), 4, "collinear points must be removed: {u:?}");
+    assert_eq!(
+        u.vertex_count(),
+        4,
+        "collinear points must be removed: {u:?}"
+    );
 }
 
 #[test]
@@ -84,11 +88,7 @@ fn vertex_on_vertex() {
 #[test]
 fn bouncing_crossings_and_delayed() {
     // Sawtooth top edge bouncing on the square's top edge at two vertices.
-    expect(
-        SQ,
-        "1:4, 2:5, 3:4, 3:6, 1:6",
-        [0.0, 19.0, 16.0, 19.0],
-    );
+    expect(SQ, "1:4, 2:5, 3:4, 3:6, 1:6", [0.0, 19.0, 16.0, 19.0]);
     // A rectangle that slides along the top edge (delayed bouncing) and one that crosses through
     // an overlapping stretch (delayed crossing).
     expect(SQ, "1:4, 3:4, 3:6, 1:6", [0.0, 20.0, 16.0, 20.0]);
@@ -181,11 +181,14 @@ fn input_errors_name_the_problem() {
         DVec2::new(1.0, 1.0),
     ]]);
     assert_eq!(nan, Err(GeomError::NonFinite { ring: 0, vertex: 1 }));
-    let inf = Shape::new(vec![rings(SQ)[0].clone(), vec![
-        DVec2::new(0.0, 0.0),
-        DVec2::new(f64::INFINITY, 0.0),
-        DVec2::new(1.0, 1.0),
-    ]]);
+    let inf = Shape::new(vec![
+        rings(SQ)[0].clone(),
+        vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(f64::INFINITY, 0.0),
+            DVec2::new(1.0, 1.0),
+        ],
+    ]);
     assert_eq!(inf, Err(GeomError::NonFinite { ring: 1, vertex: 1 }));
     let bowtie = Shape::new(rings("0:0, 2:2, 2:0, 0:2"));
     assert_eq!(
@@ -206,7 +209,10 @@ fn input_errors_name_the_problem() {
     let overlap = Shape::new(rings("0:0, 2:0, 2:2, 0:2; 2:0, 4:0, 4:2, 2:2"));
     assert!(matches!(overlap, Err(GeomError::SelfIntersecting { .. })));
     let line = Shape::new(rings("0:0, 1:1, 2:2"));
-    assert!(matches!(line, Err(GeomError::TooFewVertices { ring: 0, .. })));
+    assert!(matches!(
+        line,
+        Err(GeomError::TooFewVertices { ring: 0, .. })
+    ));
     let huge = Shape::new(vec![vec![
         DVec2::new(0.0, 0.0),
         DVec2::new(1e200, 0.0),
@@ -276,7 +282,9 @@ fn chain_of_50_differences_matches_union_first() {
             continue; // leave some holes in the occluder set, so the result has several parts
         }
         visible = boolean(&visible, t, BoolOp::Difference).unwrap();
-        visible.validate().unwrap_or_else(|e| panic!("step {k}: {e}: {visible:?}"));
+        visible
+            .validate()
+            .unwrap_or_else(|e| panic!("step {k}: {e}: {visible:?}"));
         occ = boolean(&occ, t, BoolOp::Union).unwrap();
         occ.validate().unwrap();
     }
@@ -335,21 +343,42 @@ fn class_at(a: &str, b: &str, p: (f64, f64)) -> VertexClass {
 #[test]
 fn fhp_vertex_classes() {
     // Proper crossings of two overlapping squares.
-    assert_eq!(class_at(SQ, "2:2, 6:2, 6:6, 2:6", (4.0, 2.0)), VertexClass::Crossing);
-    assert_eq!(class_at(SQ, "2:2, 6:2, 6:6, 2:6", (2.0, 4.0)), VertexClass::Crossing);
+    assert_eq!(
+        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (4.0, 2.0)),
+        VertexClass::Crossing
+    );
+    assert_eq!(
+        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (2.0, 4.0)),
+        VertexClass::Crossing
+    );
     // Corner to corner: touching without crossing.
-    assert_eq!(class_at(SQ, "4:4, 6:4, 6:6, 4:6", (4.0, 4.0)), VertexClass::Bouncing);
+    assert_eq!(
+        class_at(SQ, "4:4, 6:4, 6:6, 4:6", (4.0, 4.0)),
+        VertexClass::Bouncing
+    );
     // Vertex of B on A's edge from outside.
-    assert_eq!(class_at(SQ, "4:2, 6:0, 6:4", (4.0, 2.0)), VertexClass::Bouncing);
+    assert_eq!(
+        class_at(SQ, "4:2, 6:0, 6:4", (4.0, 2.0)),
+        VertexClass::Bouncing
+    );
     // A shared stretch with A outside B on both sides: delayed bouncing, classified at the
     // chain's start; the chain's end is on the chain.
-    assert_eq!(class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 1.0)), VertexClass::DelayedBouncing);
-    assert_eq!(class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 3.0)), VertexClass::OnChain);
+    assert_eq!(
+        class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 1.0)),
+        VertexClass::DelayedBouncing
+    );
+    assert_eq!(
+        class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 3.0)),
+        VertexClass::OnChain
+    );
     // A shared stretch that A enters from outside and leaves into B: delayed crossing.
     assert_eq!(
         class_at(SQ, "2:2, 4:2, 4:4, 6:4, 6:6, 2:6", (4.0, 2.0)),
         VertexClass::DelayedCrossing
     );
     // Vertices off the other boundary are plain.
-    assert_eq!(class_at(SQ, "2:2, 6:2, 6:6, 2:6", (0.0, 0.0)), VertexClass::Plain);
+    assert_eq!(
+        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (0.0, 0.0)),
+        VertexClass::Plain
+    );
 }

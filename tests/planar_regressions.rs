@@ -13,7 +13,8 @@ fn chain(light: &str, tris: &[&str]) {
     let mut occ = Shape::empty();
     for (k, t) in tris.iter().enumerate() {
         let t = shape(t);
-        check_all(&visible, &t, 1e-9).unwrap_or_else(|e| panic!("step {k} visible: {e}\n{visible:?}\n{t:?}"));
+        check_all(&visible, &t, 1e-9)
+            .unwrap_or_else(|e| panic!("step {k} visible: {e}\n{visible:?}\n{t:?}"));
         check_all(&occ, &t, 1e-9).unwrap_or_else(|e| panic!("step {k} occ: {e}\n{occ:?}\n{t:?}"));
         visible = boolean(&visible, &t, BoolOp::Difference).unwrap();
         occ = boolean(&occ, &t, BoolOp::Union).unwrap();

@@ -71,7 +71,9 @@ pub fn check_all(a: &Shape, b: &Shape, tol: f64) -> Result<[Shape; 4], String> {
         return Err(format!("area(A^B) {ax} != area(A|B) {au} - area(A&B) {ai}"));
     }
     if ai > aa.min(ab) + eps || au + eps < aa.max(ab) {
-        return Err(format!("bounds violated: A&B {ai}, A|B {au}, A {aa}, B {ab}"));
+        return Err(format!(
+            "bounds violated: A&B {ai}, A|B {au}, A {aa}, B {ab}"
+        ));
     }
     Ok([i, u, d, x])
 }
@@ -79,7 +81,9 @@ pub fn check_all(a: &Shape, b: &Shape, tol: f64) -> Result<[Shape; 4], String> {
 pub type IPaths = Vec<Vec<[f64; 2]>>;
 
 pub fn to_paths(s: &Shape) -> IPaths {
-    s.contours().map(|c| c.iter().map(|p| [p.x, p.y]).collect()).collect()
+    s.contours()
+        .map(|c| c.iter().map(|p| [p.x, p.y]).collect())
+        .collect()
 }
 
 /// Area of i_overlay output: each shape's first contour is its outer boundary, the rest holes.

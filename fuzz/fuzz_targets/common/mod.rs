@@ -21,15 +21,24 @@ pub struct Case {
     offset: u8,
 }
 
+/// Builds rings from lattice points, each ring ordered by angle around its points' mean so
+/// that most rings are simple (star-shaped) and most cases reach the boolean operation.
 fn shape(rings: &[Vec<(i8, i8)>], s: f64, off: f64) -> Option<Shape> {
     let rings: Vec<Vec<DVec2>> = rings
         .iter()
         .take(4)
         .map(|r| {
-            r.iter()
+            let mut pts: Vec<DVec2> = r
+                .iter()
                 .take(16)
-                .map(|&(x, y)| DVec2::new(x as f64 * s + off, y as f64 * s + off))
-                .collect()
+                .map(|&(x, y)| DVec2::new(f64::from(x % 16), f64::from(y % 16)))
+                .collect();
+            let c = pts.iter().copied().sum::<DVec2>() / pts.len().max(1) as f64;
+            pts.sort_by(|p, q| {
+                let (a, b) = (p - c, q - c);
+                a.y.atan2(a.x).total_cmp(&b.y.atan2(b.x))
+            });
+            pts.into_iter().map(|p| p * s + DVec2::splat(off)).collect()
         })
         .collect();
     Shape::new(rings).ok()

@@ -65,7 +65,16 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     for pass in 0..MAX_PASSES {
         ins_a.clear();
         ins_b.clear();
-        find(a, b, &dirty_a, &dirty_b, pass == 0, snap2, &mut ins_a, &mut ins_b);
+        find(
+            a,
+            b,
+            &dirty_a,
+            &dirty_b,
+            pass == 0,
+            snap2,
+            &mut ins_a,
+            &mut ins_b,
+        );
         if ins_a.is_empty() && ins_b.is_empty() {
             return Ok(());
         }
@@ -187,7 +196,12 @@ fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
             let p0 = r.pts[i];
             let p1 = r.pts[if i + 1 == end { start } else { i + 1 }];
             out.push((
-                [p0.x.min(p1.x), p0.x.max(p1.x), p0.y.min(p1.y), p0.y.max(p1.y)],
+                [
+                    p0.x.min(p1.x),
+                    p0.x.max(p1.x),
+                    p0.y.min(p1.y),
+                    p0.y.max(p1.y),
+                ],
                 p0,
                 p1,
             ));
@@ -258,7 +272,11 @@ fn find(
     const B_BIT: u32 = 1 << 31;
     let mut events: SmallVec<[(f64, u32); 64]> = SmallVec::with_capacity(ba.len() + bb.len());
     events.extend(ba.iter().enumerate().map(|(i, e)| (e.0[0], i as u32)));
-    events.extend(bb.iter().enumerate().map(|(j, e)| (e.0[0], j as u32 | B_BIT)));
+    events.extend(
+        bb.iter()
+            .enumerate()
+            .map(|(j, e)| (e.0[0], j as u32 | B_BIT)),
+    );
     events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
     let mut active_a: SmallVec<[u32; 32]> = SmallVec::new();
     let mut active_b: SmallVec<[u32; 32]> = SmallVec::new();

@@ -231,7 +231,11 @@ fn inside_at(v: DVec2, x: DVec2, rays: &[(DVec2, bool)]) -> bool {
             Some((b, bin)) => {
                 let (cr, cb) = (ccw_class(v, x, r), ccw_class(v, x, b));
                 let earlier = cr < cb || (cr == cb && orient(v, r, b) > 0.0);
-                if earlier { Some((r, incoming)) } else { Some((b, bin)) }
+                if earlier {
+                    Some((r, incoming))
+                } else {
+                    Some((b, bin))
+                }
             }
         };
     }
@@ -262,10 +266,7 @@ pub(crate) fn label(
         let len = end - start;
         let first_on = (start..end).find(|&i| nodes.on_other(i, side_b));
         let Some(f) = first_on else {
-            let inside = r
-                .pts
-                .get(start)
-                .is_some_and(|&p| winding(o, o_nxt, p) != 0);
+            let inside = r.pts.get(start).is_some_and(|&p| winding(o, o_nxt, p) != 0);
             let s = if inside {
                 Status::Inside
             } else {

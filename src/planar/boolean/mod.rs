@@ -201,7 +201,6 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
     ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
 }
 
-
 /// The Foster–Hormann–Popa classification of every vertex of both operands after phase 1 (the
 /// split contours), for diagnostics and tests: `(point, class)` for A's vertices, then for B's.
 ///
@@ -212,7 +211,13 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
 pub fn contact_classes(
     a: &Shape,
     b: &Shape,
-) -> Result<(Vec<(DVec2, label::VertexClass)>, Vec<(DVec2, label::VertexClass)>), GeomError> {
+) -> Result<
+    (
+        Vec<(DVec2, label::VertexClass)>,
+        Vec<(DVec2, label::VertexClass)>,
+    ),
+    GeomError,
+> {
     let mut ra = Rings::from_shape(a);
     let mut rb = Rings::from_shape(b);
     let scale = ra.scale().max(rb.scale());

@@ -135,7 +135,11 @@ fn further_left(prev: DVec2, v: DVec2, n1: DVec2, n2: DVec2) -> bool {
 /// the path closes a simple loop there, which is emitted at once. So a boundary that touches
 /// itself (FHP's vertex-on-vertex contacts in the result) comes out as separate simple contours
 /// meeting at a point, never as one contour visiting a point twice.
-pub(crate) fn trace(edges: &Edges, node_count: usize, scale: f64) -> Result<Vec<Contour>, GeomError> {
+pub(crate) fn trace(
+    edges: &Edges,
+    node_count: usize,
+    scale: f64,
+) -> Result<Vec<Contour>, GeomError> {
     let n = edges.len();
     // Out-edges per node, in compressed rows.
     let mut first: SmallVec<[u32; 128]> = SmallVec::from_elem(0, node_count + 1);

@@ -1,0 +1,330 @@
+//! Integrals of the clamped cosine over spherical polygons (Lambert's irradiance formula).
+
+use core::f64::consts::PI;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use crate::sphere::{HORIZON_TOLERANCE, SphericalPolygon};
+
+/// Baum's edge term for the edge `a -> b`: `theta * (a x b)_z / |a x b|`, with the angle taken as
+/// `atan2(|a x b|, a . b)`, which stays accurate for tiny edges (no `acos` of a rounded dot
+/// product near 1) and for edges near pi long. For a tiny edge `theta / |a x b| -> 1`.
+#[inline]
+fn edge_term(a: DVec3, b: DVec3) -> f64 {
+    let c = a.cross(b);
+    let s = c.length();
+    if s == 0.0 {
+        return 0.0; // coincident endpoints: an edge of zero length contributes nothing
+    }
+    crate::math::atan2(s, a.dot(b)) / s * c.z
+}
+
+/// A rational approximation of the edge factor `theta / sin(theta)` as a function of
+/// `x = cos(theta) = a . b`, for renderers that prefer it to an `atan2`.
+///
+/// On `[0, 1]` it is a (2, 2) rational function fitted by this crate (minimax on the relative
+/// error, see `tests/ltc_integrals.rs`); for `x < 0` it uses the reflection
+/// `theta / sin(theta) = pi / sin(theta) - (pi - theta) / sin(pi - theta)`, which needs one
+/// square root. Maximum relative error over `[-1, 1]`: [`EDGE_FACTOR_RATIONAL_MAX_ERROR`]
+/// (the factor diverges as `x -> -1`; `1 - x^2` is clamped at `1e-14`).
+#[inline]
+#[must_use]
+pub fn edge_factor_rational(x: f64) -> f64 {
+    let y = x.abs();
+    let v =
+        (5.429131712 + (3.130161863 + 0.089934273 * y) * y) / (3.456294690 + (4.192928007 + y) * y);
+    if x >= 0.0 {
+        v
+    } else {
+        PI / crate::math::sqrt((1.0 - x * x).max(1e-14)) - v
+    }
+}
+
+/// Largest relative error of [`edge_factor_rational`] against `acos(x) / sqrt(1 - x^2)` over
+/// `[-1, 1]`, as measured on a dense grid by the tests.
+pub const EDGE_FACTOR_RATIONAL_MAX_ERROR: f64 = 6.1e-7;
+
+/// [`clamped_cosine_integral`] with the edge factor from [`edge_factor_rational`] instead of an
+/// `atan2` per edge: exact clipping, approximate edge terms. Each edge term is off by at most
+/// [`EDGE_FACTOR_RATIONAL_MAX_ERROR`] times `theta_e`, so the result is off by at most that
+/// constant times the clipped polygon's perimeter over `2 pi` (below the constant itself for a
+/// convex polygon, whose perimeter inside a hemisphere is below `2 pi`).
+#[must_use]
+pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
+    clipped_sum(poly, rational_edge_term)
+}
+
+/// Integral of a linearly transformed cosine over a polygon in the shading frame: the polygon is
+/// mapped by `m_inv` (HDHN16 eq. 14: integrating `D` over `P` equals integrating the clamped
+/// cosine over `M^-1 P`) and its clamped-cosine integral is taken. Multiply by the lookup's
+/// normalization (`LtcLookup::norm`, `specular_scale`) for the specular response.
+///
+/// # Errors
+///
+/// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
+pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
+    transformed_integral(poly, m_inv, edge_term)
+}
+
+/// [`ltc_integral`] with the rational edge factor ([`edge_factor_rational`]): one `atan2` in total
+/// per polygon (for the horizon arcs), none per edge. Error bound as for
+/// [`clamped_cosine_integral_rational`], applied to the transformed polygon.
+///
+/// # Errors
+///
+/// As [`ltc_integral`].
+pub fn ltc_integral_rational(
+    poly: &SphericalPolygon,
+    m_inv: glam::DMat3,
+) -> Result<f64, crate::GeomError> {
+    transformed_integral(poly, m_inv, rational_edge_term)
+}
+
+/// The clamped-cosine integral of `m` applied to `poly`, with the given edge term: the stack-only
+/// clip-free path (thesis 003 eq. 4.6/4.7) when the map keeps orientation, the exact clip of the
+/// transformed polygon otherwise. Both agree to rounding (tested).
+fn transformed_integral(
+    poly: &SphericalPolygon,
+    m: glam::DMat3,
+    edge: fn(DVec3, DVec3) -> f64,
+) -> Result<f64, crate::GeomError> {
+    if !poly.is_full() && !poly.is_empty() && m.determinant() > 0.0 {
+        if let Some(v) = transformed_clip_free(poly, m, edge) {
+            return Ok(v);
+        }
+    }
+    Ok(clipped_sum(&poly.transformed(m)?, edge))
+}
+
+/// The GGX specular response to a uniform unit-radiance polygon light: approximately
+/// `integral over P of f(v, l) F(v, l) cos(theta_l) dl` with the height-correlated GGX BRDF and
+/// Schlick's Fresnel with reflectance `f0` (HDHN16 section 4 and eq. 14; the albedo/Fresnel split
+/// follows the Fresnel tables of this crate's fit).
+///
+/// `poly` is given in the shading frame (normal `+z`, view in the xz-plane with `x >= 0`) with
+/// the view at `cos_theta_v` from the normal; `alpha` is GGX's roughness parameter (`alpha =
+/// roughness^2` in the usual artist mapping). Evaluated here: the table lookup, the clip to the
+/// shading horizon (the tables are fitted for LTCs clipped there), the transform by `M^-1`, the
+/// horizon handling in cosine space and Baum's edge sum.
+///
+/// # Errors
+///
+/// [`crate::GeomError::OutOfRange`] for NaN parameters (see [`super::lookup`]).
+pub fn ggx_polygon_integral(
+    poly: &SphericalPolygon,
+    cos_theta_v: f64,
+    alpha: f64,
+    f0: f64,
+) -> Result<f64, crate::GeomError> {
+    if !f0.is_finite() {
+        return Err(crate::GeomError::OutOfRange {
+            what: "Fresnel reflectance f0",
+            value: f0,
+            limit: 1.0,
+        });
+    }
+    let l = super::lookup(cos_theta_v, alpha)?;
+    // The tables' LTCs are fitted as clipped to the shading horizon and renormalized (`norm`),
+    // so the light is clipped there first; the clip is skipped when nothing reaches below.
+    let above = poly.rings().flatten().all(|v| v.z > HORIZON_TOLERANCE) && !poly.is_full();
+    let integral = if above {
+        ltc_integral(poly, l.m_inv)?
+    } else {
+        ltc_integral(&poly.clip_to_hemisphere(DVec3::Z), l.m_inv)?
+    };
+    Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
+}
+
+/// The edge term with [`edge_factor_rational`] in place of `theta / sin(theta)`.
+#[inline]
+fn rational_edge_term(a: DVec3, b: DVec3) -> f64 {
+    edge_factor_rational(a.dot(b)) * a.cross(b).z
+}
+
+/// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem
+/// (Baum, Rushmeier and Winget 1989; HDHN16 eq. 11): `(1 / 2 pi) sum theta_e n_e . z`.
+fn boundary_sum(poly: &SphericalPolygon, edge: fn(DVec3, DVec3) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for ring in poly.rings() {
+        let n = ring.len();
+        for i in 0..n {
+            sum += edge(ring[i], ring[(i + 1) % n]);
+        }
+    }
+    sum / (2.0 * PI)
+}
+
+/// The exact path: clip to the upper hemisphere, then the boundary sum.
+fn clipped_sum(poly: &SphericalPolygon, edge: fn(DVec3, DVec3) -> f64) -> f64 {
+    boundary_sum(&poly.clip_to_hemisphere(DVec3::Z), edge).clamp(0.0, 1.0)
+}
+
+/// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform
+/// unit-radiance light filling the polygon onto a surface with normal `+z`, relative to a light
+/// filling the whole hemisphere. In `[0, 1]`.
+///
+/// The polygon is clipped exactly to the upper hemisphere ([`SphericalPolygon::clip_to_hemisphere`])
+/// and Baum's edge sum is evaluated on the result (HDHN16 section 3.1 and eq. 11; seed paper 000,
+/// Alg. 1 line 15). Works for every valid polygon: holes, several rings, regions larger than a
+/// hemisphere, the full sphere (which gives 1).
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::ltc::clamped_cosine_integral;
+/// use arealight::sphere::SphericalPolygon;
+///
+/// // The whole upper hemisphere receives pi * L, i.e. 1 in these units.
+/// let up = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y]])?;
+/// assert!((clamped_cosine_integral(&up) - 1.0).abs() < 1e-15);
+/// assert!(clamped_cosine_integral(&up.complement()).abs() < 1e-15);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[must_use]
+pub fn clamped_cosine_integral(poly: &SphericalPolygon) -> f64 {
+    clipped_sum(poly, edge_term)
+}
+
+/// The same integral as [`clamped_cosine_integral`] without building the clipped polygon: the
+/// parts of the original edges above the horizon are integrated as they are, and the new edges
+/// along the horizon enter only through their endpoints (thesis 003, eq. 4.6).
+///
+/// A horizon edge from an exit point `X` counter-clockwise to an entry point `E` contributes its
+/// angle `theta_E - theta_X`. Summed over all of them, the angles of the entries count `+1` and
+/// those of the exits `-1`, so no pairing of crossings is needed; and by the atan2 sum identity
+/// (eq. 4.7) the whole sum is the argument of one complex product, so one `atan2` is evaluated in
+/// total. The product gives the sum modulo `2 pi`; since the horizon arcs are disjoint their total
+/// lies in `[0, 2 pi]`, which removes the ambiguity except between "none" and "all" of the circle.
+///
+/// Configurations where that or the pairing is ambiguous (a vertex within [`HORIZON_TOLERANCE`] of
+/// the horizon, or no crossing while some vertex is below it) are delegated to the exact path, so
+/// the two agree to rounding on every valid polygon.
+#[must_use]
+pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
+    if poly.is_full() {
+        return 1.0;
+    }
+    clip_free_sum(poly.rings(), edge_term).unwrap_or_else(|| clamped_cosine_integral(poly))
+}
+
+/// The clip-free sum of [`clamped_cosine_integral_clip_free`] over rings of unit vectors, with
+/// the edge term given; `None` where the exact path must decide (a vertex on the horizon, or no
+/// crossing while some vertex is below).
+fn clip_free_sum<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    edge: impl Fn(DVec3, DVec3) -> f64,
+) -> Option<f64> {
+    let mut sum = 0.0;
+    // Running complex product of entry points and conjugates of exit points on the horizon.
+    let (mut re, mut im) = (1.0f64, 0.0f64);
+    let mut crossings = 0usize;
+    let mut any_below = false;
+    let mut any = false;
+    // Twice the signed area of the rings projected from +z, for the no-crossing case.
+    let mut planar_area2 = 0.0;
+    for ring in rings {
+        let n = ring.len();
+        for i in 0..n {
+            any = true;
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            if a.z.abs() <= HORIZON_TOLERANCE {
+                return None;
+            }
+            match (a.z > 0.0, b.z > 0.0) {
+                (true, true) => {
+                    sum += edge(a, b);
+                    planar_area2 += (a.x * b.y - a.y * b.x) / (a.z * b.z);
+                }
+                (false, false) => any_below = true,
+                (up_a, _) => {
+                    any_below = true;
+                    if b.z.abs() <= HORIZON_TOLERANCE {
+                        return None;
+                    }
+                    // The crossing point, as a positive combination of a and b on the horizon.
+                    let x = if up_a {
+                        b * a.z - a * b.z
+                    } else {
+                        a * b.z - b * a.z
+                    };
+                    let x = DVec3::new(x.x, x.y, 0.0).normalize();
+                    let (pr, pi) = (x.x, if up_a { -x.y } else { x.y });
+                    (re, im) = (re * pr - im * pi, re * pi + im * pr);
+                    crossings += 1;
+                    sum += if up_a { edge(a, x) } else { edge(x, b) };
+                }
+            }
+        }
+    }
+    let horizon = if crossings > 0 {
+        crate::math::atan2(im, re).rem_euclid(2.0 * PI)
+    } else if !any {
+        0.0
+    } else if !any_below {
+        // Everything strictly above: the horizon is inside the region iff the rings, seen from
+        // +z, wind clockwise overall (the unbounded planar face is then inside).
+        if planar_area2 < 0.0 { 2.0 * PI } else { 0.0 }
+    } else {
+        return None;
+    };
+    Some(((sum + horizon) / (2.0 * PI)).clamp(0.0, 1.0))
+}
+
+/// Maps every vertex by `m` and normalizes, into a stack buffer, and runs the clip-free sum on
+/// the images; `None` when the exact path is needed (or `m` mirrors, reversing orientation).
+fn transformed_clip_free(
+    poly: &SphericalPolygon,
+    m: glam::DMat3,
+    edge: impl Fn(DVec3, DVec3) -> f64,
+) -> Option<f64> {
+    let mut buf: SmallVec<[DVec3; 16]> = SmallVec::new();
+    let mut ends: SmallVec<[usize; 2]> = SmallVec::new();
+    for ring in poly.rings() {
+        for &v in ring {
+            buf.push((m * v).try_normalize()?);
+        }
+        ends.push(buf.len());
+    }
+    let mut start = 0;
+    let rings = ends.iter().map(|&e| {
+        let r = &buf[start..e];
+        start = e;
+        r
+    });
+    clip_free_sum(rings, edge)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec;
+
+    #[test]
+    fn edge_term_is_stable_for_tiny_and_long_edges() {
+        let a = DVec3::new(1.0, 0.0, 0.0);
+        let b = DVec3::new(1.0, 1e-9, 0.0).normalize();
+        // theta * (a x b)_z / |a x b| -> theta for an edge on the horizon going counter-clockwise.
+        assert!((edge_term(a, b) - 1e-9).abs() < 1e-24);
+        let c = DVec3::new(-1.0, 1e-9, 0.0).normalize();
+        assert!((edge_term(a, c) - (PI - 1e-9)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn full_sphere_and_empty() {
+        assert_eq!(clamped_cosine_integral(&SphericalPolygon::full()), 1.0);
+        assert_eq!(
+            clamped_cosine_integral_clip_free(&SphericalPolygon::full()),
+            1.0
+        );
+        assert_eq!(clamped_cosine_integral(&SphericalPolygon::empty()), 0.0);
+        assert_eq!(
+            clamped_cosine_integral_clip_free(&SphericalPolygon::empty()),
+            0.0
+        );
+        let down =
+            SphericalPolygon::new(vec![vec![DVec3::X, -DVec3::Y, -DVec3::X, DVec3::Y]]).unwrap();
+        assert_eq!(clamped_cosine_integral(&down), 0.0);
+    }
+}

@@ -1,0 +1,336 @@
+//! Gnomonic (central) projection between a hemisphere and its tangent plane.
+
+use glam::{DVec2, DVec3};
+use smallvec::SmallVec;
+
+use super::predicates::{normalize_any, tangent_frame};
+use crate::GeomError;
+
+/// Gnomonic projection about a center direction: a direction `p` with `p . c > 0` maps to the
+/// point where the ray through it meets the plane tangent to the sphere at `c`.
+///
+/// Great-circle arcs map to straight segments, which is why set operations on spherical polygons
+/// inside an open hemisphere reduce to planar ones (Snyder 1987, "Map projections: a working
+/// manual", section 22; seed paper 000, section 3.2, which uses a look-at camera for the same
+/// map). The plane's axes `(u, v)` satisfy `u x v = c`, so a ring counter-clockwise seen from
+/// outside the sphere stays counter-clockwise in the plane.
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::sphere::Gnomonic;
+///
+/// let g = Gnomonic::new(DVec3::Z)?;
+/// let q = g.project(DVec3::new(1.0, 0.0, 1.0)).unwrap();
+/// assert!((q.length() - 1.0).abs() < 1e-15); // 45 degrees from the center: distance tan(45)
+/// assert!(g.project(DVec3::new(1.0, 0.0, -1.0)).is_none()); // the far hemisphere has no image
+/// let p = g.unproject(q);
+/// assert!((p - DVec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-15);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gnomonic {
+    center: DVec3,
+    u: DVec3,
+    v: DVec3,
+}
+
+impl Gnomonic {
+    /// The projection about `center` (any non-zero finite vector; it is normalized).
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::NonFinite`] or [`GeomError::ZeroVector`] when `center` names no direction.
+    pub fn new(center: DVec3) -> Result<Self, GeomError> {
+        if !center.is_finite() {
+            return Err(GeomError::NonFinite { ring: 0, vertex: 0 });
+        }
+        let c = normalize_any(center).ok_or(GeomError::ZeroVector { ring: 0, vertex: 0 })?;
+        let (u, v) = tangent_frame(c);
+        Ok(Gnomonic { center: c, u, v })
+    }
+
+    /// The projection about the center of the smallest spherical cap holding all `dirs`
+    /// (see [`enclosing_cap`]), which keeps projected coordinates as small as they can be.
+    ///
+    /// # Errors
+    ///
+    /// As [`enclosing_cap`].
+    pub fn fit(dirs: &[DVec3]) -> Result<Self, GeomError> {
+        let (c, _) = enclosing_cap(dirs)?;
+        Gnomonic::new(c)
+    }
+
+    /// The unit center direction.
+    #[must_use]
+    pub fn center(&self) -> DVec3 {
+        self.center
+    }
+
+    /// The plane's axes `(u, v)`, unit vectors orthogonal to the center with `u x v = center`.
+    #[must_use]
+    pub fn axes(&self) -> (DVec3, DVec3) {
+        (self.u, self.v)
+    }
+
+    /// Projects a direction (of any positive length) to the plane; `None` when it does not lie in
+    /// the open hemisphere around the center or is not finite.
+    #[must_use]
+    pub fn project(&self, p: DVec3) -> Option<DVec2> {
+        let w = p.dot(self.center);
+        if !(w > 0.0) {
+            return None;
+        }
+        let q = DVec2::new(p.dot(self.u) / w, p.dot(self.v) / w);
+        q.is_finite().then_some(q)
+    }
+
+    /// Maps a point of the plane back to its unit direction. Every finite point has one;
+    /// non-finite input gives a NaN vector (use [`Gnomonic::try_unproject`] to check).
+    #[must_use]
+    pub fn unproject(&self, q: DVec2) -> DVec3 {
+        self.try_unproject(q).unwrap_or(DVec3::NAN)
+    }
+
+    /// As [`Gnomonic::unproject`], with `None` for non-finite input.
+    #[must_use]
+    pub fn try_unproject(&self, q: DVec2) -> Option<DVec3> {
+        if !q.is_finite() {
+            return None;
+        }
+        // Scaled so that even coordinates near f64::MAX do not overflow before normalization.
+        normalize_any(self.center + self.u * q.x + self.v * q.y).or_else(|| {
+            let m = q.abs().max_element();
+            normalize_any(self.center / m + self.u * (q.x / m) + self.v * (q.y / m))
+        })
+    }
+}
+
+/// The smallest spherical cap holding every direction in `dirs`: its center `c` (a unit vector)
+/// and `min_i c . d_i`, the cosine of its angular radius, which is positive.
+///
+/// Maximizing `min_i c . d_i` over unit `c` is dual to finding the point of the convex hull of the
+/// unit directions nearest to the origin (separating hyperplane theorem): `c` is that point,
+/// normalized. The nearest point is found exactly (up to rounding) with Wolfe's minimum-norm-point
+/// algorithm (Wolfe 1976, "Finding the nearest point in a polytope"), whose corrals in 3D have at
+/// most four points.
+///
+/// # Errors
+///
+/// - [`GeomError::Degenerate`] for an empty slice;
+/// - [`GeomError::NonFinite`] / [`GeomError::ZeroVector`] (with `vertex` the index) for an invalid
+///   direction;
+/// - [`GeomError::NotInOpenHemisphere`] when the origin lies in the hull, i.e. no open hemisphere
+///   holds all directions (the best cap would reach or pass a great circle).
+pub fn enclosing_cap(dirs: &[DVec3]) -> Result<(DVec3, f64), GeomError> {
+    if dirs.is_empty() {
+        return Err(GeomError::Degenerate("no directions to enclose"));
+    }
+    let mut pts: SmallVec<[DVec3; 16]> = SmallVec::with_capacity(dirs.len());
+    for (i, &d) in dirs.iter().enumerate() {
+        if !d.is_finite() {
+            return Err(GeomError::NonFinite { ring: 0, vertex: i });
+        }
+        pts.push(normalize_any(d).ok_or(GeomError::ZeroVector { ring: 0, vertex: i })?);
+    }
+    let x = min_norm_point(&pts);
+    let c = normalize_any(x).ok_or(GeomError::NotInOpenHemisphere)?;
+    if x.length() < 1e-12 {
+        return Err(GeomError::NotInOpenHemisphere);
+    }
+    let min_dot = pts.iter().map(|p| p.dot(c)).fold(f64::INFINITY, f64::min);
+    if min_dot > 0.0 {
+        Ok((c, min_dot))
+    } else {
+        Err(GeomError::NotInOpenHemisphere)
+    }
+}
+
+/// Wolfe's algorithm: the point of the convex hull of `pts` (unit vectors) nearest the origin.
+fn min_norm_point(pts: &[DVec3]) -> DVec3 {
+    // The corral: indices into pts and their convex weights.
+    let mut set: SmallVec<[usize; 4]> = SmallVec::new();
+    let mut lam: SmallVec<[f64; 4]> = SmallVec::new();
+    set.push(0);
+    lam.push(1.0);
+    let mut x = pts[0];
+    // Each major cycle strictly decreases |x|, and corrals never repeat, so the loop is finite;
+    // the bound only guards against rounding cycling.
+    for _ in 0..4 * pts.len() + 16 {
+        let (k, m) = pts
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i, x.dot(*p)))
+            .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+        // Optimality (Wolfe's test): no point improves on x by more than rounding.
+        if x.dot(x) - m <= 1e-15 || set.contains(&k) {
+            break;
+        }
+        if set.len() == 4 {
+            break; // cannot happen in exact arithmetic: a full corral spans the origin.
+        }
+        set.push(k);
+        lam.push(0.0);
+        // Minor cycles: move toward the affine minimizer of the corral until it is interior.
+        for _ in 0..5 {
+            let Some(alpha) = affine_minimizer(pts, &set) else {
+                // Affinely dependent corral: drop the newcomer and stop; x is already the best.
+                set.pop();
+                lam.pop();
+                return x;
+            };
+            if alpha.iter().all(|&a| a > 0.0) {
+                lam = alpha;
+                x = combine(pts, &set, &lam);
+                break;
+            }
+            let mut theta = 1.0f64;
+            for (l, a) in lam.iter().zip(&alpha) {
+                if *a <= 0.0 {
+                    theta = theta.min(l / (l - a));
+                }
+            }
+            for (l, a) in lam.iter_mut().zip(&alpha) {
+                *l += theta * (a - *l);
+            }
+            // Drop the points whose weight reached zero (at least the one that set theta).
+            let mut i = 0;
+            while i < set.len() {
+                if lam[i] <= 1e-15 {
+                    set.remove(i);
+                    lam.remove(i);
+                } else {
+                    i += 1;
+                }
+            }
+            if set.is_empty() {
+                return x;
+            }
+            let total: f64 = lam.iter().sum();
+            lam.iter_mut().for_each(|l| *l /= total);
+            x = combine(pts, &set, &lam);
+        }
+        if x.length_squared() < 1e-30 {
+            break;
+        }
+    }
+    x
+}
+
+fn combine(pts: &[DVec3], set: &[usize], lam: &[f64]) -> DVec3 {
+    set.iter().zip(lam).map(|(&i, &l)| pts[i] * l).sum()
+}
+
+/// Weights (summing to one) of the point of the corral's affine hull nearest the origin, or `None`
+/// when the corral is affinely dependent.
+fn affine_minimizer(pts: &[DVec3], set: &[usize]) -> Option<SmallVec<[f64; 4]>> {
+    let q0 = pts[set[0]];
+    let d: SmallVec<[DVec3; 3]> = set[1..].iter().map(|&i| pts[i] - q0).collect();
+    let m = d.len();
+    // Normal equations G beta = -D^T q0 with G = D^T D, m <= 3, solved by Cramer's rule on the
+    // zero-padded 3x3 system.
+    let mut g = [[0.0f64; 3]; 3];
+    let mut rhs = [0.0f64; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            g[i][j] = if i < m && j < m {
+                d[i].dot(d[j])
+            } else if i == j {
+                1.0
+            } else {
+                0.0
+            };
+        }
+        rhs[i] = if i < m { -d[i].dot(q0) } else { 0.0 };
+    }
+    let det3 = |a: &[[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let det = det3(&g);
+    let scale: f64 = (0..m)
+        .map(|i| g[i][i])
+        .product::<f64>()
+        .max(f64::MIN_POSITIVE);
+    if !(det.abs() > 1e-12 * scale) {
+        return None;
+    }
+    let mut alpha: SmallVec<[f64; 4]> = SmallVec::from_elem(0.0, m + 1);
+    let mut rest = 0.0;
+    for k in 0..m {
+        let mut gk = g;
+        for (row, r) in gk.iter_mut().zip(rhs) {
+            row[k] = r;
+        }
+        let beta = det3(&gk) / det;
+        alpha[k + 1] = beta;
+        rest += beta;
+    }
+    alpha[0] = 1.0 - rest;
+    Some(alpha)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cap_of_symmetric_points_is_centered() {
+        let dirs = [
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(-1.0, 0.0, 1.0),
+            DVec3::new(0.0, 1.0, 1.0),
+            DVec3::new(0.0, -1.0, 1.0),
+            DVec3::new(0.1, 0.1, 1.0),
+        ];
+        let (c, cosr) = enclosing_cap(&dirs).unwrap();
+        assert!((c - DVec3::Z).length() < 1e-14, "{c}");
+        assert!((cosr - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-14);
+    }
+
+    #[test]
+    fn cap_of_two_points_is_their_midpoint() {
+        let a = DVec3::new(1.0, 0.0, 0.0);
+        let b = DVec3::new(0.0, 1.0, 0.0);
+        let (c, cosr) = enclosing_cap(&[a, b, (a + b) * 3.0]).unwrap();
+        assert!((c - (a + b).normalize()).length() < 1e-14);
+        assert!((cosr - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-14);
+    }
+
+    #[test]
+    fn no_open_hemisphere() {
+        let octahedron = [
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::NEG_X,
+            DVec3::NEG_Y,
+            DVec3::NEG_Z,
+        ];
+        assert_eq!(
+            enclosing_cap(&octahedron),
+            Err(GeomError::NotInOpenHemisphere)
+        );
+        // A great circle: a closed but not an open hemisphere.
+        let equator = [DVec3::X, DVec3::Y, DVec3::NEG_X, DVec3::NEG_Y];
+        assert_eq!(enclosing_cap(&equator), Err(GeomError::NotInOpenHemisphere));
+        assert_eq!(
+            enclosing_cap(&[DVec3::X, DVec3::NEG_X]),
+            Err(GeomError::NotInOpenHemisphere)
+        );
+    }
+
+    #[test]
+    fn invalid_centers_are_errors() {
+        assert!(Gnomonic::new(DVec3::ZERO).is_err());
+        assert!(Gnomonic::new(DVec3::new(f64::INFINITY, 0.0, 0.0)).is_err());
+        assert!(enclosing_cap(&[]).is_err());
+        let g = Gnomonic::new(DVec3::new(0.0, 0.0, 1e300)).unwrap();
+        assert_eq!(g.center(), DVec3::Z);
+        assert!(g.unproject(DVec2::new(f64::NAN, 0.0)).is_nan());
+        let far = g.unproject(DVec2::new(1e308, -1e308));
+        assert!((far - DVec3::new(1.0, -1.0, 0.0).normalize()).length() < 1e-15);
+    }
+}

@@ -1,0 +1,645 @@
+//! The spherical polygon type: construction, validation, solid angle and point containment.
+
+use core::f64::consts::PI;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use super::predicates::{AXES, arcs_intersect, normalize_any, orient, triangle_solid_angle};
+use crate::GeomError;
+use alloc::vec::Vec;
+
+/// Consecutive vertices closer than this chord length are rejected as coincident.
+///
+/// Unit vectors carry about `1.1e-16` of rounding per component, so two directions within a few
+/// times that distance are the same direction for every purpose of this crate.
+pub const COINCIDENT_TOLERANCE: f64 = 1e-15;
+
+/// Consecutive vertices whose chord to each other's antipode is below this are rejected as
+/// antipodal.
+///
+/// The plane of an edge `a-b` is `a x b`, whose direction is known only to about
+/// `1e-16 / |a x b|` radians; at `|a + b| = 1e-10` the edge's great circle is uncertain by about a
+/// micro-radian, too much to call it the same edge in every later operation.
+pub const ANTIPODAL_TOLERANCE: f64 = 1e-10;
+
+/// Inline capacity for vertices: silhouettes of the lights and occluders a renderer meets (quads,
+/// boxes, clipped versions of them) fit without touching the heap.
+pub(crate) type Verts = SmallVec<[DVec3; 12]>;
+
+/// A region of the unit sphere bounded by rings of great-circle arcs.
+///
+/// Each ring is a closed sequence of unit vectors; an edge is the minor great-circle arc between
+/// consecutive vertices. The region lies to the LEFT of every edge `a -> b`, on the side where
+/// `(a x b) . p > 0`: seen from outside the sphere, an outer ring runs counter-clockwise and a hole
+/// clockwise. A single ring therefore describes either of the two regions it bounds, depending
+/// on its direction, and regions larger than a hemisphere are ordinary values. No rings is the
+/// empty region; the full sphere, which has no boundary, is [`SphericalPolygon::full`].
+///
+/// Values built with [`SphericalPolygon::new`] are valid: vertices are unit vectors, rings are
+/// simple, disjoint and consistently oriented. Every operation of the crate returns valid values.
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::sphere::SphericalPolygon;
+///
+/// // The positive octant, counter-clockwise seen from outside: an eighth of the sphere.
+/// let octant = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, DVec3::Z]])?;
+/// assert!((octant.solid_angle() - std::f64::consts::PI / 2.0).abs() < 1e-15);
+/// assert!(octant.contains(DVec3::ONE));
+/// // The same ring the other way round bounds the other seven eighths.
+/// let rest = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Z, DVec3::Y]])?;
+/// assert!((rest.solid_angle() - 3.5 * std::f64::consts::PI).abs() < 1e-14);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct SphericalPolygon {
+    verts: Verts,
+    /// One past the last vertex of each ring, in `verts`.
+    ends: SmallVec<[u32; 2]>,
+    /// The full sphere (then there are no rings).
+    full: bool,
+}
+
+impl SphericalPolygon {
+    /// Builds a polygon from rings of directions, validating them.
+    ///
+    /// Each vertex may have any non-zero finite length and is normalized. Orientation is taken as
+    /// given (interior on the left). No rings is the empty region.
+    ///
+    /// # Errors
+    ///
+    /// - [`GeomError::NonFinite`] or [`GeomError::ZeroVector`] for a vertex that names no direction;
+    /// - [`GeomError::CoincidentVertices`] for consecutive vertices closer than
+    ///   [`COINCIDENT_TOLERANCE`], [`GeomError::AntipodalVertices`] for consecutive vertices within
+    ///   [`ANTIPODAL_TOLERANCE`] of antipodal;
+    /// - [`GeomError::TooFewVertices`] for a ring of fewer than three vertices;
+    /// - [`GeomError::SelfIntersecting`] when a ring crosses or touches itself or another ring
+    ///   (checked exactly, with Shewchuk's `orient3d`; the check is quadratic in the vertex count);
+    /// - [`GeomError::InconsistentOrientation`] when two rings bounding the same face disagree on
+    ///   which side is inside (for example two nested rings both counter-clockwise).
+    pub fn new(rings: Vec<Vec<DVec3>>) -> Result<Self, GeomError> {
+        let mut poly = SphericalPolygon::empty();
+        for (r, ring) in rings.iter().enumerate() {
+            let start = poly.verts.len();
+            for (i, &p) in ring.iter().enumerate() {
+                if !p.is_finite() {
+                    return Err(GeomError::NonFinite { ring: r, vertex: i });
+                }
+                let u = normalize_any(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?;
+                poly.verts.push(u);
+            }
+            let n = ring.len();
+            if n < 3 {
+                return Err(GeomError::TooFewVertices { ring: r, count: n });
+            }
+            let vs = &poly.verts[start..];
+            for i in 0..n {
+                let (a, b) = (vs[i], vs[(i + 1) % n]);
+                if (a - b).length() <= COINCIDENT_TOLERANCE {
+                    return Err(GeomError::CoincidentVertices { ring: r, vertex: i });
+                }
+                if (a + b).length() <= ANTIPODAL_TOLERANCE {
+                    return Err(GeomError::AntipodalVertices { ring: r, vertex: i });
+                }
+            }
+            poly.ends.push(poly.verts.len() as u32);
+        }
+        poly.check_simple()?;
+        poly.check_consistent()?;
+        Ok(poly)
+    }
+
+    /// The empty region (no rings).
+    #[must_use]
+    pub fn empty() -> Self {
+        SphericalPolygon::default()
+    }
+
+    /// The whole sphere: no boundary, solid angle `4 pi`.
+    #[must_use]
+    pub fn full() -> Self {
+        SphericalPolygon {
+            full: true,
+            ..SphericalPolygon::default()
+        }
+    }
+
+    /// Builds a polygon from rings the caller guarantees valid (unit vectors, simple, disjoint,
+    /// consistently oriented). Used by the crate's own operations, whose outputs are valid by
+    /// construction, to skip the quadratic checks of [`SphericalPolygon::new`].
+    pub(crate) fn from_parts(verts: Verts, ends: SmallVec<[u32; 2]>) -> Self {
+        debug_assert!(
+            ends.last()
+                .map_or(verts.is_empty(), |&e| e as usize == verts.len())
+        );
+        SphericalPolygon {
+            verts,
+            ends,
+            full: false,
+        }
+    }
+
+    /// Whether this is the empty region.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        !self.full && self.ends.is_empty()
+    }
+
+    /// Whether this is the full sphere.
+    #[must_use]
+    pub fn is_full(&self) -> bool {
+        self.full
+    }
+
+    /// The rings, each a slice of unit vectors (the closing edge from last to first is implied).
+    pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + '_ {
+        let mut start = 0usize;
+        self.ends.iter().map(move |&e| {
+            let s = start;
+            start = e as usize;
+            &self.verts[s..e as usize]
+        })
+    }
+
+    /// Number of rings.
+    #[must_use]
+    pub fn ring_count(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// Total number of vertices over all rings.
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.verts.len()
+    }
+
+    /// The complement: every ring reversed (and empty and full swapped).
+    #[must_use]
+    pub fn complement(&self) -> Self {
+        if self.full {
+            return SphericalPolygon::empty();
+        }
+        if self.ends.is_empty() {
+            return SphericalPolygon::full();
+        }
+        let mut out = self.clone();
+        let mut start = 0usize;
+        for &e in &self.ends {
+            out.verts[start..e as usize].reverse();
+            start = e as usize;
+        }
+        out
+    }
+
+    /// The image of the region under the linear map `m` applied to directions: each vertex `v`
+    /// becomes `m v / |m v|`. Great circles map to great circles, so the rings stay valid; a map
+    /// with negative determinant mirrors the sphere, and the rings are reversed to keep the
+    /// interior on the left. This is how a polygon enters the space of a linearly transformed
+    /// cosine (HDHN16 section 3).
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::Degenerate`] when `m` is singular (or nearly so: `|det m|` below `1e-12`
+    /// times the product of its column lengths) or not finite.
+    pub fn transformed(&self, m: glam::DMat3) -> Result<SphericalPolygon, GeomError> {
+        let det = m.determinant();
+        let scale = m.x_axis.length() * m.y_axis.length() * m.z_axis.length();
+        if !det.is_finite() || !(det.abs() > 1e-12 * scale) {
+            return Err(GeomError::Degenerate(
+                "the linear map is singular or not finite",
+            ));
+        }
+        if self.full || self.ends.is_empty() {
+            return Ok(self.clone());
+        }
+        let mut out = self.clone();
+        for v in out.verts.iter_mut() {
+            *v = normalize_any(m * *v)
+                .ok_or(GeomError::Degenerate("a vertex maps to the zero vector"))?;
+        }
+        Ok(if det < 0.0 {
+            let mut start = 0usize;
+            for &e in &self.ends {
+                out.verts[start..e as usize].reverse();
+                start = e as usize;
+            }
+            out
+        } else {
+            out
+        })
+    }
+
+    /// Solid angle of the region in steradians, in `[0, 4 pi]`.
+    ///
+    /// Each ring's left region is measured as a fan of Van Oosterom–Strackee triangles from one of
+    /// its own vertices (chosen so that no vertex is near its antipode, where the triangle formula
+    /// is ill-conditioned); a triangle's area is only defined modulo `4 pi` when its far edge
+    /// passes near the apex's antipode, but the sum modulo `4 pi` is exact. The rings' areas add
+    /// up to the region's area modulo `4 pi`. Accuracy: about `1e-15 * n` absolute for `n`
+    /// vertices, and full relative precision for small polygons (the determinant is evaluated on
+    /// edge differences), so a polygon of 1e-6 rad across keeps about 1e-10 relative accuracy,
+    /// which is what its unit-vector vertices determine.
+    #[must_use]
+    pub fn solid_angle(&self) -> f64 {
+        const FOUR_PI: f64 = 4.0 * PI;
+        if self.full {
+            return FOUR_PI;
+        }
+        match self.ends.len() {
+            0 => 0.0,
+            1 => ring_left_area(&self.verts),
+            _ => {
+                let total: f64 = self.rings().map(ring_left_area).sum();
+                let omega = total.rem_euclid(FOUR_PI);
+                // Modulo 4 pi, a nearly empty and a nearly full region look alike; one point far
+                // from the boundary tells them apart.
+                let tol = 1e-9;
+                if omega < tol || omega > FOUR_PI - tol {
+                    let full_ish = self.contains(self.far_point());
+                    return match (full_ish, omega < tol) {
+                        (true, true) => FOUR_PI,
+                        (false, false) => 0.0,
+                        _ => omega,
+                    };
+                }
+                omega
+            }
+        }
+    }
+
+    /// Whether the direction `dir` lies in the region. `dir` need not be normalized; the zero
+    /// vector and non-finite vectors are in no region (not even the full sphere).
+    ///
+    /// Decided by the boundary feature (edge or vertex) nearest to `dir`: the geodesic from `dir`
+    /// to it crosses no other edge, so the side of that one feature is the answer. Directions on
+    /// the boundary, within rounding, may be reported either way.
+    #[must_use]
+    pub fn contains(&self, dir: DVec3) -> bool {
+        let Some(p) = normalize_any(dir) else {
+            return false;
+        };
+        if self.full {
+            return true;
+        }
+        nearest_feature(self.rings(), p).is_some_and(|(_, inside)| inside)
+    }
+
+    /// A direction well away from the boundary: the best of the six axis directions.
+    fn far_point(&self) -> DVec3 {
+        let mut best = (f64::NEG_INFINITY, DVec3::Z);
+        for c in AXES {
+            if let Some((d, _)) = nearest_feature(self.rings(), c)
+                && d > best.0
+            {
+                best = (d, c);
+            }
+        }
+        best.1
+    }
+
+    /// Rejects rings that cross or overlap themselves or each other.
+    ///
+    /// Rings may touch at a shared vertex (the same `DVec3` in both places), as the results of
+    /// clipping and set operations do where a hole touches an outer boundary; they may not cross
+    /// there, nor touch anywhere else.
+    fn check_simple(&self) -> Result<(), GeomError> {
+        // Every edge as (ring, index in ring, start, end).
+        let mut edges: Vec<(usize, usize, DVec3, DVec3)> = Vec::with_capacity(self.verts.len());
+        for (r, ring) in self.rings().enumerate() {
+            let n = ring.len();
+            for i in 0..n {
+                edges.push((r, i, ring[i], ring[(i + 1) % n]));
+            }
+        }
+        let err = |r: usize, s: usize| GeomError::SelfIntersecting {
+            ring: r,
+            other_ring: s,
+        };
+        for (k, &(r, i, a, b)) in edges.iter().enumerate() {
+            for &(s, j, c, d) in &edges[k + 1..] {
+                let n = self.ring_len(r);
+                let consecutive = r == s && (j == (i + 1) % n || i == (j + 1) % n);
+                // A shared endpoint is allowed; the two edges may not leave it along the same
+                // direction (that would be an overlap, or a fold for consecutive edges).
+                let shared = if b == c {
+                    Some((b, a, d))
+                } else if a == d {
+                    Some((a, b, c))
+                } else if a == c {
+                    Some((a, b, d))
+                } else if b == d {
+                    Some((b, a, c))
+                } else {
+                    None
+                };
+                match shared {
+                    Some((x, p, q)) => {
+                        let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
+                        if orient(x, p, q) == 0 && tp.dot(tq) > 0.0 {
+                            return Err(err(r, s));
+                        }
+                        // The far ends may still meet the other edge (two edges sharing both
+                        // ends are caught above, as they leave in the same direction).
+                    }
+                    None if consecutive => {}
+                    None => {
+                        if arcs_intersect(a, b, c, d) {
+                            return Err(err(r, s));
+                        }
+                    }
+                }
+            }
+        }
+        self.check_pinches()
+    }
+
+    /// At a vertex visited more than once (a pinch), each visit's two edges must be adjacent in
+    /// the angular order around the vertex; interleaved visits cross each other there.
+    fn check_pinches(&self) -> Result<(), GeomError> {
+        // (vertex, ring, prev, next) for every vertex occurrence, sorted so equal vertices meet.
+        let mut occ: Vec<(DVec3, usize, DVec3, DVec3)> = Vec::with_capacity(self.verts.len());
+        for (r, ring) in self.rings().enumerate() {
+            let n = ring.len();
+            for i in 0..n {
+                occ.push((ring[i], r, ring[(i + n - 1) % n], ring[(i + 1) % n]));
+            }
+        }
+        let key = |p: &DVec3| (p.x.to_bits(), p.y.to_bits(), p.z.to_bits());
+        occ.sort_by_key(|o| key(&o.0));
+        let mut start = 0;
+        while start < occ.len() {
+            let mut end = start + 1;
+            while end < occ.len() && occ[end].0 == occ[start].0 {
+                end += 1;
+            }
+            let group = &occ[start..end];
+            if group.len() > 1 {
+                let x = group[0].0;
+                let (u, v) = super::predicates::tangent_frame(x);
+                let ang = |p: DVec3| crate::math::atan2(p.dot(v), p.dot(u));
+                let two_pi = 2.0 * PI;
+                for (gi, &(_, ri, pi, ni)) in group.iter().enumerate() {
+                    let (lo, span) = (ang(ni), (ang(pi) - ang(ni)).rem_euclid(two_pi));
+                    let within = |t: f64| (t - lo).rem_euclid(two_pi) < span;
+                    for &(_, rj, pj, nj) in &group[gi + 1..] {
+                        if within(ang(pj)) != within(ang(nj)) {
+                            return Err(GeomError::SelfIntersecting {
+                                ring: ri,
+                                other_ring: rj,
+                            });
+                        }
+                    }
+                }
+            }
+            start = end;
+        }
+        Ok(())
+    }
+
+    fn ring_len(&self, r: usize) -> usize {
+        let s = if r == 0 { 0 } else { self.ends[r - 1] as usize };
+        self.ends[r] as usize - s
+    }
+
+    /// Rejects rings that disagree about which side of a shared face is inside.
+    ///
+    /// Disjoint simple rings cut the sphere into faces whose adjacency graph is a tree. Two rings
+    /// border a common face iff no third ring separates them; the face is then on the left of
+    /// both or of neither, which is the condition "`j` lies left of `i` iff `i` lies left of `j`".
+    fn check_consistent(&self) -> Result<(), GeomError> {
+        let k = self.ends.len();
+        if k < 2 {
+            return Ok(());
+        }
+        let rings: SmallVec<[&[DVec3]; 4]> = self.rings().collect();
+        // side[i * k + j]: ring j (any of its vertices; rings are disjoint) lies left of ring i.
+        let mut side: SmallVec<[bool; 16]> = SmallVec::from_elem(false, k * k);
+        for i in 0..k {
+            for j in 0..k {
+                if i != j {
+                    // A vertex of ring j that is not a pinch shared with ring i, so that it lies
+                    // strictly on one side of ring i (all shared would mean overlapping edges).
+                    // If every vertex is such a pinch, an edge midpoint is off ring i (edges
+                    // never overlap).
+                    let probe = rings[j]
+                        .iter()
+                        .find(|p| !rings[i].contains(p))
+                        .copied()
+                        .unwrap_or_else(|| (rings[j][0] + rings[j][1]).normalize());
+                    side[i * k + j] = nearest_feature(core::iter::once(rings[i]), probe)
+                        .is_some_and(|(_, inside)| inside);
+                }
+            }
+        }
+        for i in 0..k {
+            for j in i + 1..k {
+                let separated =
+                    (0..k).any(|l| l != i && l != j && side[l * k + i] != side[l * k + j]);
+                if !separated && side[i * k + j] != side[j * k + i] {
+                    return Err(GeomError::InconsistentOrientation {
+                        ring: i,
+                        other_ring: j,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
+pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
+    let n = ring.len();
+    let apex = fan_apex(ring);
+    let mut sum = 0.0;
+    for i in 0..n {
+        let (b, c) = (ring[i], ring[(i + 1) % n]);
+        // Triangles through the apex vertex itself are degenerate and contribute exactly zero.
+        if b != apex && c != apex {
+            sum += triangle_solid_angle(apex, b, c);
+        }
+    }
+    // A ring's left area is in (0, 4 pi); the fan gives it modulo 4 pi. A tiny clockwise ring
+    // gives -epsilon and maps to 4 pi - epsilon, as it should.
+    let area = sum.rem_euclid(4.0 * PI);
+    area.clamp(0.0, 4.0 * PI)
+}
+
+/// The fan apex for [`ring_left_area`]: the first vertex when no vertex lies near its antipode
+/// (the common case), else the vertex or axis direction whose antipode is farthest from every
+/// vertex. The Van Oosterom–Strackee denominator `1 + a.b + b.c + c.a` and numerator both vanish
+/// only when a vertex is antipodal to the apex.
+fn fan_apex(ring: &[DVec3]) -> DVec3 {
+    let clearance = |c: DVec3| {
+        ring.iter()
+            .map(|&v| (c + v).length_squared())
+            .fold(f64::INFINITY, f64::min)
+    };
+    if clearance(ring[0]) >= 0.5 {
+        return ring[0];
+    }
+    let mut best = (clearance(ring[0]), ring[0]);
+    for &c in ring.iter().chain(AXES.iter()) {
+        let d = clearance(c);
+        if d > best.0 {
+            best = (d, c);
+        }
+    }
+    best.1
+}
+
+/// The boundary feature nearest to the unit vector `p`, as (squared chord distance, whether `p`
+/// is on the inside of it), or `None` when there are no rings.
+pub(crate) fn nearest_feature<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    p: DVec3,
+) -> Option<(f64, bool)> {
+    let mut best: Option<(f64, bool)> = None;
+    let mut consider = |d: f64, inside: bool| {
+        if best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, inside));
+        }
+    };
+    for ring in rings {
+        let n = ring.len();
+        for i in 0..n {
+            let prev = ring[(i + n - 1) % n];
+            let a = ring[i];
+            let b = ring[(i + 1) % n];
+            let nrm = a.cross(b);
+            // p's nearest point on the great circle lies inside the arc iff turning from a to p
+            // and from p to b both go the arc's way round.
+            if a.cross(p).dot(nrm) > 0.0 && p.cross(b).dot(nrm) > 0.0 {
+                let s = p.dot(nrm) / nrm.length(); // sine of the distance to the circle
+                let s2 = (s * s).min(1.0);
+                // Squared chord to the nearest point, 2 - 2 cos(d), without cancellation.
+                let d = 2.0 * s2 / (1.0 + crate::math::sqrt(1.0 - s2));
+                consider(d, s > 0.0);
+            }
+            // The vertex a, with the wedge between its two edges: inside iff left of both edges'
+            // great circles at a convex vertex, left of either at a reflex one.
+            let left_in = prev.cross(a).dot(p) > 0.0;
+            let left_out = nrm.dot(p) > 0.0;
+            let convex = prev.cross(a).dot(b) > 0.0;
+            let inside = if convex {
+                left_in && left_out
+            } else {
+                left_in || left_out
+            };
+            consider((p - a).length_squared(), inside);
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use alloc::vec;
+
+    #[test]
+    fn hemisphere_ring_measures_two_pi() {
+        let up =
+            SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y]]).unwrap();
+        assert!((up.solid_angle() - 2.0 * PI).abs() < 1e-14);
+        assert!(up.contains(DVec3::Z));
+        assert!(!up.contains(-DVec3::Z));
+    }
+
+    #[test]
+    fn rejects_bad_rings() {
+        let e = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y]]);
+        assert_eq!(e, Err(GeomError::TooFewVertices { ring: 0, count: 2 }));
+        let e = SphericalPolygon::new(vec![vec![
+            DVec3::X,
+            DVec3::Y,
+            DVec3::new(f64::NAN, 0.0, 1.0),
+        ]]);
+        assert_eq!(e, Err(GeomError::NonFinite { ring: 0, vertex: 2 }));
+        let e = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::ZERO, DVec3::Z]]);
+        assert_eq!(e, Err(GeomError::ZeroVector { ring: 0, vertex: 1 }));
+        let e = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, -DVec3::Y]]);
+        assert_eq!(e, Err(GeomError::AntipodalVertices { ring: 0, vertex: 1 }));
+        let e = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::X * 2.0, DVec3::Z]]);
+        assert_eq!(e, Err(GeomError::CoincidentVertices { ring: 0, vertex: 0 }));
+        // A bow tie.
+        let bow = vec![
+            DVec3::new(1.0, -0.1, -0.1),
+            DVec3::new(1.0, 0.1, 0.1),
+            DVec3::new(1.0, 0.1, -0.1),
+            DVec3::new(1.0, -0.1, 0.1),
+        ];
+        assert!(matches!(
+            SphericalPolygon::new(vec![bow]),
+            Err(GeomError::SelfIntersecting { .. })
+        ));
+    }
+
+    #[test]
+    fn nested_rings_must_alternate() {
+        let square = |h: f64| {
+            vec![
+                DVec3::new(h, -h, 1.0),
+                DVec3::new(h, h, 1.0),
+                DVec3::new(-h, h, 1.0),
+                DVec3::new(-h, -h, 1.0),
+            ]
+        };
+        let mut hole = square(0.1);
+        hole.reverse();
+        let ok = SphericalPolygon::new(vec![square(0.5), hole.clone()]).unwrap();
+        assert!(!ok.contains(DVec3::Z));
+        assert!(ok.contains(DVec3::new(0.3, 0.0, 1.0)));
+        let (a, b) = (
+            SphericalPolygon::new(vec![square(0.5)])
+                .unwrap()
+                .solid_angle(),
+            SphericalPolygon::new(vec![square(0.1)])
+                .unwrap()
+                .solid_angle(),
+        );
+        assert!((ok.solid_angle() - (a - b)).abs() < 1e-14);
+        assert!(matches!(
+            SphericalPolygon::new(vec![square(0.5), square(0.1)]),
+            Err(GeomError::InconsistentOrientation { .. })
+        ));
+    }
+
+    #[test]
+    fn complement_adds_to_four_pi() {
+        let tri = SphericalPolygon::new(vec![vec![
+            DVec3::new(1.0, 0.0, 0.2),
+            DVec3::new(0.0, 1.0, 0.3),
+            DVec3::new(0.1, 0.2, 1.0),
+        ]])
+        .unwrap();
+        assert!((tri.solid_angle() + tri.complement().solid_angle() - 4.0 * PI).abs() < 1e-13);
+        assert_eq!(
+            SphericalPolygon::full().complement(),
+            SphericalPolygon::empty()
+        );
+    }
+
+    #[test]
+    fn tiny_polygon_keeps_relative_precision() {
+        // A square 2e-7 rad on a side around +z: planar area 4e-14 to within O(h^4).
+        let h = 1e-7;
+        let ring = vec![
+            DVec3::new(h, -h, 1.0),
+            DVec3::new(h, h, 1.0),
+            DVec3::new(-h, h, 1.0),
+            DVec3::new(-h, -h, 1.0),
+        ];
+        let w = SphericalPolygon::new(vec![ring.clone()])
+            .unwrap()
+            .solid_angle();
+        assert!((w / (4.0 * h * h) - 1.0).abs() < 1e-8, "{w}");
+        let mut rev = ring;
+        rev.reverse();
+        let big = SphericalPolygon::new(vec![rev]).unwrap().solid_angle();
+        assert!((big - (4.0 * PI - w)).abs() < 1e-14);
+    }
+}

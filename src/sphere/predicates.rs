@@ -1,0 +1,173 @@
+//! Exact orientation predicates on the unit sphere and the small geometric kernels built on them.
+
+use glam::DVec3;
+use robust::{Coord3D, orient3d};
+
+/// The six coordinate axis directions: candidate probe points and fan apexes that are far from
+/// any given small set of directions.
+pub(crate) const AXES: [DVec3; 6] = [
+    DVec3::X,
+    DVec3::Y,
+    DVec3::Z,
+    DVec3::NEG_X,
+    DVec3::NEG_Y,
+    DVec3::NEG_Z,
+];
+
+#[inline]
+fn c3(p: DVec3) -> Coord3D<f64> {
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// Sign of `det(a, b, c) = (a x b) . c`, evaluated exactly (Shewchuk's adaptive `orient3d` with the
+/// origin as the fourth point), as -1, 0 or +1.
+///
+/// Properties (as in S2's `Sign`): `sign(a, b, c) == sign(b, c, a) == -sign(b, a, c)`; it is `+1`
+/// when `c` lies to the left of the great circle through `a` then `b`.
+#[inline]
+pub(crate) fn orient(a: DVec3, b: DVec3, c: DVec3) -> i8 {
+    // robust's orient3d(pa, pb, pc, pd) = det(pa - pd, pb - pd, pc - pd); with pd = 0 that is
+    // det(a, b, c). Its fast path costs little more than the plain determinant.
+    let d = orient3d(c3(a), c3(b), c3(c), c3(DVec3::ZERO));
+    if d > 0.0 {
+        1
+    } else if d < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Whether the minor arcs `a-b` and `c-d` share any point (crossing, touching or overlapping).
+///
+/// Used by validation, where touching rings are as invalid as crossing ones. `a != b`,
+/// `c != d` and neither pair antipodal. Exact for the given floating-point inputs when the arcs
+/// are in general position.
+///
+/// Crossing: with `n = a x b`, `m = c x d`, the great circles meet at `+-x`, `x = n x m`; `x`
+/// lies inside arc `ab` iff `det(c,d,a) > 0 > det(c,d,b)` and inside arc `cd` iff
+/// `det(a,b,c) < 0 < det(a,b,d)`. The arcs cross (at `x` or at `-x`) iff the four signs follow
+/// this pattern or its reverse.
+pub(crate) fn arcs_intersect(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+    let abc = orient(a, b, c);
+    let abd = orient(a, b, d);
+    let cda = orient(c, d, a);
+    let cdb = orient(c, d, b);
+    if abc != 0 && abd != 0 && cda != 0 && cdb != 0 {
+        return abc != abd && cda != cdb && cda == abd;
+    }
+    // Touching or collinear: some endpoint lies on the other arc's great circle. Test each such
+    // endpoint for lying on the other arc itself.
+    (abc == 0 && on_arc(c, a, b))
+        || (abd == 0 && on_arc(d, a, b))
+        || (cda == 0 && on_arc(a, c, d))
+        || (cdb == 0 && on_arc(b, c, d))
+}
+
+/// Whether `p`, known to lie on the great circle through `a` and `b`, lies on the closed minor arc
+/// between them.
+fn on_arc(p: DVec3, a: DVec3, b: DVec3) -> bool {
+    // On the circle, turning from a to p and from p to b must both go the arc's way round (or not
+    // at all, at the endpoints); -a and the far side of the circle fail one of the two.
+    let n = a.cross(b);
+    a.cross(p).dot(n) >= 0.0 && p.cross(b).dot(n) >= 0.0
+}
+
+/// Signed solid angle of the spherical triangle `(a, b, c)` (unit vectors), positive when
+/// counter-clockwise seen from outside, in `(-2 pi, 2 pi)`.
+///
+/// Van Oosterom and Strackee (1983): `tan(Omega / 2) = det(a, b, c) / (1 + a.b + b.c + c.a)`.
+/// The determinant is evaluated on edge differences, `a . ((b - a) x (c - a))`, which keeps full
+/// relative precision for tiny triangles where `b x c` would cancel.
+#[inline]
+pub(crate) fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let det = a.dot((b - a).cross(c - a));
+    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    2.0 * crate::math::atan2(det, den)
+}
+
+/// A right-handed orthonormal frame `(u, v)` completing the unit vector `n` (`u x v = n`).
+///
+/// Branch-free construction of Duff et al. 2017, "Building an orthonormal basis, revisited",
+/// which is continuous except on the plane `n.z = 0` sign flip and never divides by zero.
+pub(crate) fn tangent_frame(n: DVec3) -> (DVec3, DVec3) {
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let u = DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let v = DVec3::new(b, sign + n.y * n.y * a, -n.y);
+    (u, v)
+}
+
+/// Normalizes a finite, non-zero vector of any magnitude, including ones whose squared length
+/// would overflow or underflow; `None` for zero or non-finite input.
+pub(crate) fn normalize_any(p: DVec3) -> Option<DVec3> {
+    if !p.is_finite() {
+        return None;
+    }
+    let m = p.abs().max_element();
+    if m == 0.0 {
+        return None;
+    }
+    // Scaling by the largest component first keeps the squared length in [1, 3].
+    (p / m).try_normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_and_right_handed() {
+        for n in [
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::X,
+            DVec3::new(0.3, -0.4, 0.5).normalize(),
+            DVec3::new(1e-300, 0.0, -1.0).normalize(),
+        ] {
+            let (u, v) = tangent_frame(n);
+            assert!((u.length() - 1.0).abs() < 1e-15);
+            assert!((v.length() - 1.0).abs() < 1e-15);
+            assert!(u.dot(v).abs() < 1e-15 && u.dot(n).abs() < 1e-15);
+            assert!((u.cross(v) - n).length() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn orient_properties() {
+        let a = DVec3::new(1.0, 0.1, 0.2).normalize();
+        let b = DVec3::new(0.1, 1.0, -0.3).normalize();
+        let c = DVec3::new(0.2, 0.2, 1.0).normalize();
+        assert_eq!(orient(a, b, c), 1);
+        assert_eq!(orient(b, c, a), orient(a, b, c));
+        assert_eq!(orient(b, a, c), -orient(a, b, c));
+        assert_eq!(orient(a, b, a), 0);
+    }
+
+    #[test]
+    fn octant_triangle_is_an_eighth_of_the_sphere() {
+        let w = triangle_solid_angle(DVec3::X, DVec3::Y, DVec3::Z);
+        assert!((w - core::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        assert!((triangle_solid_angle(DVec3::X, DVec3::Z, DVec3::Y) + w).abs() < 1e-15);
+    }
+
+    #[test]
+    fn crossing_arcs() {
+        let a = DVec3::new(1.0, -1.0, 0.0).normalize();
+        let b = DVec3::new(1.0, 1.0, 0.0).normalize();
+        let c = DVec3::new(1.0, 0.0, -1.0).normalize();
+        let d = DVec3::new(1.0, 0.0, 1.0).normalize();
+        assert!(arcs_intersect(a, b, c, d));
+        assert!(arcs_intersect(c, d, b, a));
+        // The antipodal arc meets the great circle of ab only at the other intersection point.
+        assert!(!arcs_intersect(a, b, -c, -d));
+        // Touching at an endpoint.
+        assert!(arcs_intersect(a, b, DVec3::X, DVec3::Z));
+        assert!(!arcs_intersect(a, b, DVec3::Z, d));
+    }
+}

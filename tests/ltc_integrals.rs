@@ -1,0 +1,247 @@
+//! The clamped-cosine integral against independent references: Gauss–Legendre quadrature for
+//! polygons above the horizon, stratified Monte Carlo (with a stated bound) for polygons crossing
+//! it, the signed-integral identity, and the exact-clip vs clip-free agreement.
+
+mod common;
+
+use arealight::glam::DVec3;
+use arealight::ltc::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
+use arealight::sphere::SphericalPolygon;
+use common::{
+    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_integral, star_ring,
+    triangle_quadrature,
+};
+use proptest::prelude::*;
+use std::f64::consts::PI;
+
+/// A random valid polygon (star-shaped rings, complements, rings with holes) around a center
+/// whose height above the horizon is drawn too, so that many polygons cross it.
+fn polygon(seed: u64) -> Option<SphericalPolygon> {
+    let mut rng = Rng::new(seed);
+    let c = rng.dir();
+    let n = 3 + (rng.next_u64() % 12) as usize;
+    let rho = rng.range(0.02, 1.5);
+    let ring = star_ring(&mut rng, c, n, rho, 0.5);
+    match rng.next_u64() % 3 {
+        0 => SphericalPolygon::new(vec![ring]).ok(),
+        1 => SphericalPolygon::new(vec![ring])
+            .ok()
+            .map(|p| p.complement()),
+        _ => {
+            let m = 3 + (rng.next_u64() % 5) as usize;
+            let mut hole = star_ring(&mut rng, c, m, 0.2 * rho, 0.8);
+            hole.reverse();
+            SphericalPolygon::new(vec![ring, hole]).ok()
+        }
+    }
+}
+
+#[test]
+fn lambert_matches_quadrature_above_the_horizon() {
+    let mut rng = Rng::new(11);
+    let mut checked = 0;
+    for _ in 0..200 {
+        let c = rng.dir();
+        let n = 3 + (rng.next_u64() % 9) as usize;
+        let rho = rng.range(1e-3, 0.8);
+        let ring = star_ring(&mut rng, c, n, rho, 0.5);
+        if ring.iter().any(|p| p.z <= 0.0) {
+            continue;
+        }
+        let poly = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+        // Fan from the star center: independent of the crate's own triangulation and clipping.
+        let quad: f64 = (0..n)
+            .map(|i| triangle_quadrature(c, ring[i], ring[(i + 1) % n], 24, |d| d.z.max(0.0) / PI))
+            .sum();
+        let exact = clamped_cosine_integral(&poly);
+        assert!((exact - quad).abs() <= 1e-9, "{exact} vs quadrature {quad}");
+        // The complement sees the rest of the hemisphere.
+        let rest = clamped_cosine_integral(&poly.complement());
+        assert!((exact + rest - 1.0).abs() <= 1e-12);
+        checked += 1;
+    }
+    assert!(
+        checked > 40,
+        "only {checked} polygons were above the horizon"
+    );
+}
+
+#[test]
+fn lambert_matches_monte_carlo_across_the_horizon() {
+    let mut done = 0;
+    for seed in 0..40u64 {
+        let Some(p) = polygon(seed) else { continue };
+        if p.rings().flatten().all(|v| v.z > 0.0) {
+            continue;
+        }
+        let mut rng = Rng::new(seed ^ 0x1A3B);
+        let mc = mc_integral(&mut rng, 96, 192, |d| {
+            if p.contains(d) {
+                d.z.max(0.0) / PI
+            } else {
+                0.0
+            }
+        });
+        let cells = crossed_cells(boundary_edges(&p).chain(great_circle(DVec3::Z)), 96, 192);
+        assert_mc_agrees(
+            clamped_cosine_integral(&p),
+            mc,
+            cells,
+            "clamped cosine vs Monte Carlo",
+        );
+        done += 1;
+    }
+    assert!(done > 10);
+}
+
+#[test]
+fn hemisphere_with_hole_at_the_zenith() {
+    // Everything above the horizon except a cap of radius r at the zenith: 1 - sin(r)^2 exactly
+    // for a disc; a 64-gon inscribed in it loses a little, measured by quadrature.
+    let n = 64;
+    let r = 0.4f64;
+    let cap: Vec<DVec3> = (0..n)
+        .map(|i| {
+            let t = 2.0 * PI * i as f64 / n as f64;
+            DVec3::new(r.sin() * t.cos(), r.sin() * t.sin(), r.cos())
+        })
+        .collect();
+    let inside_cap: f64 = (0..n)
+        .map(|i| triangle_quadrature(DVec3::Z, cap[i], cap[(i + 1) % n], 16, |d| d.z / PI))
+        .sum();
+    let mut hole = cap.clone();
+    hole.reverse();
+    let p = SphericalPolygon::new(vec![hole]).unwrap();
+    assert!((clamped_cosine_integral(&p) - (1.0 - inside_cap)).abs() < 1e-12);
+    assert!((clamped_cosine_integral_clip_free(&p) - (1.0 - inside_cap)).abs() < 1e-12);
+    assert!(inside_cap < r.sin().powi(2) && inside_cap > 0.99 * r.sin().powi(2));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(512), ..ProptestConfig::default() })]
+
+    /// The clip-free formula (thesis eq. 4.6/4.7) agrees with exact clipping to 1e-12.
+    #[test]
+    fn clip_free_agrees_with_exact_clip(seed in any::<u64>()) {
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let (a, b) = (clamped_cosine_integral(&p), clamped_cosine_integral_clip_free(&p));
+        prop_assert!((a - b).abs() <= 1e-12, "exact {} vs clip-free {}", a, b);
+        prop_assert!((0.0..=1.0).contains(&a));
+    }
+
+    /// (1/pi) * integral of z over P (Stokes, no clipping) = I(P) - I(P mirrored in the horizon).
+    #[test]
+    fn signed_integral_identity(seed in any::<u64>()) {
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let mirrored = SphericalPolygon::new(
+            p.rings()
+                .map(|r| r.iter().rev().map(|v| DVec3::new(v.x, v.y, -v.z)).collect())
+                .collect(),
+        )
+        .unwrap();
+        // Signed integral by the boundary sum on the unclipped rings.
+        let mut signed = 0.0;
+        for r in p.rings() {
+            for i in 0..r.len() {
+                let (a, b) = (r[i], r[(i + 1) % r.len()]);
+                let c = a.cross(b);
+                signed += c.length().atan2(a.dot(b)) / c.length() * c.z;
+            }
+        }
+        signed /= 2.0 * PI;
+        let diff = clamped_cosine_integral(&p) - clamped_cosine_integral(&mirrored);
+        prop_assert!((diff - signed).abs() <= 1e-12, "{} vs {}", diff, signed);
+    }
+}
+
+#[test]
+fn rational_edge_factor_error_is_as_documented() {
+    use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, edge_factor_rational};
+    let mut worst: f64 = 0.0;
+    let n = 400_000;
+    for i in 0..=n {
+        // Dense in cos(theta), including the ends; x -> -1 approached to 1e-9.
+        let x = -1.0 + 1e-9 + (2.0 - 1e-9) * i as f64 / n as f64;
+        let exact = if x >= 1.0 {
+            1.0
+        } else {
+            x.acos() / (1.0 - x * x).sqrt()
+        };
+        worst = worst.max((edge_factor_rational(x) / exact - 1.0).abs());
+    }
+    assert!(
+        worst <= EDGE_FACTOR_RATIONAL_MAX_ERROR,
+        "max relative error {worst}"
+    );
+    assert!(
+        worst > 0.5 * EDGE_FACTOR_RATIONAL_MAX_ERROR,
+        "documented bound is loose: {worst}"
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+
+    /// The rational variant stays within its documented error of the exact integral.
+    #[test]
+    fn rational_integral_within_bound(seed in any::<u64>()) {
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let clipped = p.clip_to_hemisphere(DVec3::Z);
+        let perimeter: f64 = boundary_edges(&clipped).map(|(a, b)| a.cross(b).length().atan2(a.dot(b))).sum();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-14;
+        let (a, b) = (clamped_cosine_integral(&p), clamped_cosine_integral_rational(&p));
+        prop_assert!((a - b).abs() <= bound, "{} vs {} (bound {})", a, b, bound);
+    }
+
+    /// Integrating an LTC over a polygon (transform + clamped cosine) equals quadrature of the
+    /// LTC density over the polygon (HDHN16 eq. 14).
+    #[test]
+    fn ltc_integral_matches_density_quadrature(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{Ltc, ltc_integral};
+        let mut rng = Rng::new(seed);
+        let m_inv = DMat3::from_cols(
+            DVec3::new(rng.range(0.3, 2.0), 0.0, rng.range(-0.8, 0.8)),
+            DVec3::new(0.0, rng.range(0.3, 2.0), 0.0),
+            DVec3::new(rng.range(-0.5, 0.5), 0.0, 1.0),
+        );
+        prop_assume!(m_inv.determinant() > 0.05);
+        let c = DVec3::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), 1.0).normalize();
+        let n = 3 + (rng.next_u64() % 6) as usize;
+        let rho = rng.range(0.05, 0.5);
+        let ring = star_ring(&mut rng, c, n, rho, 0.7);
+        let poly = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+        let ltc = Ltc::from_inverse(m_inv).unwrap();
+        let quad: f64 = (0..n)
+            .map(|i| triangle_quadrature(c, ring[i], ring[(i + 1) % n], 24, |d| ltc.density(d)))
+            .sum();
+        let exact = ltc_integral(&poly, m_inv).unwrap();
+        prop_assert!((exact - quad).abs() <= 1e-8, "{} vs quadrature {}", exact, quad);
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(512), ..ProptestConfig::default() })]
+
+    /// The stack-only clip-free LTC path agrees with transform + exact clip, for any matrix
+    /// (mirroring ones included), and the rational path stays within its bound.
+    #[test]
+    fn fast_ltc_paths_agree_with_exact(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let mut rng = Rng::new(seed ^ 0x17C);
+        let m = DMat3::from_cols(rng.dir() * rng.range(0.2, 3.0), rng.dir(), rng.dir() * rng.range(0.2, 3.0));
+        let Ok(t) = p.transformed(m) else { return Ok(()); };
+        let exact = clamped_cosine_integral(&t);
+        let fast = ltc_integral(&p, m).unwrap();
+        prop_assert!((exact - fast).abs() <= 1e-12, "{} vs {}", exact, fast);
+        let perimeter: f64 = boundary_edges(&t.clip_to_hemisphere(DVec3::Z))
+            .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
+            .sum();
+        let rational = ltc_integral_rational(&p, m).unwrap();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+        prop_assert!((exact - rational).abs() <= bound, "{} vs {} (bound {})", exact, rational, bound);
+    }
+}

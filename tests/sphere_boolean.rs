@@ -1,0 +1,377 @@
+//! Spherical set operations: solid-angle identities on random and degenerate operands, Monte
+//! Carlo checks for regions larger than a hemisphere, and the seed's per-triangle workflow.
+
+mod common;
+
+use arealight::glam::DVec3;
+use arealight::planar::BoolOp;
+use arealight::sphere::{SphericalPolygon, order_directed_edges};
+use common::{
+    Rng, assert_mc_agrees, boundary_edges, crossed_cells, icosphere, mc_solid_angle, star_ring,
+};
+use proptest::prelude::*;
+use std::f64::consts::PI;
+
+/// Identity tolerance: 1e-11 of the sphere, below the 1e-10 * 4 pi.
+const TOL: f64 = 1e-11 * 4.0 * PI;
+
+fn polygon_about(rng: &mut Rng, c: DVec3) -> Option<SphericalPolygon> {
+    let n = 3 + (rng.next_u64() % 9) as usize;
+    let rho = rng.range(0.05, 1.4);
+    let ring = star_ring(rng, c, n, rho, 0.6);
+    match rng.next_u64() % 4 {
+        0 | 1 => SphericalPolygon::new(vec![ring]).ok(),
+        2 => SphericalPolygon::new(vec![ring])
+            .ok()
+            .map(|p| p.complement()),
+        _ => {
+            let m = 3 + (rng.next_u64() % 5) as usize;
+            let mut hole = star_ring(rng, c, m, 0.25 * rho, 0.8);
+            hole.reverse();
+            SphericalPolygon::new(vec![ring, hole]).ok()
+        }
+    }
+}
+
+/// A pair of operands: independent random polygons with nearby centers, or degenerate pairs
+/// (identical, complementary, sharing vertices and edges).
+fn pair(seed: u64) -> Option<(SphericalPolygon, SphericalPolygon)> {
+    let mut rng = Rng::new(seed);
+    let c = rng.dir();
+    let a = polygon_about(&mut rng, c)?;
+    let b = match rng.next_u64() % 6 {
+        0 => a.clone(),
+        1 => a.complement(),
+        2 => {
+            // A polygon on a subset of a's vertices (a sub-polygon, sharing vertices and maybe
+            // edges), if valid.
+            let ring: Vec<DVec3> = a.rings().next()?.to_vec();
+            let keep: Vec<DVec3> = ring
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % 2 == 0 || *i == 1)
+                .map(|(_, p)| *p)
+                .collect();
+            SphericalPolygon::new(vec![keep]).ok()?
+        }
+        3 => {
+            let d = (c + rng.dir() * rng.range(0.0, 0.8)).normalize();
+            polygon_about(&mut rng, d)?
+        }
+        _ => {
+            // Far apart: the operands' vertices span more than a hemisphere, which sends the
+            // operation through the octant split.
+            let d = (-c + rng.dir() * rng.range(0.0, 0.5)).normalize();
+            polygon_about(&mut rng, d)?
+        }
+    };
+    Some((a, b))
+}
+
+fn check_identities(a: &SphericalPolygon, b: &SphericalPolygon) -> Result<(), TestCaseError> {
+    let op = |o| a.boolean(b, o);
+    let (i, u, d, x) = (
+        op(BoolOp::Intersection),
+        op(BoolOp::Union),
+        op(BoolOp::Difference),
+        op(BoolOp::Xor),
+    );
+    prop_assert!(
+        i.is_ok() && u.is_ok() && d.is_ok() && x.is_ok(),
+        "{:?} {:?} {:?} {:?}",
+        i,
+        u,
+        d,
+        x
+    );
+    let (i, u, d, x) = (i.unwrap(), u.unwrap(), d.unwrap(), x.unwrap());
+    let (wa, wb) = (a.solid_angle(), b.solid_angle());
+    let (wi, wu, wd, wx) = (
+        i.solid_angle(),
+        u.solid_angle(),
+        d.solid_angle(),
+        x.solid_angle(),
+    );
+    prop_assert!(
+        (wd + wi - wa).abs() <= TOL,
+        "A-B + AnB = A: {} + {} vs {}",
+        wd,
+        wi,
+        wa
+    );
+    prop_assert!(
+        (wu - (wa + wb - wi)).abs() <= TOL,
+        "AuB: {} vs {}",
+        wu,
+        wa + wb - wi
+    );
+    prop_assert!((wx - (wu - wi)).abs() <= TOL, "xor: {} vs {}", wx, wu - wi);
+    // Results are valid polygons: they pass full validation again.
+    for r in [&i, &u, &d, &x] {
+        if !r.is_full() {
+            let again = SphericalPolygon::new(r.rings().map(<[DVec3]>::to_vec).collect());
+            prop_assert!(again.is_ok(), "invalid result {:?}: {:?}", again, r);
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+
+    #[test]
+    fn identities_hold(seed in any::<u64>()) {
+        let Some((a, b)) = pair(seed) else { return Ok(()); };
+        check_identities(&a, &b)?;
+    }
+}
+
+#[test]
+fn empty_and_full_results() {
+    let mut rng = Rng::new(5);
+    let a = polygon_about(&mut rng, DVec3::new(0.2, 0.3, 0.9).normalize()).unwrap();
+    let c = a.complement();
+    assert!(a.boolean(&a, BoolOp::Difference).unwrap().is_empty());
+    assert!(a.boolean(&c, BoolOp::Intersection).unwrap().solid_angle() < 1e-12);
+    let u = a.boolean(&c, BoolOp::Union).unwrap();
+    assert!(
+        (u.solid_angle() - 4.0 * PI).abs() < 1e-12,
+        "{}",
+        u.solid_angle()
+    );
+    let x = a.boolean(&c, BoolOp::Xor).unwrap();
+    assert!((x.solid_angle() - 4.0 * PI).abs() < 1e-12);
+    let full = SphericalPolygon::full();
+    assert!(full.boolean(&a, BoolOp::Difference).unwrap() == c);
+    assert!(a.boolean(&full, BoolOp::Intersection).unwrap() == a);
+}
+
+#[test]
+fn larger_than_hemisphere_matches_monte_carlo() {
+    // A light filling the whole upper hemisphere minus occluders crossing the horizon, and
+    // operands whose union exceeds a hemisphere.
+    let up = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y]]).unwrap();
+    let mut rng = Rng::new(17);
+    for k in 0..6 {
+        let c = DVec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-0.3, 0.3),
+        )
+        .normalize();
+        let occ = SphericalPolygon::new(vec![star_ring(&mut rng, c, 7, 0.6, 0.6)]).unwrap();
+        let dir = rng.dir();
+        let big = polygon_about(&mut rng, dir).unwrap().complement();
+        for (a, b) in [(&up, &occ), (&big, &occ), (&up, &big)] {
+            for op in [
+                BoolOp::Difference,
+                BoolOp::Union,
+                BoolOp::Intersection,
+                BoolOp::Xor,
+            ] {
+                let r = a.boolean(b, op).unwrap();
+                let f = |d: DVec3| {
+                    let (x, y) = (a.contains(d), b.contains(d));
+                    match op {
+                        BoolOp::Difference => x && !y,
+                        BoolOp::Union => x || y,
+                        BoolOp::Intersection => x && y,
+                        BoolOp::Xor => x != y,
+                    }
+                };
+                let mut mrng = Rng::new(k as u64 * 31 + op as u64);
+                let mc = mc_solid_angle(&mut mrng, 64, 128, f);
+                let cells = crossed_cells(boundary_edges(a).chain(boundary_edges(b)), 64, 128);
+                assert_mc_agrees(r.solid_angle(), mc, cells, &format!("case {k} {op:?}"));
+            }
+        }
+    }
+}
+
+#[test]
+fn per_triangle_chain_equals_silhouette_difference() {
+    let x = DVec3::ZERO; // shading point
+    let light = SphericalPolygon::new(vec![vec![
+        DVec3::new(-1.0, -1.0, 3.0),
+        DVec3::new(1.0, -1.0, 3.0),
+        DVec3::new(1.0, 1.0, 3.0),
+        DVec3::new(-1.0, 1.0, 3.0),
+    ]])
+    .unwrap();
+    for (center, radius) in [
+        (DVec3::new(0.3, 0.2, 1.5), 0.4),
+        (DVec3::new(0.7, -0.4, 1.6), 0.35),
+    ] {
+        let (v, faces) = icosphere(center, radius);
+        assert_eq!(faces.len(), 80);
+        // Per triangle: subtract every face as a spherical triangle (its smaller side).
+        let mut chain = light.clone();
+        for f in &faces {
+            let tri = SphericalPolygon::new(vec![f.iter().map(|&i| v[i] - x).collect()]).unwrap();
+            let tri = if tri.solid_angle() > 2.0 * PI {
+                tri.complement()
+            } else {
+                tri
+            };
+            chain = chain.boolean(&tri, BoolOp::Difference).unwrap();
+        }
+        // Silhouette: edges between front- and back-facing faces, oriented by the front face.
+        let facing = |f: &[usize; 3]| {
+            (v[f[1]] - v[f[0]])
+                .cross(v[f[2]] - v[f[0]])
+                .dot(x - v[f[0]])
+                > 0.0
+        };
+        let mut owner = std::collections::HashMap::new();
+        for (k, f) in faces.iter().enumerate() {
+            for e in 0..3 {
+                owner.insert((f[e], f[(e + 1) % 3]), k);
+            }
+        }
+        let mut sil = Vec::new();
+        for f in faces.iter().filter(|f| facing(f)) {
+            for e in 0..3 {
+                let (a, b) = (f[e], f[(e + 1) % 3]);
+                if !facing(&faces[owner[&(b, a)]]) {
+                    sil.push((v[a] - x, v[b] - x));
+                }
+            }
+        }
+        let s = order_directed_edges(&sil).unwrap();
+        let s = if s.solid_angle() > 2.0 * PI {
+            s.complement()
+        } else {
+            s
+        };
+        let direct = light.boolean(&s, BoolOp::Difference).unwrap();
+        let (wc, wd) = (chain.solid_angle(), direct.solid_angle());
+        assert!(
+            (wc - wd).abs() <= 1e-10,
+            "per-triangle {wc} vs silhouette {wd}"
+        );
+        assert!(
+            wd < light.solid_angle() - 1e-3,
+            "the occluder must hide something: {wd} vs {} (silhouette {})",
+            light.solid_angle(),
+            s.solid_angle()
+        );
+        let (ic, id) = (
+            arealight::ltc::clamped_cosine_integral(&chain),
+            arealight::ltc::clamped_cosine_integral(&direct),
+        );
+        assert!((ic - id).abs() <= 1e-10, "{ic} vs {id}");
+    }
+}
+
+/// Minimized failures, kept as named regressions.
+#[test]
+fn regression_hole_pinched_at_all_its_vertices() {
+    // A difference produced this valid result: ring 2 is a hole touching ring 1 at all four of its
+    // vertices. Validation probed a shared vertex to decide nesting and rejected it as
+    // inconsistently oriented (proptest seed 9528998366313849765 of the first generator).
+    let v: Vec<DVec3> = [
+        [0.8805346722913457, -0.4722894962975242, -0.0400165288325119],
+        [0.9924724683883259, -0.0786389200278272, 0.09388460868555967],
+        [0.9361830267711194, 0.07291149209648706, 0.3438680774743845],
+        [0.4255883721496805, 0.28191631485901264, 0.8598823924859138],
+        [0.19846204268946735, 0.0478470059744847, 0.9789399785639575],
+        [
+            -0.14954229638130762,
+            -0.28350314118493286,
+            0.9472397112300989,
+        ],
+        [-0.6056135022243624, -0.5929388413426258, 0.5307125552978811],
+        [
+            -0.34189444626618454,
+            -0.9241232940894043,
+            0.17059989722648516,
+        ],
+        [
+            0.13750115425897727,
+            -0.9861716896054175,
+            -0.0925139513708341,
+        ],
+        [0.45650157389783674, -0.8869909583839704, -0.069666008740877],
+        [0.3384933543995443, -0.8108789802150641, 0.4773861418942971],
+        [0.4538319640554113, -0.6210286583727801, 0.6390304796183925],
+        [0.4325667033032154, -0.6173080161196025, 0.6571277352447303],
+        [0.4970250646577318, -0.5135046899765584, 0.6994848236195379],
+        [0.5340502584703976, -0.38786487927981667, 0.7512330908905405],
+        [0.5454022656463088, -0.4182637225147756, 0.7263551659181311],
+        [0.5853235416977843, -0.3228426490322618, 0.7437533028499397],
+        [0.803787863709287, -0.44528545964403266, 0.39451987222859014],
+        [0.7528420075593608, -0.6059536516879346, 0.257000162762689],
+        [0.6022318519117558, -0.6330605777798392, 0.48636519345445917],
+        [0.6070259857120942, -0.6945099893290099, 0.3862322195162894],
+        [0.4970250646577318, -0.5135046899765584, 0.6994848236195379],
+        [0.4538319640554113, -0.6210286583727801, 0.6390304796183925],
+        [0.6022318519117558, -0.6330605777798392, 0.48636519345445917],
+        [0.5454022656463088, -0.4182637225147756, 0.7263551659181311],
+    ]
+    .iter()
+    .map(|c: &[f64; 3]| DVec3::from_array(*c))
+    .collect();
+    let p = SphericalPolygon::new(vec![v[..10].to_vec(), v[10..21].to_vec(), v[21..].to_vec()]);
+    assert!(p.is_ok(), "{p:?}");
+    let p = p.unwrap();
+    let outer = SphericalPolygon::new(vec![v[..10].to_vec()])
+        .unwrap()
+        .solid_angle();
+    let inner = SphericalPolygon::new(vec![v[10..21].to_vec()])
+        .unwrap()
+        .solid_angle();
+    let hole = SphericalPolygon::new(vec![v[21..].to_vec()])
+        .unwrap()
+        .solid_angle();
+    // Each single ring measures its left side; the region is their sum modulo 4 pi, and with
+    // the pinched hole it must be smaller than the outer ring alone.
+    let w = p.solid_angle();
+    assert!((w - (outer + inner + hole).rem_euclid(4.0 * PI)).abs() < 1e-12);
+    assert!(w < outer && w > 0.0);
+}
+
+#[test]
+fn near_antipodal_operands() {
+    // Lunes from the north pole to within 1e-6 of the south pole (edges nearly pi long), against
+    // a band around the equator and against each other.
+    let lune = |phi0: f64, phi1: f64| {
+        let eq = |phi: f64| DVec3::new(phi.cos(), phi.sin(), 0.0);
+        let south = DVec3::new(1e-6, 0.0, -1.0).normalize();
+        SphericalPolygon::new(vec![vec![DVec3::Z, eq(phi0), south, eq(phi1)]]).unwrap()
+    };
+    let band = SphericalPolygon::new(vec![vec![
+        DVec3::new(1.0, -0.5, -0.2),
+        DVec3::new(1.0, 0.5, -0.2),
+        DVec3::new(1.0, 0.5, 0.2),
+        DVec3::new(1.0, -0.5, 0.2),
+    ]])
+    .unwrap();
+    let cases = [
+        (lune(-0.3, 0.3), band.clone()),
+        (lune(-0.3, 0.3), lune(0.0, 0.6)),
+        (lune(-0.3, 0.3).complement(), band.clone()),
+        (lune(0.2, 2.8), lune(2.7, 4.0)),
+    ];
+    for (k, (a, b)) in cases.iter().enumerate() {
+        check_identities(a, b).unwrap();
+        for op in [BoolOp::Difference, BoolOp::Intersection] {
+            let r = a.boolean(b, op).unwrap();
+            let mut rng = Rng::new(k as u64);
+            let mc = mc_solid_angle(&mut rng, 64, 128, |d| {
+                let (x, y) = (a.contains(d), b.contains(d));
+                if op == BoolOp::Difference {
+                    x && !y
+                } else {
+                    x && y
+                }
+            });
+            let cells = crossed_cells(boundary_edges(a).chain(boundary_edges(b)), 64, 128);
+            assert_mc_agrees(
+                r.solid_angle(),
+                mc,
+                cells,
+                &format!("near-antipodal case {k} {op:?}"),
+            );
+        }
+    }
+}
