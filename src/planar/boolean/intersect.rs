@@ -1,7 +1,7 @@
 //! Phase 1: find every contact between the boundaries of the two operands and split both at it.
 //!
 //! This is the intersection phase of Greiner and Hormann (1998, section 3.1), extended to the
-//! degenerate contacts of Foster, Hormann and Popa (2019, section 2: "vertex on edge",
+//! degenerate contacts of Foster, Hormann and Popa (2019, intersection phase: "vertex on edge",
 //! "vertex on vertex" and overlapping collinear edges) without perturbation. For every pair of
 //! edges the four exact orientations `orient2d(p0, p1, q0)`, `orient2d(p0, p1, q1)`,
 //! `orient2d(q0, q1, p0)`, `orient2d(q0, q1, p1)` decide which case applies:

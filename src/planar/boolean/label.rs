@@ -3,12 +3,12 @@
 //!
 //! Greiner and Hormann (1998, section 3.2) mark each intersection vertex as *entry* or *exit* by
 //! alternation, which fails as soon as a vertex only touches the other polygon. Foster, Hormann and
-//! Popa (2019, section 3.1, Table 1 and Figure 5) instead label each intersection from its local
+//! Popa (2019, labelling phase, Table 1) instead label each intersection from its local
 //! neighbourhood: where the predecessor and successor edges of one polygon lie relative to the
 //! other polygon's boundary chain (left/right/on). Two neighbours on different sides make a
 //! *crossing*, on the same side a *bouncing*; an edge "on" the other boundary starts or ends an
 //! overlapping chain, and the whole chain is a *delayed crossing* when the edges before and after
-//! it lie on different sides and a *delayed bouncing* otherwise (section 3.2).
+//! it lie on different sides and a *delayed bouncing* otherwise (same phase, overlapping chains).
 //!
 //! After phase 1 the split boundaries meet only in shared vertices, so every split edge is
 //! entirely inside, entirely outside, or identical to an edge of the other operand (in the same or
@@ -54,8 +54,8 @@ impl Status {
     }
 }
 
-/// Classification of a vertex after Foster, Hormann and Popa (2019, section 3.1,
-/// Table 1, and section 3.2 for the delayed cases).
+/// Classification of a vertex after Foster, Hormann and Popa (2019, labelling phase: Table 1
+/// for crossing/bouncing, overlapping chains for the delayed cases).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VertexClass {
     /// Not on the other boundary.
@@ -218,7 +218,7 @@ fn ccw_class(v: DVec2, x: DVec2, r: DVec2) -> u8 {
 /// Whether the direction from `v` towards `x` enters the interior of the other operand, given
 /// every edge of the other operand incident to `v` as a ray `(far end, is_incoming)`.
 ///
-/// This is the local neighbourhood test of FHP 2019 (section 3.1, Table 1), generalized to
+/// This is the local neighbourhood test of FHP 2019 (labelling phase, Table 1), generalized to
 /// several contours meeting at `v` (a hole touching its outer contour, two faces meeting at a
 /// corner): turning counter-clockwise from `v -> x`, the first boundary ray met is an incoming
 /// edge exactly when `v -> x` lies on its left, i.e. in the interior. Decided with exact

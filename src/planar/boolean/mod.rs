@@ -105,8 +105,8 @@ impl Rings {
 ///
 /// Contacts are decided with exact `orient2d`; the only tolerances are relative to the larger
 /// coordinate magnitude of the operands: computed crossings snap to a vertex within
-/// [`SNAP_REL`](intersect::SNAP_REL) of the scale, and result loops thinner than
-/// [`SLIVER_REL`](trace::SLIVER_REL) of the scale are dropped.
+/// [`SNAP_REL`](crate::planar::SNAP_REL) of the scale, and result loops thinner than
+/// [`SLIVER_REL`](crate::planar::SLIVER_REL) of the scale are dropped.
 ///
 /// # Examples
 ///
@@ -138,7 +138,11 @@ impl Rings {
 ///
 /// # References
 ///
-/// Greiner and Hormann 1998; Foster, Hormann and Popa 2019 (see the [module docs](self)).
+/// - G. Greiner, K. Hormann. *Efficient clipping of arbitrary polygons.* ACM TOG 17(2), 1998
+///   (intersection phase section 3.1, labelling 3.2, tracing 3.3).
+/// - E. L. Foster, K. Hormann, R. T. Popa. *Clipping simple polygons with degenerate
+///   intersections.* Computers & Graphics: X 2, 2019 (labelling phase: local classification of
+///   Table 1, overlapping chains as delayed crossings/bouncings; tracing phase).
 pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
     // Trivial cases first: they need no geometry and keep chains of operations cheap.
     if a.is_empty() || b.is_empty() {
@@ -201,6 +205,9 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
     ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
 }
 
+/// `(point, class)` for each vertex of one split operand, as returned by [`contact_classes`].
+pub type ContactClasses = Vec<(DVec2, label::VertexClass)>;
+
 /// The Foster–Hormann–Popa classification of every vertex of both operands after phase 1 (the
 /// split contours), for diagnostics and tests: `(point, class)` for A's vertices, then for B's.
 ///
@@ -211,13 +218,7 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
 pub fn contact_classes(
     a: &Shape,
     b: &Shape,
-) -> Result<
-    (
-        Vec<(DVec2, label::VertexClass)>,
-        Vec<(DVec2, label::VertexClass)>,
-    ),
-    GeomError,
-> {
+) -> Result<(ContactClasses, ContactClasses), GeomError> {
     let mut ra = Rings::from_shape(a);
     let mut rb = Rings::from_shape(b);
     let scale = ra.scale().max(rb.scale());

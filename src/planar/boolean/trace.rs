@@ -3,7 +3,7 @@
 //! Greiner and Hormann (1998, section 3.3) walk from an entry intersection along one polygon
 //! until the next intersection, then switch polygons. With the per-edge labels of phase 2 the same
 //! walk is "follow the selected edges": which edges of which operand bound the result, and in
-//! which direction, is a table per operation (FHP 2019, section 4, gives the same rules for
+//! which direction, is a table per operation (FHP 2019, tracing phase, gives the same rules for
 //! overlapping edges: a chain shared in the same direction belongs to union and intersection, one
 //! shared in opposite directions to the difference only):
 //!
