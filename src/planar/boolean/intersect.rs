@@ -40,6 +40,15 @@ pub const SNAP_REL: f64 = 64.0 * f64::EPSILON;
 /// stretches), and the operation returns [`GeomError::Degenerate`] instead of looping.
 pub const MAX_PASSES: usize = 8;
 
+/// The vertices of both operands sorted by x, built once more than a few computed crossings
+/// need a nearby vertex (the first few scan linearly, which is cheaper than sorting).
+#[derive(Default)]
+struct SnapIndex {
+    pts: SmallVec<[DVec2; 64]>,
+    built: bool,
+    crossings: usize,
+}
+
 /// One point to insert into an edge, with its parameter along the edge for ordering.
 #[derive(Clone, Copy)]
 struct Insert {
@@ -62,6 +71,7 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     let mut dirty_b: SmallVec<[bool; 64]> = SmallVec::new();
     let mut ins_a = Inserts::new();
     let mut ins_b = Inserts::new();
+    let mut by_x = SnapIndex::default();
     for pass in 0..MAX_PASSES {
         ins_a.clear();
         ins_b.clear();
@@ -72,6 +82,7 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
             &dirty_b,
             pass == 0,
             snap2,
+            &mut by_x,
             &mut ins_a,
             &mut ins_b,
         );
@@ -217,10 +228,10 @@ fn boxes_overlap(a: &[f64; 4], b: &[f64; 4]) -> bool {
 
 /// One pass over the edge pairs in which at least one edge is new.
 ///
-/// The first pass (everything new) sweeps the edges of both operands in order of their left
-/// ends, so only pairs whose x-ranges overlap are examined: `O((n + m) log(n + m) + k)` instead
-/// of all `n * m` pairs. Later passes see only the few edges next to inserted points, and test
-/// each of them against all edges of the other operand.
+/// Every pass sweeps the edges of both operands in order of their left ends, so only pairs whose
+/// x-ranges overlap are examined: `O((n + m) log(n + m) + k)` instead of all `n * m` pairs.
+/// Passes after the first test only pairs with an edge next to a newly inserted point (directly,
+/// without the sweep, when there are only a few such edges).
 #[allow(clippy::too_many_arguments)]
 fn find(
     a: &Rings,
@@ -229,6 +240,7 @@ fn find(
     dirty_b: &[bool],
     first_pass: bool,
     snap2: f64,
+    by_x: &mut SnapIndex,
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
@@ -238,7 +250,7 @@ fn find(
     edge_boxes(b, &mut bb);
     // Plain slices: indexing a SmallVec re-checks whether it spilled on every access.
     let (ba, bb): (&[EdgeBox], &[EdgeBox]) = (&ba, &bb);
-    let (all_a, all_b): (&[DVec2], &[DVec2]) = (&a.pts, &b.pts);
+
     let mut test = |i: usize, j: usize| {
         let (boxa, p0, p1) = &ba[i];
         let (boxb, q0, q1) = &bb[j];
@@ -246,14 +258,17 @@ fn find(
             pair(
                 [*p0, *p1, *q0, *q1],
                 (i as u32, j as u32),
-                (all_a, all_b),
+                (by_x, &a.pts, &b.pts),
                 snap2,
                 ins_a,
                 ins_b,
             );
         }
     };
-    if !first_pass {
+    // After the first pass only pairs with a new (dirty) edge can have new contacts. When there
+    // are few of them, testing each against all edges of the other operand beats a sweep.
+    let n_dirty = dirty_a.iter().chain(dirty_b.iter()).filter(|d| **d).count();
+    if !first_pass && n_dirty <= 16 {
         for (i, _) in dirty_a.iter().enumerate().filter(|x| *x.1) {
             for j in 0..bb.len() {
                 test(i, j);
@@ -268,6 +283,11 @@ fn find(
         }
         return;
     }
+    let dirty = |i: usize, j: usize| {
+        first_pass
+            || dirty_a.get(i).copied().unwrap_or(true)
+            || dirty_b.get(j).copied().unwrap_or(true)
+    };
     // Sweep: events are edges keyed by their left end; the high bit of the id marks B's edges.
     const B_BIT: u32 = 1 << 31;
     let mut events: SmallVec<[(f64, u32); 64]> = SmallVec::with_capacity(ba.len() + bb.len());
@@ -285,14 +305,18 @@ fn find(
             let i = id as usize;
             active_b.retain(|j| bb[*j as usize].0[1] >= x);
             for &j in &active_b {
-                test(i, j as usize);
+                if dirty(i, j as usize) {
+                    test(i, j as usize);
+                }
             }
             active_a.push(id);
         } else {
             let j = (id & !B_BIT) as usize;
             active_a.retain(|i| ba[*i as usize].0[1] >= x);
             for &i in &active_a {
-                test(i as usize, j);
+                if dirty(i as usize, j) {
+                    test(i as usize, j);
+                }
             }
             active_b.push(j as u32);
         }
@@ -303,7 +327,7 @@ fn find(
 fn pair(
     [p0, p1, q0, q1]: [DVec2; 4],
     (i, j): (u32, u32),
-    (all_a, all_b): (&[DVec2], &[DVec2]),
+    (by_x, all_a, all_b): (&mut SnapIndex, &[DVec2], &[DVec2]),
     snap2: f64,
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
@@ -406,9 +430,30 @@ fn pair(
     // vertex of the other operand lying on this edge) must become that vertex, or the boundary
     // would carry two distinct points a few ulps apart and the split edges between them could
     // double back.
-    let x = all_a
+    let snap = sqrt(snap2);
+    by_x.crossings += 1;
+    if by_x.crossings <= 8 {
+        // Few crossings: a linear scan is cheaper than sorting.
+        let x = all_a
+            .iter()
+            .chain(all_b.iter())
+            .copied()
+            .find(|&v| (x - v).length_squared() <= snap2)
+            .unwrap_or(x);
+        push(ins_a, i, p0, p1, x, true);
+        push(ins_b, j, q0, q1, x, true);
+        return;
+    }
+    if !by_x.built {
+        by_x.pts.extend(all_a.iter().chain(all_b.iter()).copied());
+        by_x.pts.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
+        by_x.built = true;
+    }
+    let by_x: &[DVec2] = &by_x.pts;
+    let lo = by_x.partition_point(|v| v.x < x.x - snap);
+    let x = by_x[lo..]
         .iter()
-        .chain(all_b.iter())
+        .take_while(|v| v.x <= x.x + snap)
         .copied()
         .find(|&v| (x - v).length_squared() <= snap2)
         .unwrap_or(x);
