@@ -382,3 +382,25 @@ fn fhp_vertex_classes() {
         VertexClass::Plain
     );
 }
+
+#[test]
+fn extreme_scales_keep_identities() {
+    // The predicates are exact while products of coordinate differences neither overflow nor
+    // underflow; these scales are far inside both limits, and every tolerance is relative.
+    for s in [1e-100, 1e-20, 1e20, 1e100] {
+        let scaled = |text: &str| {
+            Shape::new(
+                rings(text)
+                    .into_iter()
+                    .map(|r| r.into_iter().map(|p| p * s).collect())
+                    .collect(),
+            )
+            .unwrap()
+        };
+        let a = scaled("0:0, 4:0, 4:4, 0:4; 1:1, 1:2, 2:2, 2:1");
+        let b = scaled("2:1, 6:1, 6:3, 2:3");
+        let [i, u, _, _] = check_all(&a, &b, 1e-12).unwrap_or_else(|e| panic!("scale {s}: {e}"));
+        assert!((i.area() / (s * s) - 4.0).abs() < 1e-9, "scale {s}: {i:?}");
+        assert!((u.area() / (s * s) - 19.0).abs() < 1e-9, "scale {s}: {u:?}");
+    }
+}
