@@ -238,7 +238,9 @@ pub(crate) fn trace(
 /// Removes repeated and exactly collinear points (spikes included) in one stack pass, then drops
 /// the loop if it bounds no area or only a sliver.
 fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option<Contour> {
-    let mut out: Vec<DVec2> = Vec::new();
+    // Scratch on the stack; the output contour is allocated once, at its final size, and only
+    // if it survives.
+    let mut out: SmallVec<[DVec2; 32]> = SmallVec::new();
     for p in pts {
         while let [.., a, b] = out[..] {
             if b == p || orient(a, b, p) == 0.0 {
@@ -273,5 +275,5 @@ fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option<Contour> {
     if area2 == 0.0 || area2.abs() <= SLIVER_REL * scale * perimeter {
         return None;
     }
-    Some(Contour { pts: out })
+    Some(Contour { pts: out.to_vec() })
 }
