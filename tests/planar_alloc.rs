@@ -63,6 +63,10 @@ fn only_the_output_is_allocated_for_small_inputs() {
             ngon(12, DVec2::ZERO, 1.0, 0.0),
             ngon(3, DVec2::ZERO, 0.3, 0.0),
         ), // hole in the middle
+        (
+            ngon(16, DVec2::ZERO, 1.0, 0.0),
+            ngon(16, DVec2::new(0.37, 0.21), 1.0, 0.13),
+        ),
     ];
     for (a, b) in &cases {
         for op in [
