@@ -283,6 +283,15 @@ fn find(
         }
         return;
     }
+    if first_pass && ba.len() * bb.len() <= 256 {
+        // Tiny operands: all pairs directly; sorting for a sweep would cost more.
+        for i in 0..ba.len() {
+            for j in 0..bb.len() {
+                test(i, j);
+            }
+        }
+        return;
+    }
     let dirty = |i: usize, j: usize| {
         first_pass
             || dirty_a.get(i).copied().unwrap_or(true)
