@@ -1,1 +1,106 @@
-fn main() {}
+//! Planar boolean operations, side by side with i_overlay, clipper2 and geo on identical inputs.
+//!
+//! Groups `planar/{difference,intersection}/{convex,star}`, each with the sizes 4, 8, 16 and 64
+//! vertices per operand and one entry per implementation:
+//!
+//! - `arealight`: `boolean` on prebuilt `Shape`s (validation by `Shape::new` happens once per
+//!   polygon, when it is projected, not per operation);
+//! - `arealight+new`: the same including `Shape::new` for both operands, for a like-for-like view
+//!   with the references, which take raw point lists;
+//! - `i_overlay`: `overlay` with the default (i32 grid) float adapter, non-zero fill;
+//! - `clipper2`: `difference`/`intersect` on `Paths<Centi>` built per call (the crate's API
+//!   converts to its C++ core in every call);
+//! - `geo`: `BooleanOps` on `Polygon<f64>` (backed by i_overlay).
+//!
+//! Run: `cargo bench --bench planar`; results are summarized in BENCHMARKS.md.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use arealight::glam::DVec2;
+use arealight::planar::{BoolOp, Shape, boolean};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use geo::BooleanOps;
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::float::single::SingleFloatOverlay;
+
+/// `n` vertices on a circle (convex) or alternating between two radii (star-shaped, concave).
+fn polygon(n: usize, center: DVec2, phase: f64, star: bool) -> Vec<DVec2> {
+    (0..n)
+        .map(|k| {
+            let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
+            let r = if star && k % 2 == 1 { 0.55 } else { 1.0 };
+            center + DVec2::new(t.cos(), t.sin()) * r
+        })
+        .collect()
+}
+
+fn bench(c: &mut Criterion) {
+    for (op, op_name) in [
+        (BoolOp::Difference, "difference"),
+        (BoolOp::Intersection, "intersection"),
+    ] {
+        for star in [false, true] {
+            let mut g = c.benchmark_group(format!(
+                "planar/{op_name}/{}",
+                if star { "star" } else { "convex" }
+            ));
+            g.sample_size(30)
+                .warm_up_time(Duration::from_millis(300))
+                .measurement_time(Duration::from_millis(1200));
+            for n in [4usize, 8, 16, 64] {
+                let pa = polygon(n, DVec2::ZERO, 0.0, star);
+                let pb = polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+                let sa = Shape::new(vec![pa.clone()]).unwrap();
+                let sb = Shape::new(vec![pb.clone()]).unwrap();
+                g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {
+                    bch.iter(|| boolean(black_box(&sa), black_box(&sb), op).unwrap())
+                });
+                g.bench_with_input(BenchmarkId::new("arealight+new", n), &n, |bch, _| {
+                    bch.iter(|| {
+                        let a = Shape::new(vec![black_box(&pa).clone()]).unwrap();
+                        let b = Shape::new(vec![black_box(&pb).clone()]).unwrap();
+                        boolean(&a, &b, op).unwrap()
+                    })
+                });
+                let ia: Vec<[f64; 2]> = pa.iter().map(|p| [p.x, p.y]).collect();
+                let ib: Vec<[f64; 2]> = pb.iter().map(|p| [p.x, p.y]).collect();
+                let rule = match op {
+                    BoolOp::Difference => OverlayRule::Difference,
+                    _ => OverlayRule::Intersect,
+                };
+                g.bench_with_input(BenchmarkId::new("i_overlay", n), &n, |bch, _| {
+                    bch.iter(|| black_box(&ia).overlay(black_box(&ib), rule, FillRule::NonZero))
+                });
+                let ca: Vec<(f64, f64)> = pa.iter().map(|p| (p.x, p.y)).collect();
+                let cb: Vec<(f64, f64)> = pb.iter().map(|p| (p.x, p.y)).collect();
+                g.bench_with_input(BenchmarkId::new("clipper2", n), &n, |bch, _| {
+                    bch.iter(|| {
+                        let a: clipper2::Paths = vec![black_box(&ca).clone()].into();
+                        let b: clipper2::Paths = vec![black_box(&cb).clone()].into();
+                        match op {
+                            BoolOp::Difference => {
+                                clipper2::difference(a, b, clipper2::FillRule::NonZero)
+                            }
+                            _ => clipper2::intersect(a, b, clipper2::FillRule::NonZero),
+                        }
+                        .unwrap()
+                    })
+                });
+                let ga = geo::Polygon::new(geo::LineString::from(ca.clone()), vec![]);
+                let gb = geo::Polygon::new(geo::LineString::from(cb.clone()), vec![]);
+                g.bench_with_input(BenchmarkId::new("geo", n), &n, |bch, _| {
+                    bch.iter(|| match op {
+                        BoolOp::Difference => black_box(&ga).difference(black_box(&gb)),
+                        _ => black_box(&ga).intersection(black_box(&gb)),
+                    })
+                });
+            }
+            g.finish();
+        }
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

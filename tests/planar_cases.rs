@@ -5,7 +5,7 @@ mod planar_support;
 
 use arealight::GeomError;
 use arealight::glam::DVec2;
-use arealight::planar::{BoolOp, Shape, boolean};
+use arealight::planar::{BoolOp, Shape, VertexClass, boolean, contact_classes};
 use planar_support::*;
 
 /// Checks validity, identities, and the exact expected areas [A&B, A|B, A-B, A^B].
@@ -329,4 +329,78 @@ fn chain_of_differences_on_projected_fan() {
     }
     let direct = boolean(&light, &occ, BoolOp::Difference).unwrap();
     assert!((visible.area() - direct.area()).abs() <= 1e-9 * light.area());
+}
+
+/// The Foster–Hormann–Popa class of A's vertex at `p` (after splitting).
+fn class_at(a: &str, b: &str, p: (f64, f64)) -> VertexClass {
+    let (ca, _) = contact_classes(&shape(a), &shape(b)).unwrap();
+    ca.iter()
+        .find(|(q, _)| *q == DVec2::new(p.0, p.1))
+        .map(|x| x.1)
+        .unwrap_or_else(|| panic!("no vertex at {p:?} in {ca:?}"))
+}
+
+#[test]
+fn fhp_vertex_classes() {
+    // Proper crossings of two overlapping squares.
+    assert_eq!(
+        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (4.0, 2.0)),
+        VertexClass::Crossing
+    );
+    assert_eq!(
+        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (2.0, 4.0)),
+        VertexClass::Crossing
+    );
+    // Corner to corner: touching without crossing.
+    assert_eq!(
+        class_at(SQ, "4:4, 6:4, 6:6, 4:6", (4.0, 4.0)),
+        VertexClass::Bouncing
+    );
+    // Vertex of B on A's edge from outside.
+    assert_eq!(
+        class_at(SQ, "4:2, 6:0, 6:4", (4.0, 2.0)),
+        VertexClass::Bouncing
+    );
+    // A shared stretch with A outside B on both sides: delayed bouncing, classified at the
+    // chain's start; the chain's end is on the chain.
+    assert_eq!(
+        class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 1.0)),
+        VertexClass::DelayedBouncing
+    );
+    assert_eq!(
+        class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 3.0)),
+        VertexClass::OnChain
+    );
+    // A shared stretch that A enters from outside and leaves into B: delayed crossing.
+    assert_eq!(
+        class_at(SQ, "2:2, 4:2, 4:4, 6:4, 6:6, 2:6", (4.0, 2.0)),
+        VertexClass::DelayedCrossing
+    );
+    // Vertices off the other boundary are plain.
+    assert_eq!(
+        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (0.0, 0.0)),
+        VertexClass::Plain
+    );
+}
+
+#[test]
+fn extreme_scales_keep_identities() {
+    // The predicates are exact while products of coordinate differences neither overflow nor
+    // underflow; these scales are far inside both limits, and every tolerance is relative.
+    for s in [1e-100, 1e-20, 1e20, 1e100] {
+        let scaled = |text: &str| {
+            Shape::new(
+                rings(text)
+                    .into_iter()
+                    .map(|r| r.into_iter().map(|p| p * s).collect())
+                    .collect(),
+            )
+            .unwrap()
+        };
+        let a = scaled("0:0, 4:0, 4:4, 0:4; 1:1, 1:2, 2:2, 2:1");
+        let b = scaled("2:1, 6:1, 6:3, 2:3");
+        let [i, u, _, _] = check_all(&a, &b, 1e-12).unwrap_or_else(|e| panic!("scale {s}: {e}"));
+        assert!((i.area() / (s * s) - 4.0).abs() < 1e-9, "scale {s}: {i:?}");
+        assert!((u.area() / (s * s) - 19.0).abs() < 1e-9, "scale {s}: {u:?}");
+    }
 }

@@ -46,10 +46,16 @@ fn check(a: &Shape, b: &Shape) -> Result<(), TestCaseError> {
             b,
             r
         );
+        // clipper2 is the second reference. Where it disagrees with i_overlay too, i_overlay
+        // decides: clipper2's union fills a hole that touches the boundary at a single point
+        // (found by this property; see `vertex_at_edge_midpoint_union` in
+        // tests/planar_regressions.rs, whose areas are checked by hand there).
         let ca = clipper_area(a, b, *op);
+        let ia = ioverlay_area(&ioverlay(&to_paths(a), &to_paths(b), *op));
+        let refs_agree = (ca - ia).abs() <= REF_TOL * norm;
         prop_assert!(
-            (ca - r.area()).abs() <= REF_TOL * norm,
-            "{}: area {} vs clipper2 {ca}\nA = {:?}\nB = {:?}",
+            (ca - r.area()).abs() <= REF_TOL * norm || !refs_agree,
+            "{}: area {} vs clipper2 {ca} (i_overlay {ia})\nA = {:?}\nB = {:?}",
             op_name(*op),
             r.area(),
             a,

@@ -59,3 +59,20 @@ fn chain_grid_triangles_3() {
         &["1:-1, -3:4, -3:-1", "2:3, -3:3, 0:1", "-3:2, -1:1, -1:4"],
     );
 }
+
+/// proptest `vertex_on_edge_and_vertex_on_vertex` (seed in `proptest-regressions/`): B's vertex
+/// exactly at the midpoint of A's edge. Our union disagreed with clipper2 (11.5) but agrees with
+/// i_overlay; by hand, A = 5/2, B = 39/4, A & B = the triangle (2,-1), (4/3,-2), (3,-2) of area
+/// 5/6, so A | B = 5/2 + 39/4 - 5/6 = 137/12, with a hole (1,-2.5), (1,-2), (4/3,-2) of area
+/// 1/12 pinched at (1,-2.5): clipper2's union fills that hole.
+#[test]
+fn vertex_at_edge_midpoint_union() {
+    let a = shape("2:-1, 0:-4, 3:-2");
+    let b = shape("2:2, 1:2, 0:2, 0:1, 1:-2.5, 1:-2, 4:-2, 2:1");
+    let [i, u, _, _] = check_all(&a, &b, 1e-9).unwrap();
+    assert!((i.area() - 5.0 / 6.0).abs() < 1e-12, "{i:?}");
+    assert!((u.area() - 137.0 / 12.0).abs() < 1e-12, "{u:?}");
+    assert_eq!(u.contour_list().iter().filter(|c| c.is_hole()).count(), 1);
+    let sd = sym_diff_vs_ioverlay(&a, &b, BoolOp::Union, &u);
+    assert!(sd <= 1e-9 * (a.area() + b.area()), "{sd}: {u:?}");
+}

@@ -124,3 +124,51 @@ pub(crate) fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
     }
     on_segment(a, b, c) || on_segment(a, b, d) || on_segment(c, d, a) || on_segment(c, d, b)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn pt() -> impl Strategy<Value = DVec2> {
+        (-1e3f64..1e3, -1e3f64..1e3).prop_map(|(x, y)| DVec2::new(x, y))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+        /// S2-style algebraic properties of the orientation predicate.
+        #[test]
+        fn orient_is_cyclic_and_antisymmetric(a in pt(), b in pt(), c in pt()) {
+            let s = orient_sign(a, b, c);
+            prop_assert_eq!(s, orient_sign(b, c, a));
+            prop_assert_eq!(s, orient_sign(c, a, b));
+            prop_assert_eq!(s, -orient_sign(b, a, c));
+        }
+
+        /// Points on a segment built by exact binary fractions are exactly collinear.
+        #[test]
+        fn exact_midpoints_are_on_segment(a in pt(), b in pt()) {
+            let m = (a + b) * 0.5;
+            if orient(a, b, m) == 0.0 {
+                prop_assert!(on_segment(a, b, m));
+            }
+        }
+    }
+
+    #[test]
+    fn winding_counts_orientation() {
+        let sq = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+        ];
+        assert_eq!(winding(&sq, DVec2::splat(0.5)), 1);
+        let mut cw = sq;
+        cw.reverse();
+        assert_eq!(winding(&cw, DVec2::splat(0.5)), -1);
+        assert_eq!(winding(&sq, DVec2::splat(2.0)), 0);
+        assert!((signed_area2(&sq) - 2.0).abs() < 1e-15);
+    }
+}

@@ -1,7 +1,7 @@
 //! Phase 1: find every contact between the boundaries of the two operands and split both at it.
 //!
 //! This is the intersection phase of Greiner and Hormann (1998, section 3.1), extended to the
-//! degenerate contacts of Foster, Hormann and Popa (2019, section 2: "vertex on edge",
+//! degenerate contacts of Foster, Hormann and Popa (2019, intersection phase: "vertex on edge",
 //! "vertex on vertex" and overlapping collinear edges) without perturbation. For every pair of
 //! edges the four exact orientations `orient2d(p0, p1, q0)`, `orient2d(p0, p1, q1)`,
 //! `orient2d(q0, q1, p0)`, `orient2d(q0, q1, p1)` decide which case applies:
@@ -40,6 +40,15 @@ pub const SNAP_REL: f64 = 64.0 * f64::EPSILON;
 /// stretches), and the operation returns [`GeomError::Degenerate`] instead of looping.
 pub const MAX_PASSES: usize = 8;
 
+/// The vertices of both operands sorted by x, built once more than a few computed crossings
+/// need a nearby vertex (the first few scan linearly, which is cheaper than sorting).
+#[derive(Default)]
+struct SnapIndex {
+    pts: SmallVec<[DVec2; 64]>,
+    built: bool,
+    crossings: usize,
+}
+
 /// One point to insert into an edge, with its parameter along the edge for ordering.
 #[derive(Clone, Copy)]
 struct Insert {
@@ -58,14 +67,25 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
         let s = SNAP_REL * scale;
         s * s
     };
-    let mut dirty_a: SmallVec<[bool; 64]> = SmallVec::from_elem(true, a.pts.len());
-    let mut dirty_b: SmallVec<[bool; 64]> = SmallVec::from_elem(true, b.pts.len());
+    let mut dirty_a: SmallVec<[bool; 64]> = SmallVec::new();
+    let mut dirty_b: SmallVec<[bool; 64]> = SmallVec::new();
     let mut ins_a = Inserts::new();
     let mut ins_b = Inserts::new();
-    for _ in 0..MAX_PASSES {
+    let mut by_x = SnapIndex::default();
+    for pass in 0..MAX_PASSES {
         ins_a.clear();
         ins_b.clear();
-        find(a, b, &dirty_a, &dirty_b, snap2, &mut ins_a, &mut ins_b);
+        find(
+            a,
+            b,
+            &dirty_a,
+            &dirty_b,
+            pass == 0,
+            snap2,
+            &mut by_x,
+            &mut ins_a,
+            &mut ins_b,
+        );
         if ins_a.is_empty() && ins_b.is_empty() {
             return Ok(());
         }
@@ -86,10 +106,14 @@ pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
     let snap = SNAP_REL * scale;
     let snap2 = snap * snap;
     let mut changed = false;
+    // A's points sorted by x; each of B's points looks only at the x-window around it.
+    let mut by_x: SmallVec<[DVec2; 32]> = a.pts.iter().copied().collect();
+    by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
     for q in b.pts.iter_mut() {
-        if let Some(&p) = a
-            .pts
+        let lo = by_x.partition_point(|p| p.x < q.x - snap);
+        if let Some(&p) = by_x[lo..]
             .iter()
+            .take_while(|p| p.x <= q.x + snap)
             .find(|&&p| p != *q && (p - *q).length_squared() <= snap2)
         {
             *q = p;
@@ -169,43 +193,141 @@ pub(crate) fn split_self_contacts(r: &mut Rings) {
     }
 }
 
-/// One pass over all edge pairs in which at least one edge is new.
+/// One edge for the pair search: bounding box `[min x, max x, min y, max y]` and its ends.
+type EdgeBox = ([f64; 4], DVec2, DVec2);
+
+/// Fills `out` with the edges of `r` (kept in the caller's frame: these buffers are large and
+/// moving them would cost more than filling them).
+fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
+    out.clear();
+    let mut start = 0usize;
+    for &end in &r.ends {
+        let end = end as usize;
+        for i in start..end {
+            let p0 = r.pts[i];
+            let p1 = r.pts[if i + 1 == end { start } else { i + 1 }];
+            out.push((
+                [
+                    p0.x.min(p1.x),
+                    p0.x.max(p1.x),
+                    p0.y.min(p1.y),
+                    p0.y.max(p1.y),
+                ],
+                p0,
+                p1,
+            ));
+        }
+        start = end;
+    }
+}
+
+#[inline]
+fn boxes_overlap(a: &[f64; 4], b: &[f64; 4]) -> bool {
+    a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3]
+}
+
+/// One pass over the edge pairs in which at least one edge is new.
+///
+/// Every pass sweeps the edges of both operands in order of their left ends, so only pairs whose
+/// x-ranges overlap are examined: `O((n + m) log(n + m) + k)` instead of all `n * m` pairs.
+/// Passes after the first test only pairs with an edge next to a newly inserted point (directly,
+/// without the sweep, when there are only a few such edges).
+#[allow(clippy::too_many_arguments)]
 fn find(
     a: &Rings,
     b: &Rings,
     dirty_a: &[bool],
     dirty_b: &[bool],
+    first_pass: bool,
     snap2: f64,
+    by_x: &mut SnapIndex,
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
-    let na = a.next_table();
-    let nb = b.next_table();
-    for (i, &ni) in na.iter().enumerate() {
-        let (p0, p1) = (a.pts[i], a.pts[ni as usize]);
-        let (pminx, pmaxx) = (p0.x.min(p1.x), p0.x.max(p1.x));
-        let (pminy, pmaxy) = (p0.y.min(p1.y), p0.y.max(p1.y));
-        let da = dirty_a.get(i).copied().unwrap_or(true);
-        for (j, &nj) in nb.iter().enumerate() {
-            if !da && !dirty_b.get(j).copied().unwrap_or(true) {
-                continue;
-            }
-            let (q0, q1) = (b.pts[j], b.pts[nj as usize]);
-            if q0.x.max(q1.x) < pminx
-                || q0.x.min(q1.x) > pmaxx
-                || q0.y.max(q1.y) < pminy
-                || q0.y.min(q1.y) > pmaxy
-            {
-                continue;
-            }
+    let mut ba: SmallVec<[EdgeBox; 32]> = SmallVec::new();
+    let mut bb: SmallVec<[EdgeBox; 32]> = SmallVec::new();
+    edge_boxes(a, &mut ba);
+    edge_boxes(b, &mut bb);
+    // Plain slices: indexing a SmallVec re-checks whether it spilled on every access.
+    let (ba, bb): (&[EdgeBox], &[EdgeBox]) = (&ba, &bb);
+
+    let mut test = |i: usize, j: usize| {
+        let (boxa, p0, p1) = &ba[i];
+        let (boxb, q0, q1) = &bb[j];
+        if boxes_overlap(boxa, boxb) {
             pair(
-                [p0, p1, q0, q1],
+                [*p0, *p1, *q0, *q1],
                 (i as u32, j as u32),
-                (&a.pts, &b.pts),
+                (by_x, &a.pts, &b.pts),
                 snap2,
                 ins_a,
                 ins_b,
             );
+        }
+    };
+    // After the first pass only pairs with a new (dirty) edge can have new contacts. When there
+    // are few of them, testing each against all edges of the other operand beats a sweep.
+    let n_dirty = dirty_a.iter().chain(dirty_b.iter()).filter(|d| **d).count();
+    if !first_pass && n_dirty <= 16 {
+        for (i, _) in dirty_a.iter().enumerate().filter(|x| *x.1) {
+            for j in 0..bb.len() {
+                test(i, j);
+            }
+        }
+        for (j, _) in dirty_b.iter().enumerate().filter(|x| *x.1) {
+            for i in 0..ba.len() {
+                if !dirty_a.get(i).copied().unwrap_or(false) {
+                    test(i, j);
+                }
+            }
+        }
+        return;
+    }
+    if first_pass && ba.len() * bb.len() <= 256 {
+        // Tiny operands: all pairs directly; sorting for a sweep would cost more.
+        for i in 0..ba.len() {
+            for j in 0..bb.len() {
+                test(i, j);
+            }
+        }
+        return;
+    }
+    let dirty = |i: usize, j: usize| {
+        first_pass
+            || dirty_a.get(i).copied().unwrap_or(true)
+            || dirty_b.get(j).copied().unwrap_or(true)
+    };
+    // Sweep: events are edges keyed by their left end; the high bit of the id marks B's edges.
+    const B_BIT: u32 = 1 << 31;
+    let mut events: SmallVec<[(f64, u32); 64]> = SmallVec::with_capacity(ba.len() + bb.len());
+    events.extend(ba.iter().enumerate().map(|(i, e)| (e.0[0], i as u32)));
+    events.extend(
+        bb.iter()
+            .enumerate()
+            .map(|(j, e)| (e.0[0], j as u32 | B_BIT)),
+    );
+    events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    let mut active_a: SmallVec<[u32; 32]> = SmallVec::new();
+    let mut active_b: SmallVec<[u32; 32]> = SmallVec::new();
+    for &(x, id) in &events {
+        if id & B_BIT == 0 {
+            let i = id as usize;
+            active_b.retain(|j| bb[*j as usize].0[1] >= x);
+            for &j in &active_b {
+                if dirty(i, j as usize) {
+                    test(i, j as usize);
+                }
+            }
+            active_a.push(id);
+        } else {
+            let j = (id & !B_BIT) as usize;
+            active_a.retain(|i| ba[*i as usize].0[1] >= x);
+            for &i in &active_a {
+                if dirty(i as usize, j) {
+                    test(i as usize, j);
+                }
+            }
+            active_b.push(j as u32);
         }
     }
 }
@@ -214,28 +336,53 @@ fn find(
 fn pair(
     [p0, p1, q0, q1]: [DVec2; 4],
     (i, j): (u32, u32),
-    (all_a, all_b): (&[DVec2], &[DVec2]),
+    (by_x, all_a, all_b): (&mut SnapIndex, &[DVec2], &[DVec2]),
     snap2: f64,
     ins_a: &mut Inserts,
     ins_b: &mut Inserts,
 ) {
+    // Edges with a common endpoint (the normal case after splitting, and between adjacent mesh
+    // triangles) can meet anywhere else only if they are (nearly) collinear: one orientation
+    // test, instead of four, settles the common case.
+    let common = if p0 == q0 {
+        Some((p0, p1, q1))
+    } else if p0 == q1 {
+        Some((p0, p1, q0))
+    } else if p1 == q0 {
+        Some((p1, p0, q1))
+    } else if p1 == q1 {
+        Some((p1, p0, q0))
+    } else {
+        None
+    };
+    if let Some((v, pa, qa)) = common {
+        let o = orient(v, pa, qa);
+        let d = (pa - v).abs() + (qa - v).abs();
+        if o.abs() > sqrt(snap2) * (d.x + d.y) {
+            return;
+        }
+    }
     // A vertex within the snapping distance of the other edge's line counts as on it: it is
     // inserted into that edge (bending it by at most the tolerance), exactly as FHP's
     // vertex-on-edge case. Without this, a vertex a few ulps off an edge survives as a
     // near-touch that the next operation in a chain sees as either a crossing or a gap.
+    //
+    // `|orient| / |edge|` is the distance from the line; `|dx| + |dy|` bounds `|edge|` from above,
+    // so the square root is only taken for the rare candidates that pass the cheap test.
     let snap = sqrt(snap2);
-    let near = |o: f64, len: f64| o == 0.0 || o.abs() <= snap * len;
-    let lp = sqrt((p1 - p0).length_squared());
+    let near = |o: f64, e0: DVec2, e1: DVec2| {
+        let d = (e1 - e0).abs();
+        o == 0.0 || (o.abs() <= snap * (d.x + d.y) && o.abs() <= snap * sqrt(d.length_squared()))
+    };
     let oq0 = orient(p0, p1, q0);
     let oq1 = orient(p0, p1, q1);
-    let (zq0, zq1) = (near(oq0, lp), near(oq1, lp));
+    let (zq0, zq1) = (near(oq0, p0, p1), near(oq1, p0, p1));
     if !zq0 && !zq1 && ((oq0 > 0.0 && oq1 > 0.0) || (oq0 < 0.0 && oq1 < 0.0)) {
         return;
     }
-    let lq = sqrt((q1 - q0).length_squared());
     let op0 = orient(q0, q1, p0);
     let op1 = orient(q0, q1, p1);
-    let (zp0, zp1) = (near(op0, lq), near(op1, lq));
+    let (zp0, zp1) = (near(op0, q0, q1), near(op1, q0, q1));
     if !zp0 && !zp1 && ((op0 > 0.0 && op1 > 0.0) || (op0 < 0.0 && op1 < 0.0)) {
         return;
     }
@@ -292,9 +439,30 @@ fn pair(
     // vertex of the other operand lying on this edge) must become that vertex, or the boundary
     // would carry two distinct points a few ulps apart and the split edges between them could
     // double back.
-    let x = all_a
+    let snap = sqrt(snap2);
+    by_x.crossings += 1;
+    if by_x.crossings <= 8 {
+        // Few crossings: a linear scan is cheaper than sorting.
+        let x = all_a
+            .iter()
+            .chain(all_b.iter())
+            .copied()
+            .find(|&v| (x - v).length_squared() <= snap2)
+            .unwrap_or(x);
+        push(ins_a, i, p0, p1, x, true);
+        push(ins_b, j, q0, q1, x, true);
+        return;
+    }
+    if !by_x.built {
+        by_x.pts.extend(all_a.iter().chain(all_b.iter()).copied());
+        by_x.pts.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
+        by_x.built = true;
+    }
+    let by_x: &[DVec2] = &by_x.pts;
+    let lo = by_x.partition_point(|v| v.x < x.x - snap);
+    let x = by_x[lo..]
         .iter()
-        .chain(all_b.iter())
+        .take_while(|v| v.x <= x.x + snap)
         .copied()
         .find(|&v| (x - v).length_squared() <= snap2)
         .unwrap_or(x);

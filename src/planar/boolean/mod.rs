@@ -41,7 +41,7 @@ pub enum BoolOp {
 }
 
 /// Point storage of the split contours of one operand.
-pub(crate) type Split = SmallVec<[DVec2; 64]>;
+pub(crate) type Split = SmallVec<[DVec2; 32]>;
 
 /// The contours of one operand as one flat point list: ring `k` occupies
 /// `ends[k - 1]..ends[k]`.
@@ -105,8 +105,8 @@ impl Rings {
 ///
 /// Contacts are decided with exact `orient2d`; the only tolerances are relative to the larger
 /// coordinate magnitude of the operands: computed crossings snap to a vertex within
-/// [`SNAP_REL`](intersect::SNAP_REL) of the scale, and result loops thinner than
-/// [`SLIVER_REL`](trace::SLIVER_REL) of the scale are dropped.
+/// [`SNAP_REL`](crate::planar::SNAP_REL) of the scale, and result loops thinner than
+/// [`SLIVER_REL`](crate::planar::SLIVER_REL) of the scale are dropped.
 ///
 /// # Examples
 ///
@@ -138,7 +138,11 @@ impl Rings {
 ///
 /// # References
 ///
-/// Greiner and Hormann 1998; Foster, Hormann and Popa 2019 (see the [module docs](self)).
+/// - G. Greiner, K. Hormann. *Efficient clipping of arbitrary polygons.* ACM TOG 17(2), 1998
+///   (intersection phase section 3.1, labelling 3.2, tracing 3.3).
+/// - E. L. Foster, K. Hormann, R. T. Popa. *Clipping simple polygons with degenerate
+///   intersections.* Computers & Graphics: X 2, 2019 (labelling phase: local classification of
+///   Table 1, overlapping chains as delayed crossings/bouncings; tracing phase).
 pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
     // Trivial cases first: they need no geometry and keep chains of operations cheap.
     if a.is_empty() || b.is_empty() {
@@ -175,30 +179,15 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
 
     let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
     let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
-    let a_twins = label::Twins::new(&ra);
-    let b_twins = label::Twins::new(&rb);
+    let nodes = label::Nodes::new(&ra, &rb);
     let mut sa = SmallVec::new();
     let mut sb = SmallVec::new();
-    label::label(&ra, &a_nxt, &rb, &b_nxt, &b_prv, &b_twins, &mut sa);
-    label::label(&rb, &b_nxt, &ra, &a_nxt, &a_prv, &a_twins, &mut sb);
-
-    let mut classes = SmallVec::new();
-    let on_b: SmallVec<[bool; 64]> = ra
-        .pts
-        .iter()
-        .map(|&p| !b_twins.of(&rb, p).is_empty())
-        .collect();
-    label::classify(&a_nxt, &a_prv, &on_b, &sa, &mut classes)?;
-    let on_a: SmallVec<[bool; 64]> = rb
-        .pts
-        .iter()
-        .map(|&p| !a_twins.of(&ra, p).is_empty())
-        .collect();
-    label::classify(&b_nxt, &b_prv, &on_a, &sb, &mut classes)?;
+    label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
+    label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
 
     let mut edges = SmallVec::new();
-    trace::select(&ra, &a_nxt, &sa, &rb, &b_nxt, &sb, op, &mut edges);
-    let contours = trace::trace(&edges, scale)?;
+    trace::select(&ra, &a_nxt, &sa, &rb, &b_nxt, &sb, &nodes, op, &mut edges);
+    let contours = trace::trace(&edges, ra.pts.len() + rb.pts.len(), scale)?;
     Ok(Shape::from_contours(contours))
 }
 
@@ -214,4 +203,42 @@ fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
     let (alo, ahi) = bbox(a);
     let (blo, bhi) = bbox(b);
     ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
+}
+
+/// `(point, class)` for each vertex of one split operand, as returned by [`contact_classes`].
+pub type ContactClasses = Vec<(DVec2, label::VertexClass)>;
+
+/// The Foster–Hormann–Popa classification of every vertex of both operands after phase 1 (the
+/// split contours), for diagnostics and tests: `(point, class)` for A's vertices, then for B's.
+///
+/// # Errors
+///
+/// As [`boolean`].
+#[doc(hidden)]
+pub fn contact_classes(
+    a: &Shape,
+    b: &Shape,
+) -> Result<(ContactClasses, ContactClasses), GeomError> {
+    let mut ra = Rings::from_shape(a);
+    let mut rb = Rings::from_shape(b);
+    let scale = ra.scale().max(rb.scale());
+    intersect::snap_vertices(&ra, &mut rb, scale);
+    intersect::split_self_contacts(&mut ra);
+    intersect::split_self_contacts(&mut rb);
+    intersect::split(&mut ra, &mut rb, scale)?;
+    let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
+    let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
+    let nodes = label::Nodes::new(&ra, &rb);
+    let mut sa = SmallVec::new();
+    let mut sb = SmallVec::new();
+    label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
+    label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
+    let mut ca = Vec::new();
+    let mut cb = Vec::new();
+    label::classify(&a_nxt, &a_prv, false, &nodes, &sa, &mut ca);
+    label::classify(&b_nxt, &b_prv, true, &nodes, &sb, &mut cb);
+    Ok((
+        ra.pts.iter().copied().zip(ca).collect(),
+        rb.pts.iter().copied().zip(cb).collect(),
+    ))
 }

@@ -3,7 +3,7 @@
 //! Greiner and Hormann (1998, section 3.3) walk from an entry intersection along one polygon
 //! until the next intersection, then switch polygons. With the per-edge labels of phase 2 the same
 //! walk is "follow the selected edges": which edges of which operand bound the result, and in
-//! which direction, is a table per operation (FHP 2019, section 4, gives the same rules for
+//! which direction, is a table per operation (FHP 2019, tracing phase, gives the same rules for
 //! overlapping edges: a chain shared in the same direction belongs to union and intersection, one
 //! shared in opposite directions to the difference only):
 //!
@@ -26,7 +26,7 @@ use alloc::vec::Vec;
 use glam::DVec2;
 use smallvec::SmallVec;
 
-use super::label::Status;
+use super::label::{Nodes, Status};
 use super::{BoolOp, Rings};
 use crate::GeomError;
 use crate::math::sqrt;
@@ -39,9 +39,19 @@ use crate::planar::predicates::{orient, orient_sign, signed_area2};
 /// artifact of `f64`, not part of the true result.
 pub const SLIVER_REL: f64 = 256.0 * f64::EPSILON;
 
-type Edges = SmallVec<[(DVec2, DVec2); 64]>;
+/// A selected, directed result edge: nodes (see [`Nodes`]) and points of its ends.
+#[derive(Clone, Copy)]
+pub(crate) struct Edge {
+    from: u32,
+    to: u32,
+    p: DVec2,
+    q: DVec2,
+}
+
+pub(crate) type Edges = SmallVec<[Edge; 64]>;
 
 /// Collects the directed result edges of both operands for `op`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn select(
     a: &Rings,
     a_nxt: &[u32],
@@ -49,46 +59,45 @@ pub(crate) fn select(
     b: &Rings,
     b_nxt: &[u32],
     sb: &[Status],
+    nodes: &Nodes,
     op: BoolOp,
     out: &mut Edges,
 ) {
     out.clear();
-    for (i, &n) in a_nxt.iter().enumerate() {
-        let e = (a.pts[i], a.pts[n as usize]);
-        let keep = match (op, sa[i]) {
-            (BoolOp::Intersection, Status::Inside | Status::SharedSame) => Some(false),
-            (BoolOp::Union, Status::Outside | Status::SharedSame) => Some(false),
-            (BoolOp::Difference, Status::Outside | Status::SharedOpposite) => Some(false),
-            (BoolOp::Xor, Status::Outside) => Some(false),
-            (BoolOp::Xor, Status::Inside) => Some(true),
-            _ => None,
-        };
-        match keep {
-            Some(false) => out.push(e),
-            Some(true) => out.push((e.1, e.0)),
-            None => {}
+    for (side_b, r, nxt, st) in [(false, a, a_nxt, sa), (true, b, b_nxt, sb)] {
+        for (i, &n) in nxt.iter().enumerate() {
+            let keep = match (op, side_b, st[i]) {
+                (BoolOp::Intersection, _, Status::Inside) => Some(false),
+                (BoolOp::Intersection, false, Status::SharedSame) => Some(false),
+                (BoolOp::Union, _, Status::Outside) => Some(false),
+                (BoolOp::Union, false, Status::SharedSame) => Some(false),
+                (BoolOp::Difference, false, Status::Outside | Status::SharedOpposite) => {
+                    Some(false)
+                }
+                (BoolOp::Difference, true, Status::Inside) => Some(true),
+                (BoolOp::Xor, _, Status::Outside) => Some(false),
+                (BoolOp::Xor, _, Status::Inside) => Some(true),
+                _ => None,
+            };
+            let n = n as usize;
+            let (u, w) = (nodes.of(i, side_b), nodes.of(n, side_b));
+            match keep {
+                Some(false) => out.push(Edge {
+                    from: u,
+                    to: w,
+                    p: r.pts[i],
+                    q: r.pts[n],
+                }),
+                Some(true) => out.push(Edge {
+                    from: w,
+                    to: u,
+                    p: r.pts[n],
+                    q: r.pts[i],
+                }),
+                None => {}
+            }
         }
     }
-    for (i, &n) in b_nxt.iter().enumerate() {
-        let e = (b.pts[i], b.pts[n as usize]);
-        let keep = match (op, sb[i]) {
-            (BoolOp::Intersection, Status::Inside) => Some(false),
-            (BoolOp::Union, Status::Outside) => Some(false),
-            (BoolOp::Difference, Status::Inside) => Some(true),
-            (BoolOp::Xor, Status::Outside) => Some(false),
-            (BoolOp::Xor, Status::Inside) => Some(true),
-            _ => None,
-        };
-        match keep {
-            Some(false) => out.push(e),
-            Some(true) => out.push((e.1, e.0)),
-            None => {}
-        }
-    }
-}
-
-fn cmp_pt(a: DVec2, b: DVec2) -> core::cmp::Ordering {
-    a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y))
 }
 
 /// Rank of the turn `prev -> v -> n` for the leftmost-turn rule: smaller is further left.
@@ -121,132 +130,150 @@ fn further_left(prev: DVec2, v: DVec2, n1: DVec2, n2: DVec2) -> bool {
 }
 
 /// Links the selected edges into regularized contours.
-pub(crate) fn trace(edges: &Edges, scale: f64) -> Result<Vec<Contour>, GeomError> {
+///
+/// The walk keeps the position of each node on the current path; arriving at a node already on
+/// the path closes a simple loop there, which is emitted at once. So a boundary that touches
+/// itself (FHP's vertex-on-vertex contacts in the result) comes out as separate simple contours
+/// meeting at a point, never as one contour visiting a point twice.
+pub(crate) fn trace(
+    edges: &Edges,
+    node_count: usize,
+    scale: f64,
+) -> Result<Vec<Contour>, GeomError> {
     let n = edges.len();
-    let mut order: SmallVec<[u32; 64]> = (0..n as u32).collect();
-    order.sort_unstable_by(|&x, &y| cmp_pt(edges[x as usize].0, edges[y as usize].0));
+    // Out-edges per node, in compressed rows.
+    let mut first: SmallVec<[u32; 128]> = SmallVec::from_elem(0, node_count + 1);
+    for e in edges {
+        if let Some(c) = first.get_mut(e.from as usize + 1) {
+            *c += 1;
+        }
+    }
+    for k in 1..first.len() {
+        first[k] += first[k - 1];
+    }
+    let mut fill: SmallVec<[u32; 128]> = first.clone();
+    let mut out_edges: SmallVec<[u32; 64]> = SmallVec::from_elem(0, n);
+    for (k, e) in edges.iter().enumerate() {
+        let slot = &mut fill[e.from as usize];
+        out_edges[*slot as usize] = k as u32;
+        *slot += 1;
+    }
     let mut used: SmallVec<[bool; 64]> = SmallVec::from_elem(false, n);
-    let mut out = Vec::new();
-    let mut ring: SmallVec<[DVec2; 64]> = SmallVec::new();
+    // Position + 1 of each node on the current path (0: not on it).
+    let mut on_path: SmallVec<[u32; 128]> = SmallVec::from_elem(0, node_count);
+    // The path as (node, point) pairs, and the edge that left each (for the turn rule).
+    let mut path: SmallVec<[(u32, DVec2); 64]> = SmallVec::new();
+    let mut contours = Vec::new();
+    let mut steps = 0usize;
     for s in 0..n {
         if used[s] {
             continue;
         }
-        ring.clear();
-        let start = edges[s].0;
+        let start = edges[s];
+        path.clear();
+        path.push((start.from, start.p));
+        on_path[start.from as usize] = 1;
         let mut cur = s;
-        let mut closed = false;
-        // Each step uses one edge, so `n` steps bound the walk.
-        for _ in 0..n {
-            used[cur] = true;
-            let (from, v) = edges[cur];
-            ring.push(from);
-            if v == start {
-                closed = true;
-                break;
+        loop {
+            // Each iteration uses one edge, so `n` iterations bound the whole trace.
+            steps += 1;
+            if steps > n {
+                return Err(GeomError::Degenerate(
+                    "result boundary tracing did not terminate; the operands are too close to \
+                     degenerate for f64",
+                ));
             }
-            let lo = order
-                .partition_point(|&k| cmp_pt(edges[k as usize].0, v) == core::cmp::Ordering::Less);
+            used[cur] = true;
+            let e = edges[cur];
+            let pos = on_path[e.to as usize];
+            if pos != 0 {
+                // Closed a loop: emit path[pos-1..], keep the path up to the repeated node.
+                let keep = pos as usize;
+                for &(node, _) in &path[keep..] {
+                    on_path[node as usize] = 0;
+                }
+                if let Some(c) = regularize(path[keep - 1..].iter().map(|x| x.1), scale) {
+                    contours.push(c);
+                }
+                path.truncate(keep);
+            } else {
+                path.push((e.to, e.q));
+                on_path[e.to as usize] = path.len() as u32;
+            }
+            // Choose the next edge out of the current node (the end of the path).
+            let Some(&(v_node, v)) = path.last() else {
+                break;
+            };
+            let lo = first[v_node as usize] as usize;
+            let hi = first[v_node as usize + 1] as usize;
             let mut best: Option<usize> = None;
-            for &k in order[lo..]
-                .iter()
-                .take_while(|&&k| edges[k as usize].0 == v)
-            {
+            for &k in &out_edges[lo..hi] {
                 let k = k as usize;
                 if used[k] {
                     continue;
                 }
                 best = match best {
-                    Some(b) if !further_left(from, v, edges[k].1, edges[b].1) => Some(b),
+                    Some(b) if !further_left(e.p, v, edges[k].q, edges[b].q) => Some(b),
                     _ => Some(k),
                 };
             }
             match best {
                 Some(b) => cur = b,
-                None => break,
-            }
-        }
-        if !closed {
-            return Err(GeomError::Degenerate(
-                "result boundary does not close; the operands are too close to degenerate for f64",
-            ));
-        }
-        split_and_emit(&ring, scale, &mut out);
-    }
-    Ok(out)
-}
-
-/// Cuts a closed walk at repeated points into simple loops, regularizes each and emits it.
-fn split_and_emit(walk: &[DVec2], scale: f64, out: &mut Vec<Contour>) {
-    let mut stack: SmallVec<[SmallVec<[DVec2; 32]>; 4]> = SmallVec::new();
-    stack.push(walk.iter().copied().collect());
-    // Every cut removes at least one point from the loop being cut, so this terminates; the
-    // counter is a belt-and-braces bound.
-    let mut budget = 4 * walk.len() + 4;
-    while let Some(mut lp) = stack.pop() {
-        if budget == 0 {
-            break;
-        }
-        budget -= 1;
-        match find_repeat(&lp) {
-            Some((i, j)) => {
-                let inner: SmallVec<[DVec2; 32]> = lp[i..j].iter().copied().collect();
-                lp.drain(i..j);
-                stack.push(inner);
-                stack.push(lp);
-            }
-            None => {
-                if let Some(c) = regularize(lp, scale) {
-                    out.push(c);
+                None if path.len() == 1 => {
+                    on_path[v_node as usize] = 0;
+                    break;
+                }
+                None => {
+                    return Err(GeomError::Degenerate(
+                        "result boundary does not close; the operands are too close to \
+                         degenerate for f64",
+                    ));
                 }
             }
         }
     }
+    Ok(contours)
 }
 
-/// Two positions `i < j` holding the same point, if any.
-fn find_repeat(lp: &[DVec2]) -> Option<(usize, usize)> {
-    let mut idx: SmallVec<[u32; 64]> = (0..lp.len() as u32).collect();
-    idx.sort_unstable_by(|&x, &y| cmp_pt(lp[x as usize], lp[y as usize]).then(x.cmp(&y)));
-    idx.windows(2).find_map(|w| {
-        let (x, y) = (w[0] as usize, w[1] as usize);
-        (lp[x] == lp[y]).then_some((x.min(y), x.max(y)))
-    })
-}
-
-/// Removes repeated and exactly collinear points, then drops the loop if it bounds no area or
-/// only a sliver.
-fn regularize(mut pts: SmallVec<[DVec2; 32]>, scale: f64) -> Option<Contour> {
-    // Each pass removes a point or stops.
-    loop {
-        let n = pts.len();
-        if n < 3 {
-            return None;
-        }
-        let mut removed = false;
-        for i in 0..n {
-            let a = pts[(i + n - 1) % n];
-            let b = pts[i];
-            let c = pts[(i + 1) % n];
-            if a == b || orient(a, b, c) == 0.0 {
-                pts.remove(i);
-                removed = true;
+/// Removes repeated and exactly collinear points (spikes included) in one stack pass, then drops
+/// the loop if it bounds no area or only a sliver.
+fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option<Contour> {
+    // Scratch on the stack; the output contour is allocated once, at its final size, and only
+    // if it survives.
+    let mut out: SmallVec<[DVec2; 32]> = SmallVec::new();
+    for p in pts {
+        while let [.., a, b] = out[..] {
+            if b == p || orient(a, b, p) == 0.0 {
+                out.pop();
+            } else {
                 break;
             }
         }
-        if !removed {
+        if out.last() != Some(&p) {
+            out.push(p);
+        }
+    }
+    // Fix the seam between the end and the start (bounded: each round removes a point).
+    loop {
+        let n = out.len();
+        if n < 3 {
+            return None;
+        }
+        if out[n - 1] == out[0] || orient(out[n - 2], out[n - 1], out[0]) == 0.0 {
+            out.pop();
+        } else if orient(out[n - 1], out[0], out[1]) == 0.0 {
+            out.remove(0);
+        } else {
             break;
         }
     }
-    let area2 = signed_area2(&pts);
-    let n = pts.len();
+    let area2 = signed_area2(&out);
+    let n = out.len();
     let perimeter: f64 = (0..n)
-        .map(|i| sqrt((pts[(i + 1) % n] - pts[i]).length_squared()))
+        .map(|i| sqrt((out[(i + 1) % n] - out[i]).length_squared()))
         .sum();
     if area2 == 0.0 || area2.abs() <= SLIVER_REL * scale * perimeter {
         return None;
     }
-    Some(Contour {
-        pts: pts.into_vec(),
-    })
+    Some(Contour { pts: out.to_vec() })
 }
