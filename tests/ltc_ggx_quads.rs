@@ -51,7 +51,7 @@ fn brute_force(
             );
             let l = ggx_sample_vndf(v, alpha, u);
             let pdf = ggx_vndf_pdf(v, l, alpha);
-            if !(pdf > 0.0) || l.z <= 0.0 {
+            if pdf.is_nan() || pdf <= 0.0 || l.z <= 0.0 {
                 continue;
             }
             let w = ggx_brdf_cos(v, l, alpha) / pdf;

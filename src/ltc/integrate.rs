@@ -89,10 +89,12 @@ fn transformed_integral(
     m: glam::DMat3,
     edge: fn(DVec3, DVec3) -> f64,
 ) -> Result<f64, crate::GeomError> {
-    if !poly.is_full() && !poly.is_empty() && m.determinant() > 0.0 {
-        if let Some(v) = transformed_clip_free(poly, m, edge) {
-            return Ok(v);
-        }
+    if !poly.is_full()
+        && !poly.is_empty()
+        && m.determinant() > 0.0
+        && let Some(v) = transformed_clip_free(poly, m, edge)
+    {
+        return Ok(v);
     }
     Ok(clipped_sum(&poly.transformed(m)?, edge))
 }
