@@ -1,5 +1,7 @@
-//! Known failures of the spherical boolean met by the shading layer's per-triangle path, kept as
-//! ignored regression tests for the `sphere` layer (run with `cargo test -- --ignored`).
+//! Failures of the spherical boolean once met by the shading layer's per-triangle path, kept as
+//! regression tests for the `sphere` layer. Both pass now: repeated directions after
+//! unprojection are dropped, and a planar `Degenerate` in one projection is retried through the
+//! octant split.
 //!
 //! Found by running the per-triangle method over 3000 ground points of the demo scene: 16 of
 //! 2.4 million triangle differences failed. This one is light-minus-occluder-triangle where the
@@ -11,7 +13,6 @@ use arealight::planar::BoolOp;
 use arealight::sphere::SphericalPolygon;
 
 #[test]
-#[ignore = "sphere layer: boolean difference with a nearly shared edge reports Degenerate"]
 fn difference_with_nearly_shared_edge() {
     let a = SphericalPolygon::new(vec![vec![
         DVec3::new(-0.6690880280221996, -0.1568454495401529, 0.7264438833908037),

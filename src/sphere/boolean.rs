@@ -32,7 +32,8 @@ impl SphericalPolygon {
     /// (a complement, or a light surrounding the point) is handled as the complement of a
     /// bounded planar shape, using `A - B = A n B'` and `(A n B)' = A' u B'`.
     ///
-    /// When no cap narrower than a hemisphere (with margin, [`MIN_CAP_COS`]) holds the vertices,
+    /// When no cap narrower than a hemisphere (with margin, [`MIN_CAP_COS`]) holds the vertices
+    /// (or the planar operation reports a configuration it cannot resolve in that projection),
     /// both operands are cut into the eight octants of the coordinate frame (by exact hemisphere
     /// clipping, which adds vertices on the cuts), each octant is solved with its own projection,
     /// and the pieces are merged by cancelling the cut edges that two octants share. No area is
@@ -79,7 +80,13 @@ impl SphericalPolygon {
         if let Ok((c, cos_r)) = enclosing_cap(&verts)
             && cos_r >= MIN_CAP_COS
         {
-            return projected(self, other, op, c);
+            match projected(self, other, op, c) {
+                // The planar operation could not settle a configuration within rounding in this
+                // projection; the octant split sees it in other coordinates (and usually in
+                // simpler pieces), so it gets a second, deterministic attempt.
+                Err(GeomError::Degenerate(_)) => {}
+                done => return done,
+            }
         }
         split(self, other, op)
     }
