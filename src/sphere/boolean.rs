@@ -147,6 +147,58 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
     })
 }
 
+/// Vertices of the two operands closer than this chord are made the same vertex before an
+/// operation. Results of earlier operations carry the round-off of their projections, so one
+/// mesh vertex can reach a later operation as several copies a few ulps apart (up to about
+/// `1e-13` for vertices far from the projection center); the planar operation must see them as
+/// one vertex, or it meets edges that overlap within rounding but not exactly.
+const WELD_TOLERANCE: f64 = 1e-12;
+
+/// Both operands with every vertex replaced by the first vertex (in either operand) within
+/// [`WELD_TOLERANCE`] of it; repeats that this creates along a ring are dropped.
+fn weld(a: &SphericalPolygon, b: &SphericalPolygon) -> (SphericalPolygon, SphericalPolygon) {
+    let all: Vec<DVec3> = a.rings().chain(b.rings()).flatten().copied().collect();
+    // Sort by x so that each vertex is compared only with those within the tolerance window.
+    let mut order: Vec<usize> = (0..all.len()).collect();
+    order.sort_by(|&i, &j| all[i].x.total_cmp(&all[j].x).then(i.cmp(&j)));
+    let mut rep: Vec<usize> = (0..all.len()).collect();
+    for (k, &i) in order.iter().enumerate() {
+        for &j in &order[k + 1..] {
+            if all[j].x - all[i].x > WELD_TOLERANCE {
+                break;
+            }
+            if (all[i] - all[j]).length() <= WELD_TOLERANCE {
+                // The earliest vertex (by input position) represents the group.
+                let (ri, rj) = (rep[i], rep[j]);
+                let r = ri.min(rj);
+                rep[i] = r;
+                rep[j] = r;
+            }
+        }
+    }
+    let mut at = 0usize;
+    let mut rebuild = |p: &SphericalPolygon| {
+        if p.is_full() || p.is_empty() {
+            at += p.vertex_count();
+            return p.clone();
+        }
+        let mut verts = Verts::new();
+        let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
+        for ring in p.rings() {
+            let start = verts.len();
+            for _ in ring {
+                verts.push(all[rep[at]]);
+                at += 1;
+            }
+            close_ring(&mut verts, &mut ends, start);
+        }
+        SphericalPolygon::from_parts(verts, ends)
+    };
+    let wa = rebuild(a);
+    let wb = rebuild(b);
+    (wa, wb)
+}
+
 /// Splits a ring that visits a vertex more than once (a pinch, valid on the sphere) into simple
 /// rings, as planar shapes require: the loop between two visits becomes a ring of its own.
 fn split_pinches(mut ring: Vec<DVec2>, out: &mut Vec<Vec<DVec2>>) {
@@ -181,7 +233,8 @@ fn projected(
     c: DVec3,
 ) -> Result<SphericalPolygon, GeomError> {
     let g = Gnomonic::new(c)?;
-    let (pa, pb) = (to_plane(a, &g)?, to_plane(b, &g)?);
+    let (a, b) = weld(a, b);
+    let (pa, pb) = (to_plane(&a, &g)?, to_plane(&b, &g)?);
     let (ca, cb) = (pa.complemented, pb.complemented);
     let (sa, sb) = (&pa.shape, &pb.shape);
     // Rewrite the operation on possibly complemented operands as one on bounded shapes, with
