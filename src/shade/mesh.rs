@@ -5,8 +5,9 @@ use alloc::vec;
 use alloc::vec::Vec;
 use core::f64::consts::PI;
 
+use crate::sphere::predicates::c3;
 use glam::DVec3;
-use robust::{Coord3D, orient3d};
+use robust::orient3d;
 
 use crate::GeomError;
 use crate::math::{sin_cos, sqrt};
@@ -34,15 +35,6 @@ pub const DEGENERATE_TRIANGLE: f64 = 1e-12;
 /// face edge-on (zero solid angle) and treats it as back-facing, which handles shading points
 /// lying in a face's plane (a cube standing on the ground plane, seen from the ground).
 pub const FACE_TOLERANCE: f64 = 1e-11;
-
-#[inline]
-fn c3(p: DVec3) -> Coord3D<f64> {
-    Coord3D {
-        x: p.x,
-        y: p.y,
-        z: p.z,
-    }
-}
 
 /// Checks a vertex list: finite and within [`MAX_COORDINATE`]. `ring` in the error is 0.
 fn check_vertices(vertices: &[DVec3]) -> Result<(), GeomError> {

@@ -14,8 +14,9 @@ pub(crate) const AXES: [DVec3; 6] = [
     DVec3::NEG_Z,
 ];
 
+/// glam's vector as robust's coordinate type.
 #[inline]
-fn c3(p: DVec3) -> Coord3D<f64> {
+pub(crate) fn c3(p: DVec3) -> Coord3D<f64> {
     Coord3D {
         x: p.x,
         y: p.y,

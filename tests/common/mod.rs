@@ -224,59 +224,15 @@ pub fn triangle_quadrature(
     sum
 }
 
-/// The icosahedron subdivided once: 42 vertices, 80 faces, counter-clockwise from outside.
+/// The icosahedron subdivided once (42 vertices, 80 faces, counter-clockwise from outside), from
+/// the crate's own mesh primitives.
 pub fn icosphere(center: DVec3, radius: f64) -> (Vec<DVec3>, Vec<[usize; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let f0 = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let mut mid = std::collections::HashMap::new();
-    let mut faces = Vec::new();
-    for [a, b, c] in f0 {
-        let mut m = |i: usize, j: usize| {
-            *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                v.push((v[i] + v[j]).normalize());
-                v.len() - 1
-            })
-        };
-        let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-        faces.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-    }
-    (v.into_iter().map(|p| center + p * radius).collect(), faces)
+    let ico = arealight::shade::ConvexPolyhedron::icosphere(center, radius, 1).expect("icosphere");
+    let mesh = ico.mesh();
+    let faces = mesh
+        .triangles()
+        .iter()
+        .map(|t| t.map(|i| i as usize))
+        .collect();
+    (mesh.vertices().to_vec(), faces)
 }
