@@ -426,3 +426,42 @@ fn fuzz_regression_vertex_exactly_on_own_edge_is_rejected() {
         "{r:?}"
     );
 }
+
+#[test]
+fn fuzz_regression_two_entries_at_one_pinch_on_the_circle() {
+    // Rings 0 and 1 share a vertex lying on the clip circle, and both enter the hemisphere
+    // there; the boundary arriving along the circle took the wrong one (the result exceeded the
+    // input). It now turns into the entry met first clockwise from the circle behind it.
+    let v = DVec3::new;
+    let p = poly(vec![
+        vec![
+            v(-1.0, -1.0, -1.0),
+            v(-1.0, -5.0, -1.0),
+            v(-63.0, -68.0, 26.0),
+        ],
+        vec![
+            v(-1.0, -1.0, 8.0),
+            v(35.0, 43.0, -1.0),
+            v(-1.0, 1.0, 0.0),
+            v(-1.0, -1.0, -1.0),
+        ],
+        vec![
+            v(-1.0, -43.0, 57.0),
+            v(0.0, -1.0, -5.0),
+            v(-1.0, -91.0, -1.0),
+            v(10.0, -43.0, 7.0),
+            v(-1.0, -1.0, 8.0),
+        ],
+    ])
+    .complement();
+    let n = v(-1.0, 0.0, 1.0);
+    let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+    assert!(close(
+        up.solid_angle() + down.solid_angle(),
+        p.solid_angle(),
+        1e-12
+    ));
+    for q in [&up, &down] {
+        assert!(SphericalPolygon::new(q.rings().map(<[DVec3]>::to_vec).collect()).is_ok());
+    }
+}

@@ -199,7 +199,14 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                 continue;
             }
             let key = circle_gap(&scratch, n, chain, other);
-            if key < best.0 {
+            let better = if key.0 == best.0.0 && best.1 != usize::MAX && key.0 > 0.0 {
+                // Two entries at one point (a pinch on the circle), reached along the circle:
+                // the boundary turns into the one met first clockwise from the circle behind.
+                entry_turn(&scratch, n, other) < entry_turn(&scratch, n, &chains[best.1])
+            } else {
+                key < best.0
+            };
+            if better {
                 best = (key, d);
             }
         }
@@ -271,6 +278,18 @@ fn circle_gap(scratch: &[DVec3], n: DVec3, from: &Chain, to: &Chain) -> (f64, f6
     } else {
         (2.0 * PI, along_entry)
     }
+}
+
+/// Clockwise turn, about the entry point of `to`, from the circle behind it (the direction the
+/// boundary arrives from when it runs counter-clockwise along the circle) to the entry's first
+/// edge.
+fn entry_turn(scratch: &[DVec3], n: DVec3, to: &Chain) -> f64 {
+    let e = scratch[to.start];
+    let (u, v) = tangent_frame(e);
+    let ang = |q: DVec3| crate::math::atan2(q.dot(v), q.dot(u));
+    let back = ang(e - n.cross(e));
+    let t = (back - ang(scratch[to.start + 1])).rem_euclid(2.0 * PI);
+    if t <= 0.0 { 2.0 * PI } else { t }
 }
 
 /// When every vertex lies strictly inside the open hemisphere about `c`: whether the circle
