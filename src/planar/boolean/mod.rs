@@ -158,8 +158,8 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
             }
         });
     }
-    let mut ra = Rings::from_shape(a);
-    let mut rb = Rings::from_shape(b);
+    let ra = Rings::from_shape(a);
+    let rb = Rings::from_shape(b);
     if disjoint_boxes(&ra, &rb) {
         return Ok(match op {
             BoolOp::Intersection => Shape::empty(),
@@ -171,24 +171,58 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
             }
         });
     }
-    let scale = ra.scale().max(rb.scale());
-    intersect::snap_vertices(&ra, &mut rb, scale);
-    intersect::split_self_contacts(&mut ra);
-    intersect::split_self_contacts(&mut rb);
-    intersect::split(&mut ra, &mut rb, scale)?;
-
-    let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
-    let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
-    let nodes = label::Nodes::new(&ra, &rb);
-    let mut sa = SmallVec::new();
-    let mut sb = SmallVec::new();
-    label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
-    label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
-
+    let l = Labelled::new(ra, rb)?;
     let mut edges = SmallVec::new();
-    trace::select(&ra, &a_nxt, &sa, &rb, &b_nxt, &sb, &nodes, op, &mut edges);
-    let contours = trace::trace(&edges, ra.pts.len() + rb.pts.len(), scale)?;
+    trace::select(
+        &l.ra, &l.a_nxt, &l.sa, &l.rb, &l.b_nxt, &l.sb, &l.nodes, op, &mut edges,
+    );
+    let contours = trace::trace(&edges, l.ra.pts.len() + l.rb.pts.len(), l.scale)?;
     Ok(Shape::from_contours(contours))
+}
+
+/// Both operands after the intersection phase (split at every contact) and the labelling phase:
+/// what tracing and the diagnostic classification both start from.
+struct Labelled {
+    ra: Rings,
+    rb: Rings,
+    scale: f64,
+    a_nxt: SmallVec<[u32; 64]>,
+    a_prv: SmallVec<[u32; 64]>,
+    b_nxt: SmallVec<[u32; 64]>,
+    b_prv: SmallVec<[u32; 64]>,
+    nodes: label::Nodes,
+    sa: SmallVec<[label::Status; 64]>,
+    sb: SmallVec<[label::Status; 64]>,
+}
+
+impl Labelled {
+    fn new(mut ra: Rings, mut rb: Rings) -> Result<Labelled, GeomError> {
+        let scale = ra.scale().max(rb.scale());
+        intersect::snap_vertices(&ra, &mut rb, scale);
+        intersect::split_self_contacts(&mut ra);
+        intersect::split_self_contacts(&mut rb);
+        intersect::split(&mut ra, &mut rb, scale)?;
+
+        let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
+        let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
+        let nodes = label::Nodes::new(&ra, &rb);
+        let mut sa = SmallVec::new();
+        let mut sb = SmallVec::new();
+        label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
+        label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
+        Ok(Labelled {
+            ra,
+            rb,
+            scale,
+            a_nxt,
+            a_prv,
+            b_nxt,
+            b_prv,
+            nodes,
+            sa,
+            sb,
+        })
+    }
 }
 
 fn bbox(r: &Rings) -> (DVec2, DVec2) {
@@ -219,26 +253,13 @@ pub fn contact_classes(
     a: &Shape,
     b: &Shape,
 ) -> Result<(ContactClasses, ContactClasses), GeomError> {
-    let mut ra = Rings::from_shape(a);
-    let mut rb = Rings::from_shape(b);
-    let scale = ra.scale().max(rb.scale());
-    intersect::snap_vertices(&ra, &mut rb, scale);
-    intersect::split_self_contacts(&mut ra);
-    intersect::split_self_contacts(&mut rb);
-    intersect::split(&mut ra, &mut rb, scale)?;
-    let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
-    let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
-    let nodes = label::Nodes::new(&ra, &rb);
-    let mut sa = SmallVec::new();
-    let mut sb = SmallVec::new();
-    label::label(&ra, &a_nxt, false, &nodes, &rb, &b_nxt, &b_prv, &mut sa);
-    label::label(&rb, &b_nxt, true, &nodes, &ra, &a_nxt, &a_prv, &mut sb);
+    let l = Labelled::new(Rings::from_shape(a), Rings::from_shape(b))?;
     let mut ca = Vec::new();
     let mut cb = Vec::new();
-    label::classify(&a_nxt, &a_prv, false, &nodes, &sa, &mut ca);
-    label::classify(&b_nxt, &b_prv, true, &nodes, &sb, &mut cb);
+    label::classify(&l.a_nxt, &l.a_prv, false, &l.nodes, &l.sa, &mut ca);
+    label::classify(&l.b_nxt, &l.b_prv, true, &l.nodes, &l.sb, &mut cb);
     Ok((
-        ra.pts.iter().copied().zip(ca).collect(),
-        rb.pts.iter().copied().zip(cb).collect(),
+        l.ra.pts.iter().copied().zip(ca).collect(),
+        l.rb.pts.iter().copied().zip(cb).collect(),
     ))
 }
