@@ -113,6 +113,29 @@ proptest! {
         prop_assert!(revalidate(&down).is_ok(), "invalid clip result {:?}", down);
     }
 
+    /// Polygons from 1e-12 rad to a radian across, anywhere strictly above the circle, and their
+    /// complements: the clip keeps a polygon whole and cuts the complement to the hemisphere
+    /// minus the polygon (found by the LTC tests: a ring of 3e-12 rad far from the pole was
+    /// taken for a ring around the circle, its projected shoelace sum lost to rounding).
+    #[test]
+    fn clip_keeps_small_polygons_above_the_circle(seed in any::<u64>(), n in unit()) {
+        let mut rng = Rng::new(seed);
+        let (u, v) = (n.any_orthonormal_pair().0, n.any_orthonormal_pair().1);
+        let h = rng.range(0.02, 1.0);
+        let phi = rng.range(0.0, 2.0 * PI);
+        let c = (n * h + (u * phi.cos() + v * phi.sin()) * (1.0 - h * h).sqrt()).normalize();
+        let rho = 10f64.powf(rng.range(-12.0, 0.0)).min(0.9 * h.asin());
+        let k = 3 + (rng.next_u64() % 8) as usize;
+        let Ok(p) = SphericalPolygon::new(vec![star_ring(&mut rng, c, k, rho, 0.5)]) else {
+            return Ok(());
+        };
+        let area = p.solid_angle();
+        let kept = p.clip_to_hemisphere(n).solid_angle();
+        prop_assert!((kept - area).abs() <= 1e-12 * 4.0 * PI, "{} vs {}", kept, area);
+        let rest = p.complement().clip_to_hemisphere(n).solid_angle();
+        prop_assert!((rest - (2.0 * PI - area)).abs() <= 1e-12 * 4.0 * PI, "{} vs {}", rest, 2.0 * PI - area);
+    }
+
     /// Clipping to a hemisphere through vertices of the polygon (the degenerate case) still
     /// partitions it.
     #[test]

@@ -77,18 +77,8 @@ impl FitMode {
 
     fn grid(self, n: usize) -> Grid {
         match self {
-            FitMode::Arealight => Grid {
-                n,
-                cos_min: 1e-3,
-                alpha_min: 1e-4,
-                rough_from_zero: false,
-            },
-            FitMode::Reference => Grid {
-                n,
-                cos_min: 1.57f64.cos(),
-                alpha_min: 1e-4,
-                rough_from_zero: true,
-            },
+            FitMode::Arealight => Grid::new(n, 1e-3, 1e-4, false),
+            FitMode::Reference => Grid::new(n, 1.57f64.cos(), 1e-4, true),
         }
     }
 }
@@ -163,7 +153,7 @@ impl FittedTable {
         &self.refinements
     }
 
-    /// Rust source for `table_data.rs`: plain `pub(crate) static` arrays, one per channel.
+    /// Rust source for `table_data.rs`: plain `pub(crate) const` arrays, one per channel.
     #[must_use]
     pub fn to_source(&self, command: &str) -> String {
         let g = self.table.grid();
@@ -189,8 +179,8 @@ impl FittedTable {
             "M_INV_00", "M_INV_02", "M_INV_20", "M_INV_22", "NORM", "ALBEDO", "FRESNEL",
         ];
         for (ch, name) in names.iter().enumerate() {
-            let vals = self.table.channel(ch);
-            let _ = writeln!(s, "pub(crate) static {name}: [f64; {}] = [", vals.len());
+            let vals: Vec<f64> = self.table.channel(ch).collect();
+            let _ = writeln!(s, "pub(crate) const {name}: [f64; {}] = [", vals.len());
             for row in vals.chunks(8) {
                 s.push_str("    ");
                 for v in row {
@@ -456,7 +446,7 @@ const MAX_REFINE_PASSES: usize = 6;
 /// use arealight::ltc::fit::{FitConfig, FitMode, fit_ggx};
 /// let fitted = fit_ggx(&FitConfig::new(FitMode::Arealight), |_| {});
 /// let source = fitted.to_source("cargo run --release --features fit --example fit_ltc");
-/// assert!(source.contains("pub(crate) static NORM"));
+/// assert!(source.contains("pub(crate) const NORM"));
 /// ```
 pub fn fit_ggx(cfg: &FitConfig, progress: impl Fn(usize) + Sync) -> FittedTable {
     let n = cfg.size.max(2);

@@ -3,15 +3,34 @@
 use core::f64::consts::PI;
 
 use glam::DVec3;
-use smallvec::SmallVec;
 
 use crate::sphere::{HORIZON_TOLERANCE, SphericalPolygon};
+
+/// A direction of any positive length with its squared length, computed once per vertex because
+/// the horizon test and the rational edge term both need it.
+#[derive(Clone, Copy)]
+struct Ray {
+    v: DVec3,
+    len2: f64,
+}
+
+impl Ray {
+    #[inline(always)]
+    fn new(v: DVec3) -> Self {
+        Self {
+            v,
+            len2: v.length_squared(),
+        }
+    }
+}
 
 /// Baum's edge term for the edge `a -> b`: `theta * (a x b)_z / |a x b|`, with the angle taken as
 /// `atan2(|a x b|, a . b)`, which stays accurate for tiny edges (no `acos` of a rounded dot
 /// product near 1) and for edges near pi long. For a tiny edge `theta / |a x b| -> 1`.
 #[inline]
-fn edge_term(a: DVec3, b: DVec3) -> f64 {
+fn edge_term(a: Ray, b: Ray) -> f64 {
+    // Invariant under positive scaling of `a` and `b`, so the endpoints need not be unit vectors.
+    let (a, b) = (a.v, b.v);
     let c = a.cross(b);
     let s = c.length();
     if s == 0.0 {
@@ -31,15 +50,25 @@ fn edge_term(a: DVec3, b: DVec3) -> f64 {
 #[inline]
 #[must_use]
 pub fn edge_factor_rational(x: f64) -> f64 {
+    let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
     let y = x.abs();
-    let v =
-        (5.429131712 + (3.130161863 + 0.089934273 * y) * y) / (3.456294690 + (4.192928007 + y) * y);
+    let v = (p0 + (p1 + p2 * y) * y) / (q0 + (q1 + y) * y);
     if x >= 0.0 {
         v
     } else {
         PI / crate::math::sqrt((1.0 - x * x).max(1e-14)) - v
     }
 }
+
+/// `(p0 + p1 y + p2 y^2) / (q0 + q1 y + y^2)`: this crate's minimax fit of `theta / sin(theta)`
+/// for `y = cos(theta)` in `[0, 1]`.
+const EDGE_FACTOR_COEFFS: [f64; 5] = [
+    5.429131712,
+    3.130161863,
+    0.089934273,
+    3.456294690,
+    4.192928007,
+];
 
 /// Largest relative error of [`edge_factor_rational`] against `acos(x) / sqrt(1 - x^2)` over
 /// `[-1, 1]`, as measured on a dense grid by the tests.
@@ -84,10 +113,11 @@ pub fn ltc_integral_rational(
 /// The clamped-cosine integral of `m` applied to `poly`, with the given edge term: the stack-only
 /// clip-free path (thesis 003 eq. 4.6/4.7) when the map keeps orientation, the exact clip of the
 /// transformed polygon otherwise. Both agree to rounding (tested).
+#[inline(always)]
 fn transformed_integral(
     poly: &SphericalPolygon,
     m: glam::DMat3,
-    edge: fn(DVec3, DVec3) -> f64,
+    edge: impl Fn(Ray, Ray) -> f64 + Copy,
 ) -> Result<f64, crate::GeomError> {
     if !poly.is_full()
         && !poly.is_empty()
@@ -138,27 +168,48 @@ pub fn ggx_polygon_integral(
     Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
 }
 
-/// The edge term with [`edge_factor_rational`] in place of `theta / sin(theta)`.
+/// The edge term with [`edge_factor_rational`] in place of `theta / sin(theta)`, for endpoints of
+/// any positive length (the clip-free path does not normalize).
+///
+/// With `l = |a| |b|` and `d = a . b`, the (2, 2) rational function of `|d| / l` is evaluated in
+/// homogeneous form, so the whole term costs one square root and one division; edges longer than
+/// a quarter circle add the reflection term `pi / sin(theta)` with `l sin(theta) = |a x b|`.
 #[inline]
-fn rational_edge_term(a: DVec3, b: DVec3) -> f64 {
-    edge_factor_rational(a.dot(b)) * a.cross(b).z
+fn rational_edge_term(a: Ray, b: Ray) -> f64 {
+    let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
+    let l2 = a.len2 * b.len2;
+    let (a, b) = (a.v, b.v);
+    let l = crate::math::sqrt(l2);
+    let d = a.dot(b);
+    let y = d.abs();
+    let cz = a.x * b.y - a.y * b.x;
+    let num = p0 * l2 + (p1 * l + p2 * y) * y;
+    let den = (q0 * l2 + (q1 * l + y) * y) * l;
+    let v = num * cz / den;
+    if d >= 0.0 {
+        v
+    } else {
+        // As in `edge_factor_rational`, sin(theta) is kept above 1e-7.
+        let s = crate::math::sqrt(a.cross(b).length_squared()).max(1e-7 * l);
+        PI * cz / s - v
+    }
 }
 
 /// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem
 /// (Baum, Rushmeier and Winget 1989; HDHN16 eq. 11): `(1 / 2 pi) sum theta_e n_e . z`.
-fn boundary_sum(poly: &SphericalPolygon, edge: fn(DVec3, DVec3) -> f64) -> f64 {
+fn boundary_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
     let mut sum = 0.0;
     for ring in poly.rings() {
         let n = ring.len();
         for i in 0..n {
-            sum += edge(ring[i], ring[(i + 1) % n]);
+            sum += edge(Ray::new(ring[i]), Ray::new(ring[(i + 1) % n]));
         }
     }
     sum / (2.0 * PI)
 }
 
 /// The exact path: clip to the upper hemisphere, then the boundary sum.
-fn clipped_sum(poly: &SphericalPolygon, edge: fn(DVec3, DVec3) -> f64) -> f64 {
+fn clipped_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
     boundary_sum(&poly.clip_to_hemisphere(DVec3::Z), edge).clamp(0.0, 1.0)
 }
 
@@ -216,86 +267,173 @@ pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
 /// crossing while some vertex is below).
 fn clip_free_sum<'a>(
     rings: impl Iterator<Item = &'a [DVec3]>,
-    edge: impl Fn(DVec3, DVec3) -> f64,
+    edge: impl Fn(Ray, Ray) -> f64 + Copy,
 ) -> Option<f64> {
-    let mut sum = 0.0;
-    // Running complex product of entry points and conjugates of exit points on the horizon.
-    let (mut re, mut im) = (1.0f64, 0.0f64);
-    let mut crossings = 0usize;
-    let mut any_below = false;
-    let mut any = false;
-    // Twice the signed area of the rings projected from +z, for the no-crossing case.
-    let mut planar_area2 = 0.0;
-    for ring in rings {
-        let n = ring.len();
-        for i in 0..n {
-            any = true;
-            let (a, b) = (ring[i], ring[(i + 1) % n]);
-            if a.z.abs() <= HORIZON_TOLERANCE {
-                return None;
-            }
-            match (a.z > 0.0, b.z > 0.0) {
-                (true, true) => {
-                    sum += edge(a, b);
-                    planar_area2 += (a.x * b.y - a.y * b.x) / (a.z * b.z);
-                }
-                (false, false) => any_below = true,
-                (up_a, _) => {
-                    any_below = true;
-                    if b.z.abs() <= HORIZON_TOLERANCE {
-                        return None;
-                    }
-                    // The crossing point, as a positive combination of a and b on the horizon.
-                    let x = if up_a {
-                        b * a.z - a * b.z
-                    } else {
-                        a * b.z - b * a.z
-                    };
-                    let x = DVec3::new(x.x, x.y, 0.0).normalize();
-                    let (pr, pi) = (x.x, if up_a { -x.y } else { x.y });
-                    (re, im) = (re * pr - im * pi, re * pi + im * pr);
-                    crossings += 1;
-                    sum += if up_a { edge(a, x) } else { edge(x, b) };
-                }
-            }
-        }
-    }
-    let horizon = if crossings > 0 {
-        crate::math::atan2(im, re).rem_euclid(2.0 * PI)
-    } else if !any {
-        0.0
-    } else if !any_below {
-        // Everything strictly above: the horizon is inside the region iff the rings, seen from
-        // +z, wind clockwise overall (the unbounded planar face is then inside).
-        if planar_area2 < 0.0 { 2.0 * PI } else { 0.0 }
-    } else {
-        return None;
-    };
-    Some(((sum + horizon) / (2.0 * PI)).clamp(0.0, 1.0))
+    ring_sum(rings, |v| v, edge)
 }
 
-/// Maps every vertex by `m` and normalizes, into a stack buffer, and runs the clip-free sum on
-/// the images; `None` when the exact path is needed (or `m` mirrors, reversing orientation).
+/// The clip-free sum over the images of the rings' vertices under `map`, which need not be unit
+/// vectors: every quantity the sum uses is invariant under positive scaling of each vertex (the
+/// edge terms by construction, the horizon crossings as positive combinations, the arguments of
+/// the crossing product, the sign tests), so no vertex is normalized. Each image is computed once
+/// and nothing is buffered.
+#[inline(always)]
+fn ring_sum<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    map: impl Fn(DVec3) -> DVec3,
+    edge: impl Fn(Ray, Ray) -> f64 + Copy,
+) -> Option<f64> {
+    let mut acc = ClipFree::new();
+    for ring in rings {
+        let Some((&first, rest)) = ring.split_first() else {
+            continue;
+        };
+        let first = Ray::new(map(first));
+        let mut prev = first;
+        for &v in rest {
+            let cur = Ray::new(map(v));
+            acc.add_edge(prev, cur, edge)?;
+            prev = cur;
+        }
+        acc.add_edge(prev, first, edge)?;
+    }
+    acc.finish()
+}
+
+/// Running state of the clip-free sum (thesis 003 eq. 4.6 and 4.7) over the edges of closed
+/// rings.
+struct ClipFree {
+    /// Sum of the edge terms of the parts of edges above the horizon.
+    sum: f64,
+    /// Running complex product of the entry points and conjugated exit points on the horizon.
+    re: f64,
+    im: f64,
+    crossings: usize,
+    edges: usize,
+    any_below: bool,
+    /// Sum of the magnitudes of the edge terms: the scale of the rounding in `sum`.
+    magnitude: f64,
+}
+
+impl ClipFree {
+    /// Squared [`HORIZON_TOLERANCE`]: a vertex `v` is on the horizon when
+    /// `v.z^2 <= HORIZON_TOLERANCE^2 |v|^2`, the tolerance of the exact clip for unit vectors.
+    const ON_HORIZON2: f64 = HORIZON_TOLERANCE * HORIZON_TOLERANCE;
+
+    /// Relative margin for the sign of the edge sum when no edge crosses the horizon: above the
+    /// error of the rational edge factor ([`EDGE_FACTOR_RATIONAL_MAX_ERROR`]) and of rounding.
+    const SIGN_MARGIN: f64 = 4.0 * EDGE_FACTOR_RATIONAL_MAX_ERROR;
+
+    /// Bound on the absolute rounding error of one edge term: `(a x b)_z` is a difference of
+    /// products of the (scaled) coordinates, off by a few ulps of 1 whatever the edge's length,
+    /// and the factor `theta / |a x b|` is accurate (for a tiny edge both parts of the ratio come
+    /// from the same `|a x b|`). So the sum of a ring of width `h` (about `h^2`) is decided by
+    /// its sign only above roughly `h = 1e-7`; smaller regions take the exact path.
+    const TERM_ROUNDING: f64 = 64.0 * f64::EPSILON;
+
+    fn new() -> Self {
+        Self {
+            sum: 0.0,
+            re: 1.0,
+            im: 0.0,
+            crossings: 0,
+            edges: 0,
+            any_below: false,
+            magnitude: 0.0,
+        }
+    }
+
+    /// Adds the edge `a -> b` (vectors of any positive length); `None` when `a` lies on the
+    /// horizon (or is zero or not finite), where the exact path must decide.
+    #[inline(always)]
+    fn add_edge(&mut self, ra: Ray, rb: Ray, edge: impl Fn(Ray, Ray) -> f64) -> Option<()> {
+        let (a, b) = (ra.v, rb.v);
+        // Written so that NaN and infinite components also bail out.
+        if !(a.z * a.z > Self::ON_HORIZON2 * ra.len2) {
+            return None;
+        }
+        self.edges += 1;
+        match (a.z > 0.0, b.z > 0.0) {
+            (true, true) => {
+                let t = edge(ra, rb);
+                self.sum += t;
+                self.magnitude += t.abs();
+            }
+            (false, false) => self.any_below = true,
+            (up_a, _) => {
+                self.any_below = true;
+                // The crossing point, as a positive combination of a and b on the horizon.
+                let x = if up_a {
+                    b * a.z - a * b.z
+                } else {
+                    a * b.z - b * a.z
+                };
+                let x = Ray::new(DVec3::new(x.x, x.y, 0.0));
+                let (pr, pi) = (x.v.x, if up_a { -x.v.y } else { x.v.y });
+                let (re, im) = (self.re * pr - self.im * pi, self.re * pi + self.im * pr);
+                // Only the argument matters: keep the product's magnitude in range.
+                let size = re.abs() + im.abs();
+                (self.re, self.im) = if (1e-100..=1e100).contains(&size) {
+                    (re, im)
+                } else {
+                    (re / size, im / size)
+                };
+                self.crossings += 1;
+                self.sum += if up_a { edge(ra, x) } else { edge(x, rb) };
+            }
+        }
+        Some(())
+    }
+
+    /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
+    /// (the pairing of the horizon arcs is then unknown here).
+    fn finish(self) -> Option<f64> {
+        let horizon = if self.crossings > 0 {
+            crate::math::atan2(self.im, self.re).rem_euclid(2.0 * PI)
+        } else if self.edges == 0 {
+            0.0
+        } else if !self.any_below {
+            // Every edge strictly above: the horizon is wholly inside or wholly outside. Outside,
+            // the region lies in the upper hemisphere and the edge sum is 2 pi times its
+            // (positive) integral; inside, the complement does and the sum is minus 2 pi times
+            // the complement's integral. So the sign decides, unless it is within the rounding
+            // (or the rational edge factor's error) of zero: a region of almost no integral on
+            // one side or the other, left to the exact path.
+            let margin =
+                Self::SIGN_MARGIN * self.magnitude + Self::TERM_ROUNDING * self.edges as f64;
+            if self.sum < -margin {
+                2.0 * PI
+            } else if self.sum > margin {
+                0.0
+            } else {
+                return None;
+            }
+        } else {
+            return None;
+        };
+        Some(((self.sum + horizon) / (2.0 * PI)).clamp(0.0, 1.0))
+    }
+}
+
+/// Runs the clip-free sum on the images of the polygon's vertices under `m`; `None` when the
+/// exact path is needed.
 fn transformed_clip_free(
     poly: &SphericalPolygon,
     m: glam::DMat3,
-    edge: impl Fn(DVec3, DVec3) -> f64,
+    edge: impl Fn(Ray, Ray) -> f64 + Copy,
 ) -> Option<f64> {
-    let mut buf: SmallVec<[DVec3; 16]> = SmallVec::new();
-    let mut ends: SmallVec<[usize; 2]> = SmallVec::new();
-    for ring in poly.rings() {
-        for &v in ring {
-            buf.push((m * v).try_normalize()?);
-        }
-        ends.push(buf.len());
+    let (x, y, z) = (m.x_axis, m.y_axis, m.z_axis);
+    if y == DVec3::Y && x.y == 0.0 && z.y == 0.0 {
+        // The form of the fitted tables' matrices (HDHN16 §4.1): `y` passes unchanged, so four
+        // products per vertex instead of nine; the images are the same.
+        ring_sum(
+            poly.rings(),
+            |v| DVec3::new(x.x * v.x + z.x * v.z, v.y, x.z * v.x + z.z * v.z),
+            edge,
+        )
+    } else {
+        ring_sum(poly.rings(), |v| m * v, edge)
     }
-    let mut start = 0;
-    let rings = ends.iter().map(|&e| {
-        let r = &buf[start..e];
-        start = e;
-        r
-    });
-    clip_free_sum(rings, edge)
 }
 
 #[cfg(test)]
@@ -308,9 +446,9 @@ mod tests {
         let a = DVec3::new(1.0, 0.0, 0.0);
         let b = DVec3::new(1.0, 1e-9, 0.0).normalize();
         // theta * (a x b)_z / |a x b| -> theta for an edge on the horizon going counter-clockwise.
-        assert!((edge_term(a, b) - 1e-9).abs() < 1e-24);
+        assert!((edge_term(Ray::new(a), Ray::new(b)) - 1e-9).abs() < 1e-24);
         let c = DVec3::new(-1.0, 1e-9, 0.0).normalize();
-        assert!((edge_term(a, c) - (PI - 1e-9)).abs() < 1e-15);
+        assert!((edge_term(Ray::new(a), Ray::new(c)) - (PI - 1e-9)).abs() < 1e-15);
     }
 
     #[test]

@@ -41,6 +41,9 @@ pub mod ggx;
 mod integrate;
 mod table;
 #[rustfmt::skip]
+// The generated channel arrays are constants read only at compile time, where `table.rs`
+// interleaves them into one static of nodes; no copy of them exists at run time.
+#[allow(clippy::large_const_arrays)]
 mod table_data;
 
 pub use distribution::Ltc;

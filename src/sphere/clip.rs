@@ -298,18 +298,23 @@ fn entry_turn(scratch: &[DVec3], n: DVec3, to: &Chain) -> f64 {
 /// In the gnomonic plane about `c` the rings are closed polygons and the circle is at infinity;
 /// the unbounded face is inside the region iff the outermost rings run clockwise, i.e. iff the
 /// total signed area is negative (nested rings alternate and are smaller than their parents).
-/// The projected cross product is `(p x q) . c / ((p . c)(q . c))`.
+/// Each ring's shoelace sum is taken about its own first vertex: summing `P_i x P_{i+1}` about the
+/// plane's origin instead adds terms of the size of the ring's distance from `c` times its width,
+/// whose rounding swamps the area of a ring of 1e-8 rad or less (fuzz-like finding: a polygon of
+/// 3e-12 rad clipped to its complement).
 fn winds_clockwise_about(poly: &SphericalPolygon, c: DVec3) -> Option<bool> {
     let mut area2 = 0.0;
     for ring in poly.rings() {
-        let m = ring.len();
-        for i in 0..m {
-            let (p, q) = (ring[i], ring[(i + 1) % m]);
-            let (wp, wq) = (p.dot(c), q.dot(c));
-            if !(wp > HORIZON_TOLERANCE) {
-                return None;
-            }
-            area2 += p.cross(q).dot(c) / (wp * wq);
+        let project = |p: DVec3| {
+            let w = p.dot(c);
+            (w > HORIZON_TOLERANCE).then(|| p / w)
+        };
+        let origin = project(*ring.first()?)?;
+        let mut prev = DVec3::ZERO;
+        for &p in &ring[1..] {
+            let d = project(p)? - origin;
+            area2 += prev.cross(d).dot(c);
+            prev = d;
         }
     }
     Some(area2 < 0.0)
