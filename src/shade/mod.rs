@@ -57,6 +57,7 @@ pub mod demo;
 pub mod mesh;
 pub mod reference;
 pub mod scene;
+mod separation;
 pub mod silhouette;
 
 pub use brdf::Material;
