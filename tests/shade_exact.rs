@@ -5,11 +5,16 @@
 //! ray-triangle visibility with the same opacity model: occluders, other lights and a mesh
 //! light's own triangles block).
 //!
-//! Confidence bound, as in tests/shade_mc.rs: with the LTC BRDF the analytic value and the
-//! estimate are the same integral, so per point and channel `|analytic - mc| <= 4 sigma_hat +
-//! 1e-6` (a normal deviate exceeds 4 sigma with probability 6e-5; seeds are fixed, so the outcome
-//! is deterministic; the `1e-6` floor covers slivers no sample hits). A bias too small for any one
-//! point shows in the mean z-score, which must stay within `4 / sqrt(points)`.
+//! Confidence bound, in the style of tests/shade_mc.rs: with the LTC BRDF the analytic value and
+//! the estimate are the same integral, so per point and channel `|analytic - mc| <= 4.5
+//! sigma_hat + 1e-6`, with `sigma_hat` the estimator's standard error (the `1e-6` floor covers
+//! slivers no sample hits). The file makes about 8 x 900 such checks (the two methods share the
+//! estimates), so the per-check level must be a Bonferroni share of the family's: a normal
+//! deviate exceeds 4.5 sigma with probability 6.8e-6, which keeps the chance of any false alarm
+//! in the file below 5% (at 4 sigma, 6.3e-5 per check, about one false alarm per run would be
+//! expected; one was seen, |z| = 4.05 on one channel, which 400 000 samples at that point
+//! resolved to |z| < 1.3). Seeds are fixed, so the outcome is deterministic. A bias too small for
+//! any one point shows in the mean z-score, which must stay within `4 / sqrt(points)`.
 //!
 //! Every scene here fails with the old rule (subtract every culled occluder's whole projection,
 //! lights transparent to each other; checked once against the old `Scene::shade`): each test
@@ -78,7 +83,7 @@ fn run(scene: &Scene, method: Method, count: usize, h: f64, seed: u64) -> Report
                     zn += 1;
                 }
             }
-            if (av - mv).abs() > 4.0 * s + 1e-6 {
+            if (av - mv).abs() > 4.5 * s + 1e-6 {
                 failures.push(format!(
                     "point {i} x {x} ch {c}: analytic {av} mc {mv} +- {s}"
                 ));
@@ -368,4 +373,123 @@ fn occluder_in_the_gap_of_a_closed_non_convex_light() {
     )
     .unwrap();
     check("closed two-box light with occluder", &scene, 300, 2.0, 27);
+}
+
+#[test]
+fn occluders_touching_lights() {
+    // Contacts, where the blocker and the light share points of the light's plane:
+    // - a box hanging from a downward quad light, its top face in the quad's plane (it hides
+    //   what it covers: rays reach the contact only through the box);
+    // - a box standing on the back of the same quad (it hides nothing);
+    // - a box beside a cuboid light, sharing the plane of its bottom face and overlapping it
+    //   sideways (it hides part of the side faces, nothing of the bottom face).
+    let scene = Scene::new(
+        vec![
+            light(
+                quad(DVec3::new(-0.5, 0.0, 2.5), 0.6, true),
+                DVec3::new(1.0, 2.0, 3.0),
+            ),
+            light(
+                cuboid(DVec3::new(1.0, 0.0, 2.4), DVec3::new(0.4, 0.4, 0.2)),
+                DVec3::new(2.0, 1.0, 1.0),
+            ),
+        ],
+        vec![
+            cuboid(DVec3::new(-0.2, 0.2, 2.3), DVec3::new(0.25, 0.2, 0.2)).into(),
+            cuboid(DVec3::new(-0.7, -0.1, 2.8), DVec3::new(0.3, 0.3, 0.3)).into(),
+            cuboid(DVec3::new(1.45, 0.1, 2.3), DVec3::new(0.2, 0.2, 0.1)).into(),
+        ],
+    )
+    .unwrap();
+    check("contacts", &scene, 300, 2.0, 28);
+}
+
+#[test]
+fn shading_never_fails_on_degenerate_points() {
+    // Shading points on light and occluder vertices, edge midpoints, in face planes and inside
+    // objects, with random normals and views, in the scenes above: both methods must return a
+    // finite, non-negative radiance (or, for the per-triangle method only, an error of the
+    // sphere layer, counted and required to be rare), never panic.
+    let scenes = [
+        Scene::new(
+            vec![
+                light(quad(DVec3::new(0.0, 0.0, 2.5), 0.6, true), DVec3::ONE),
+                light(
+                    ConvexPolyhedron::icosphere(DVec3::new(0.35, 0.15, 3.2), 0.5, 1).unwrap(),
+                    DVec3::ONE,
+                ),
+            ],
+            vec![
+                cuboid(DVec3::new(0.45, 0.1, 2.5), DVec3::new(0.3, 0.25, 0.4)).into(),
+                cuboid(DVec3::new(0.35, 0.15, 3.2), DVec3::new(0.1, 0.1, 1.0)).into(),
+            ],
+        )
+        .unwrap(),
+        Scene::new(
+            vec![light(
+                quad(DVec3::new(-0.2, 0.0, 2.0), 0.5, false)
+                    .merged(&quad(DVec3::new(0.4, 0.1, 3.0), 0.6, true))
+                    .unwrap(),
+                DVec3::ONE,
+            )],
+            vec![cuboid(DVec3::new(0.5, 0.0, 2.5), DVec3::new(0.25, 0.25, 0.2)).into()],
+        )
+        .unwrap(),
+    ];
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
+    let mut rng = Pcg32::new(77, 13);
+    let dir = |rng: &mut Pcg32| {
+        let z = 2.0 * rng.next_f64() - 1.0;
+        let phi = std::f64::consts::TAU * rng.next_f64();
+        let r = (1.0 - z * z).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let (mut failures, mut per_tri_errors, mut total) = (Vec::new(), 0, 0);
+    for scene in &scenes {
+        let meshes: Vec<&TriangleMesh> = scene
+            .occluders()
+            .iter()
+            .chain(scene.lights().iter().map(|l| l.shape()))
+            .map(|s| s.mesh())
+            .collect();
+        for i in 0..1500 {
+            let mesh = meshes[i % meshes.len()];
+            let t = (rng.next_u32() as usize) % mesh.triangle_count();
+            let [a, b, c] = mesh.triangle(t);
+            let x = match i % 5 {
+                0 => a,
+                1 => (a + b) / 2.0,
+                // In the triangle's plane, outside it.
+                2 => a + (b - a) * (1.0 + 2.0 * rng.next_f64()) + (c - a) * rng.next_f64(),
+                3 => (a + b + c) / 3.0,
+                _ => DVec3::new(
+                    3.0 * rng.next_f64() - 1.5,
+                    3.0 * rng.next_f64() - 1.5,
+                    4.0 * rng.next_f64(),
+                ),
+            };
+            let (n, v) = (dir(&mut rng), dir(&mut rng));
+            for method in [Method::Silhouette, Method::PerTriangle] {
+                total += 1;
+                match scene.clone().with_method(method).shade(x, n, v, &m) {
+                    Ok(c) if c.is_finite() && c.min_element() >= 0.0 => {}
+                    Err(e) if method == Method::PerTriangle => {
+                        per_tri_errors += 1;
+                        eprintln!("per-triangle x {x} n {n} v {v}: {e}");
+                    }
+                    other => failures.push(format!("{method:?} x {x} n {n} v {v}: {other:?}")),
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    assert!(
+        per_tri_errors * 1000 <= total,
+        "{per_tri_errors} per-triangle errors in {total} evaluations"
+    );
 }
