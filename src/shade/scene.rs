@@ -569,8 +569,9 @@ impl Scene {
         frame: &ShadingFrame,
     ) -> Result<SphericalPolygon, GeomError> {
         let up = DVec3::Z;
-        let x = frame.origin();
+        let (x, up_world) = (frame.origin(), frame.normal());
         let (n, a) = (light_mesh.triangle_normal(f), light_mesh.triangle(f)[0]);
+        let face_bound = triangle_bound(light_mesh.triangle(f));
         let bm = blocker.mesh();
         // Seen from outside a convex blocker, a ray enters through a front triangle before it can
         // meet a back one, so the back ones add nothing.
@@ -578,6 +579,10 @@ impl Scene {
             && (0..bm.triangle_count()).any(|t| triangle_side(bm, t, x) > 0);
         for t in 0..bm.triangle_count() {
             if (!external && t == f) || (front_only && triangle_side(bm, t, x) < 0) {
+                continue;
+            }
+            // Only a triangle whose cone from x meets the face's can hide part of it.
+            if !may_occlude(x, up_world, face_bound, triangle_bound(bm.triangle(t))) {
                 continue;
             }
             let dist = bm.triangle(t).map(|v| {
@@ -672,19 +677,7 @@ impl Scene {
             (shape, _) => {
                 let mesh = shape.mesh();
                 for t in 0..mesh.triangle_count() {
-                    let tri = mesh.triangle(t);
-                    let c = (tri[0] + tri[1] + tri[2]) / 3.0;
-                    let r =
-                        tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max) * (1.0 + 1e-12);
-                    if !may_occlude(
-                        x,
-                        n,
-                        lb,
-                        BoundingSphere {
-                            center: c,
-                            radius: r,
-                        },
-                    ) {
+                    if !may_occlude(x, n, lb, triangle_bound(mesh.triangle(t))) {
                         continue;
                     }
                     if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Blocker)? {
@@ -697,6 +690,17 @@ impl Scene {
             }
         }
         Ok(())
+    }
+}
+
+/// A sphere holding a triangle (about its centroid, padded by a relative ulp margin), for the
+/// per-triangle culling.
+fn triangle_bound(tri: [DVec3; 3]) -> BoundingSphere {
+    let c = (tri[0] + tri[1] + tri[2]) / 3.0;
+    let r = tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max) * (1.0 + 1e-12);
+    BoundingSphere {
+        center: c,
+        radius: r,
     }
 }
 
