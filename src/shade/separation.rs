@@ -9,6 +9,13 @@
 //! always exists, and per shading point the decision is one dot product; the per-face handling of
 //! [`crate::shade::Scene::visible_region`] is left for blockers that interpenetrate a light.
 //!
+//! Why not the simpler per-point test "every blocker vertex on the point's side of every front
+//! face plane": a light's nearly edge-on front faces have planes passing close to the point, and
+//! most of the cone towards the light lies behind them, so the test fails for many occluders that
+//! are plainly in front. On 3000 random ground points of the demo scene it recognised 1790 of
+//! the 3278 (point, light, occluder) triples that survive culling; the separating plane decides
+//! all of them.
+//!
 //! The plane comes from the point of the Minkowski difference `hull(blocker) - hull(light)`
 //! nearest the origin (Wolfe's minimum-norm-point algorithm, Wolfe 1976, run on the difference
 //! through its support function as in GJK; Gilbert, Johnson, Keerthi 1988), and is then verified
