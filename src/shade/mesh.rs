@@ -803,6 +803,30 @@ mod tests {
     }
 
     #[test]
+    fn closedness() {
+        let cube = ConvexPolyhedron::cuboid(DVec3::ZERO, DVec3::ONE).unwrap();
+        assert!(cube.mesh().is_closed());
+        let quad = TriangleMesh::quad(DVec3::ZERO, DVec3::X, DVec3::Y).unwrap();
+        assert!(!quad.is_closed());
+        // Two closed parts are closed; a closed part plus a sheet is not.
+        assert!(cube.mesh().merged(cube.mesh()).unwrap().is_closed());
+        assert!(!cube.mesh().merged(&quad).unwrap().is_closed());
+        // A triangle and its reverse form a closed (two-sided) surface; a repeated triangle does
+        // not.
+        let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        assert!(
+            TriangleMesh::new(v.clone(), vec![[0, 1, 2], [0, 2, 1]])
+                .unwrap()
+                .is_closed()
+        );
+        assert!(
+            !TriangleMesh::new(v, vec![[0, 1, 2], [0, 1, 2], [0, 2, 1]])
+                .unwrap()
+                .is_closed()
+        );
+    }
+
+    #[test]
     fn invalid_meshes_are_errors() {
         let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
         assert!(matches!(

@@ -442,6 +442,69 @@ mod tests {
     }
 
     #[test]
+    fn a_cut_triangle_splits_its_solid_angle() {
+        // The parts of a triangle on either side of a plane cover, together, what the triangle
+        // covers: solid angles add up, for cuts through edges and through a corner, seen from
+        // both sides; a triangle in the plane, or behind it, covers nothing.
+        let f = ShadingFrame::new(DVec3::new(0.1, -0.2, 0.0), DVec3::Z, DVec3::X).unwrap();
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for case in 0..200 {
+            let c = DVec3::new(next(), next(), 2.0 + next());
+            let mut v: Vec<DVec3> = (0..3)
+                .map(|_| c + DVec3::new(next(), next(), next()))
+                .collect();
+            let n = DVec3::new(next(), next(), next()).normalize();
+            let mut a = c + DVec3::new(next(), next(), next()) * 0.3;
+            if case % 4 == 0 {
+                a = v[0]; // the plane through a corner
+            }
+            if case % 2 == 1 {
+                v.swap(1, 2); // seen from the back
+            }
+            let mesh = TriangleMesh::new(v, vec![[0, 1, 2]]).unwrap();
+            let whole = triangle_polygon(&mesh, 0, &f, TriangleRole::Blocker)
+                .unwrap()
+                .map_or(0.0, |p| p.solid_angle());
+            let d = mesh.triangle(0).map(|p| n.dot(p - a));
+            // Every corner of a part, taken back to the triangle's plane along its ray, lies on
+            // the kept side of the cutting plane (`sign` 1: n . (q - a) >= 0, -1: <= 0).
+            let (tn, t0) = (mesh.triangle_normal(0), mesh.triangle(0)[0]);
+            let on_side = |p: &SphericalPolygon, sign: f64| {
+                p.rings().flatten().all(|&l| {
+                    let w = f.dir_to_world(l);
+                    let q = f.origin() + w * (tn.dot(t0 - f.origin()) / tn.dot(w));
+                    sign * n.dot(q - a) >= -1e-12
+                })
+            };
+            let part = |d: [f64; 3], sign: f64| {
+                let p = clipped_triangle_polygon(&mesh, 0, d, &f).unwrap();
+                assert!(p.as_ref().is_none_or(|p| on_side(p, sign)), "case {case}");
+                p.map_or(0.0, |p| p.solid_angle())
+            };
+            let (pos, neg) = (part(d, 1.0), part(d.map(|x| -x), -1.0));
+            assert!(
+                (pos + neg - whole).abs() <= 1e-12 * (1.0 + whole),
+                "case {case}: {pos} + {neg} vs {whole}"
+            );
+            assert!(part([0.0; 3], 1.0) == 0.0 && part([-1.0, -2.0, 0.0], 1.0) == 0.0);
+            assert!(
+                (clipped_triangle_polygon(&mesh, 0, [1.0, 0.0, 2.0], &f)
+                    .unwrap()
+                    .map_or(0.0, |p| p.solid_angle())
+                    - whole)
+                    .abs()
+                    <= 1e-15
+            );
+        }
+    }
+
+    #[test]
     fn per_triangle_sum_equals_silhouette_for_convex() {
         let ico = ConvexPolyhedron::icosphere(DVec3::new(0.3, -0.2, 3.0), 1.0, 1).unwrap();
         let f = ShadingFrame::new(DVec3::new(0.1, 0.2, 0.0), DVec3::Z, DVec3::X).unwrap();
