@@ -8,19 +8,20 @@
 //! Confidence bound, in the style of tests/shade_mc.rs: with the LTC BRDF the analytic value and
 //! the estimate are the same integral, so per point and channel `|analytic - mc| <= 4.5
 //! sigma_hat + 1e-6`, with `sigma_hat` the estimator's standard error (the `1e-6` floor covers
-//! slivers no sample hits). The file makes about 8 x 900 such checks (the two methods share the
-//! estimates), so the per-check level must be a Bonferroni share of the family's: a normal
-//! deviate exceeds 4.5 sigma with probability 6.8e-6, which keeps the chance of any false alarm
-//! in the file below 5% (at 4 sigma, 6.3e-5 per check, about one false alarm per run would be
-//! expected; one was seen, |z| = 4.05 on one channel, which 400 000 samples at that point
-//! resolved to |z| < 1.3). Seeds are fixed, so the outcome is deterministic. A bias too small for
-//! any one point shows in the mean z-score, which must stay within `4 / sqrt(points)`.
+//! slivers no sample hits). The file makes about 9 000 such checks (8 scenes x 900 and 24 random
+//! scenes x 75; the two methods share the estimates), so the per-check level must be a Bonferroni
+//! share of the family's: a normal deviate exceeds 4.5 sigma with probability 6.8e-6, which keeps
+//! the chance of any false alarm in the file near 6%. At 4 sigma (6.3e-5 per check) about one
+//! false alarm per run would be expected; one was seen, |z| = 4.05 on one channel, which 400 000
+//! samples at that point resolved to |z| < 1.3. Seeds are fixed, so the outcome is
+//! deterministic. A bias too small for any one point shows in the mean z-score, which must stay
+//! within `4 / sqrt(points)`.
 //!
-//! Every scene here fails with the old rule (subtract every culled occluder's whole projection,
-//! lights transparent to each other; checked once against the old `Scene::shade`): each test
-//! also asserts that the scene is one where the rule matters, by recomputing the old rule's
-//! diffuse integral from the public geometry API and counting the points where it differs from
-//! the new visible region's by more than 2%.
+//! Every Monte Carlo test here fails with the old rule (subtract every culled occluder's whole
+//! projection, lights transparent to each other; checked once against the old `Scene::shade`).
+//! The eight hand-built scenes also assert that they are scenes where the rule matters, by
+//! recomputing the old rule's diffuse integral from the public geometry API and counting the
+//! points where it differs from the new visible region's by more than 2%.
 
 use arealight::glam::DVec3;
 use arealight::ltc::clamped_cosine_integral;
@@ -492,4 +493,74 @@ fn shading_never_fails_on_degenerate_points() {
         per_tri_errors * 1000 <= total,
         "{per_tri_errors} per-triangle errors in {total} evaluations"
     );
+}
+
+#[test]
+fn random_scenes_with_interpenetrating_objects() {
+    // Random lights (quad, cuboid, icosphere, frustum, two-sheet mesh) with random boxes,
+    // icospheres and rods placed so that they often cut through the light, touch it or sit behind
+    // it, and a second light nearby: 24 scenes, 25 ground points each.
+    let mut rng = Pcg32::new(31, 14);
+    let mut r = |lo: f64, hi: f64| lo + (hi - lo) * rng.next_f64();
+    for case in 0..24u64 {
+        let c = DVec3::new(r(-0.5, 0.5), r(-0.5, 0.5), r(2.0, 3.0));
+        let size = r(0.3, 0.7);
+        let shape: Shape = match case % 5 {
+            0 => quad(c, size, true).into(),
+            1 => cuboid(c, DVec3::new(size, r(0.2, 0.6), r(0.1, 0.4))).into(),
+            2 => ConvexPolyhedron::icosphere(c, size, 1).unwrap().into(),
+            3 => ConvexPolyhedron::frustum(
+                c,
+                DVec3::new(r(-0.3, 0.3), r(-0.3, 0.3), r(0.3, 0.8)),
+                size * 0.6,
+                size * 0.3,
+                7,
+            )
+            .unwrap()
+            .into(),
+            _ => quad(c, size, true)
+                .merged(&quad(
+                    c + DVec3::new(r(-0.4, 0.4), 0.0, r(0.4, 0.8)),
+                    size,
+                    true,
+                ))
+                .unwrap()
+                .into(),
+        };
+        let second = light(
+            cuboid(
+                c + DVec3::new(r(-1.2, 1.2), r(-1.2, 1.2), r(-0.2, 0.8)),
+                DVec3::splat(r(0.15, 0.35)),
+            ),
+            DVec3::new(0.5, 1.0, 1.5),
+        );
+        let mut occluders: Vec<Shape> = Vec::new();
+        for k in 0..2 {
+            let o = c + DVec3::new(r(-0.7, 0.7), r(-0.7, 0.7), r(-0.7, 0.5));
+            occluders.push(match (case + k) % 3 {
+                0 => cuboid(o, DVec3::new(r(0.1, 0.4), r(0.1, 0.4), r(0.1, 0.4))).into(),
+                1 => ConvexPolyhedron::icosphere(o, r(0.1, 0.35), 1)
+                    .unwrap()
+                    .into(),
+                _ => cuboid(o, DVec3::new(0.08, 0.08, r(0.4, 1.0))).into(),
+            });
+        }
+        let scene = Scene::new(
+            vec![light(shape, DVec3::new(1.5, 1.0, 0.5)), second],
+            occluders,
+        )
+        .unwrap();
+        let name = format!("random scene {case}");
+        let mut all = Vec::new();
+        for method in [Method::Silhouette, Method::PerTriangle] {
+            let rep = run(&scene, method, 25, 2.0, 100 + case);
+            all.extend(rep.failures.into_iter().map(|f| format!("{method:?} {f}")));
+        }
+        assert!(
+            all.is_empty(),
+            "{name}: {} failures:\n{}",
+            all.len(),
+            all.join("\n")
+        );
+    }
 }
