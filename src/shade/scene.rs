@@ -172,7 +172,9 @@ impl Scene {
     /// A scene with the default [`Method::Silhouette`].
     ///
     /// Computes, once for the scene, a separating plane between every light and every other
-    /// object (the fast path of [`Scene::visible_region`]).
+    /// object (the fast path of [`Scene::visible_region`]): `lights x (occluders + lights)`
+    /// minimum-norm-point runs, each a few passes over the two vertex lists (and, only for hulls
+    /// that touch, one scan of their face normals).
     ///
     /// # Errors
     ///
