@@ -102,6 +102,9 @@ pub struct TriangleMesh {
     radius: f64,
     /// All triangles in one plane, facing the same way.
     planar: bool,
+    /// Every directed edge has exactly one reversed twin (a closed, consistently oriented
+    /// surface).
+    closed: bool,
 }
 
 impl TriangleMesh {
@@ -142,6 +145,7 @@ impl TriangleMesh {
             && vertices
                 .iter()
                 .all(|v| n0.dot(*v - p0).abs() <= FACE_TOLERANCE * radius);
+        let closed = is_closed(&triangles);
         Ok(TriangleMesh {
             vertices,
             triangles,
@@ -149,6 +153,7 @@ impl TriangleMesh {
             center,
             radius,
             planar,
+            closed,
         })
     }
 
@@ -214,6 +219,18 @@ impl TriangleMesh {
         self.planar
     }
 
+    /// Whether the mesh is a closed, consistently oriented surface: every directed edge `a -> b`
+    /// of a triangle has exactly one reversed twin `b -> a` in another triangle (by vertex index).
+    ///
+    /// Seen from outside a closed mesh, every ray that meets the mesh meets a front face first
+    /// (it has to enter), which is why the union of the front faces is the region a closed light
+    /// covers; an open mesh (sheets) can show a back face first, which then hides what lies
+    /// behind it.
+    #[must_use]
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
     /// The mesh of all triangles of `self` and `other` (no vertices are merged).
     ///
     /// # Errors
@@ -235,6 +252,22 @@ impl TriangleMesh {
         triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + n as u32)));
         TriangleMesh::new(vertices, triangles)
     }
+}
+
+/// Whether every directed edge of `triangles` has exactly one reversed twin and no directed edge
+/// repeats (see [`TriangleMesh::is_closed`]).
+fn is_closed(triangles: &[[u32; 3]]) -> bool {
+    let mut directed: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    directed.sort_unstable();
+    if directed.windows(2).any(|w| w[0] == w[1]) {
+        return false;
+    }
+    directed
+        .iter()
+        .all(|&(a, b)| directed.binary_search(&(b, a)).is_ok())
 }
 
 /// Unit normal of the triangle `(a, b, c)` (counter-clockwise seen from the side it points to),
@@ -767,6 +800,30 @@ mod tests {
                 2
             );
         }
+    }
+
+    #[test]
+    fn closedness() {
+        let cube = ConvexPolyhedron::cuboid(DVec3::ZERO, DVec3::ONE).unwrap();
+        assert!(cube.mesh().is_closed());
+        let quad = TriangleMesh::quad(DVec3::ZERO, DVec3::X, DVec3::Y).unwrap();
+        assert!(!quad.is_closed());
+        // Two closed parts are closed; a closed part plus a sheet is not.
+        assert!(cube.mesh().merged(cube.mesh()).unwrap().is_closed());
+        assert!(!cube.mesh().merged(&quad).unwrap().is_closed());
+        // A triangle and its reverse form a closed (two-sided) surface; a repeated triangle does
+        // not.
+        let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        assert!(
+            TriangleMesh::new(v.clone(), vec![[0, 1, 2], [0, 2, 1]])
+                .unwrap()
+                .is_closed()
+        );
+        assert!(
+            !TriangleMesh::new(v, vec![[0, 1, 2], [0, 1, 2], [0, 2, 1]])
+                .unwrap()
+                .is_closed()
+        );
     }
 
     #[test]

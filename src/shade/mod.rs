@@ -8,20 +8,30 @@
 //! - [`cull`]: discarding occluders that cannot lie between the point and a light (`GetBetween`).
 //! - [`brdf`]: [`Material`] (Lambert + GGX with Schlick's Fresnel).
 //! - [`demo`]: the test scene of seed 000 (Fig. 4), shared by the render example, tests and benches.
-//! - [`scene`]: [`Scene::shade`], the analytic radiance at a shading point.
+//! - [`scene`]: [`Scene::shade`], the analytic radiance at a shading point, with the exact
+//!   visibility rule of [`Scene::visible_region`]: a blocker hides a light face only with its
+//!   part on the point's side of the face's plane. Blockers whose convex hull is disjoint from
+//!   the light's are decided by a separating plane computed once per scene (a private module,
+//!   `separation`), so the silhouette path stays as fast as plain subtraction; blockers that
+//!   interpenetrate a light are cut by its face planes.
 //! - [`reference`](mod@reference): a Monte Carlo estimator of the same radiance (solid-angle sampling of the
 //!   lights' triangles, exact ray-triangle visibility), with its standard error, for tests and
 //!   comparisons.
 //!
 //! # Limitations
 //!
-//! - Lights do not block each other; occluders block every light.
-//! - An occluder partly behind a light (interpenetrating it) is subtracted as if it were in
-//!   front; culling removes occluders entirely behind the light.
+//! - Every object is opaque: occluders block every light, lights block each other (both sides),
+//!   and a non-planar mesh light blocks itself. There are no transparent or emit-only objects.
+//! - A blocker that interpenetrates a light and straddles some of its face planes makes that
+//!   light go face by face (one spherical triangle per front face, minus cut blocker
+//!   triangles): exact, but many spherical booleans, so much slower than the silhouette path.
+//!   Open non-planar mesh lights always go face by face (their own back faces can hide them).
+//! - A shading point inside a closed light: the silhouette path counts the whole sphere, the
+//!   face-by-face path and the Monte Carlo reference nothing (no front face is seen).
 //! - The per-triangle path (meshes, and [`Method::PerTriangle`]) chains many spherical booleans
-//!   of edge-sharing triangles; on a few near-degenerate configurations (about 1 shading point in
-//!   1000 in the tests) the `sphere` layer reports [`crate::GeomError::Degenerate`]. The
-//!   silhouette path of convex shapes has not been seen to fail.
+//!   of edge-sharing triangles; on a few near-degenerate configurations the `sphere` layer may
+//!   report [`crate::GeomError::Degenerate`] (none in the current tests). The silhouette path
+//!   of convex shapes has not been seen to fail.
 //!
 //! # Examples
 //!
@@ -57,6 +67,7 @@ pub mod demo;
 pub mod mesh;
 pub mod reference;
 pub mod scene;
+mod separation;
 pub mod silhouette;
 
 pub use brdf::Material;

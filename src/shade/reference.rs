@@ -3,15 +3,17 @@
 //! Each light is sampled by solid angle over its front-facing triangles (Arvo's spherical
 //! triangle sampling, [`SphericalTriangle`]; thesis 003 section 6), a triangle chosen with
 //! probability proportional to its solid angle, so every sample has density `1 / Omega` with
-//! `Omega` the summed solid angle. Visibility is exact: the sample's ray is intersected with every
-//! triangle of every occluder (no culling, so the analytic path's culling is checked too), and of
-//! the light's own mesh for non-convex lights (self-occlusion). The estimator returns its mean and
+//! `Omega` the summed solid angle. Visibility is exact and brute force, the same opacity model as
+//! [`Scene`]'s: the sample's ray is intersected with every triangle of every occluder and of
+//! every other light (no culling and no separating planes, so the analytic path's shortcuts are
+//! checked too), and of the light's own mesh for mesh lights (self-occlusion); any hit strictly
+//! before the sampled point on the light blocks the sample. The estimator returns its mean and
 //! standard error, so tests can state a confidence bound.
 //!
-//! Like the analytic path, lights do not block each other, and only the outer (front) side of a
-//! light emits: a shading point inside a closed light sees none of its triangles from the front
-//! and gets nothing here, where the analytic path counts the whole sphere (the one configuration
-//! where the two differ; no scene meant for rendering has it).
+//! Only the outer (front) side of a light emits: a shading point inside a closed light sees none
+//! of its triangles from the front and gets nothing here, where the analytic silhouette path
+//! counts the whole sphere (the one configuration where the two differ; no scene meant for
+//! rendering has it).
 
 use alloc::vec::Vec;
 
@@ -198,16 +200,21 @@ impl MonteCarlo {
         let mut rng = Pcg32::new(seed, 0x5ade);
         let n = self.samples_per_light.max(1);
         let x = frame.origin();
-        let occluder_bounds: Vec<(DVec3, f64)> = scene
+        // Every object that can block a sample: the occluders, then the lights (a light is
+        // skipped as a blocker of itself; its own mesh is checked separately when it is not
+        // convex).
+        let no = scene.occluders().len();
+        let blockers: Vec<(&super::mesh::TriangleMesh, (DVec3, f64))> = scene
             .occluders()
             .iter()
-            .map(|o| o.mesh().bounding_sphere())
+            .chain(scene.lights().iter().map(|l| l.shape()))
+            .map(|o| (o.mesh(), o.mesh().bounding_sphere()))
             .collect();
         let mut mean = DVec3::ZERO;
         let mut var = DVec3::ZERO;
         let mut tris: Vec<(SphericalTriangle, usize)> = Vec::new();
         let mut cdf: Vec<f64> = Vec::new();
-        for light in scene.lights() {
+        for (li, light) in scene.lights().iter().enumerate() {
             let mesh = light.shape().mesh();
             tris.clear();
             cdf.clear();
@@ -261,8 +268,11 @@ impl MonteCarlo {
                 };
                 let mut blocked = self_occluding && blocked_by(mesh, Some(ti));
                 if !blocked {
-                    for (o, &(c, r)) in scene.occluders().iter().zip(&occluder_bounds) {
-                        if ray_meets_sphere(x, w, c, r, t_max) && blocked_by(o.mesh(), None) {
+                    for (j, &(m, (c, r))) in blockers.iter().enumerate() {
+                        if j != no + li
+                            && ray_meets_sphere(x, w, c, r, t_max)
+                            && blocked_by(m, None)
+                        {
                             blocked = true;
                             break;
                         }

@@ -3,11 +3,16 @@
 use alloc::vec::Vec;
 
 use glam::{DMat3, DVec3};
+use smallvec::SmallVec;
 
 use super::brdf::Material;
 use super::cull::{BoundingSphere, above_horizon, may_occlude};
-use super::mesh::{ConvexPolyhedron, TriangleMesh};
-use super::silhouette::{ShadingFrame, TriangleRole, convex_silhouette, triangle_polygon};
+use super::mesh::{ConvexPolyhedron, FACE_TOLERANCE, TriangleMesh};
+use super::separation::{Separation, separating_plane};
+use super::silhouette::{
+    ShadingFrame, TriangleRole, clipped_triangle_polygon, convex_silhouette, triangle_polygon,
+    triangle_side,
+};
 use crate::GeomError;
 use crate::ltc::{clamped_cosine_integral, lookup, ltc_integral};
 use crate::planar::BoolOp;
@@ -112,7 +117,14 @@ pub enum Method {
 /// A `Scene` is immutable after construction and holds no interior mutability, so it is
 /// `Send + Sync`: a renderer shares one `&Scene` among all its threads.
 ///
-/// Lights do not block each other; occluders block every light.
+/// # What blocks what
+///
+/// Every object is opaque. Occluders block every light; a light's geometry blocks every other
+/// light (both its sides: only the front side emits, but all of it is solid), and a mesh light's
+/// triangles block the rest of the same light. The [Monte Carlo reference](super::MonteCarlo)
+/// models exactly the same thing. An object hides a direction only where it lies strictly
+/// between the shading point and the light surface along that direction; see
+/// [`Scene::visible_region`] for the exact rule and how it is evaluated.
 ///
 /// # Examples
 ///
@@ -139,10 +151,30 @@ pub struct Scene {
     light_bounds: Vec<BoundingSphere>,
     occluder_bounds: Vec<BoundingSphere>,
     method: Method,
+    /// Per light `i` and blocker `j` (occluders first, then lights), at `i * blockers + j`: a
+    /// plane separating the convex hulls of the two, or `None` when they overlap (the blocker
+    /// interpenetrates the light, or is the light itself).
+    separations: Vec<Option<Separation>>,
+}
+
+/// How a blocker acts on one front face of a light (or on all of them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Reach {
+    /// Entirely on the point's side of the face plane: hides all it covers.
+    Whole,
+    /// Nothing strictly on the point's side: hides nothing of the face.
+    Nothing,
+    /// On both sides: only the part on the point's side hides the face.
+    Straddles,
 }
 
 impl Scene {
     /// A scene with the default [`Method::Silhouette`].
+    ///
+    /// Computes, once for the scene, a separating plane between every light and every other
+    /// object (the fast path of [`Scene::visible_region`]): `lights x (occluders + lights)`
+    /// minimum-norm-point runs, each a few passes over the two vertex lists (and, only for hulls
+    /// that touch, one scan of their face normals).
     ///
     /// # Errors
     ///
@@ -151,12 +183,27 @@ impl Scene {
     pub fn new(lights: Vec<Light>, occluders: Vec<Shape>) -> Result<Self, GeomError> {
         let light_bounds = lights.iter().map(|l| l.shape.bounding_sphere()).collect();
         let occluder_bounds = occluders.iter().map(Shape::bounding_sphere).collect();
+        let mut separations = Vec::with_capacity(lights.len() * (occluders.len() + lights.len()));
+        for (i, light) in lights.iter().enumerate() {
+            let lm = light.shape.mesh();
+            for o in &occluders {
+                separations.push(separating_plane(lm, o.mesh()));
+            }
+            for (k, other) in lights.iter().enumerate() {
+                separations.push(if k == i {
+                    None
+                } else {
+                    separating_plane(lm, other.shape.mesh())
+                });
+            }
+        }
         Ok(Scene {
             lights,
             occluders,
             light_bounds,
             occluder_bounds,
             method: Method::Silhouette,
+            separations,
         })
     }
 
@@ -195,17 +242,46 @@ impl Scene {
     }
 
     /// Indices of the occluders that may hide part of light `light` from the frame's point (the
-    /// culling of [`may_occlude`]).
+    /// culling of [`may_occlude`]). Other lights block too ([`Scene::blockers_between`]).
     pub fn occluders_between(
         &self,
         light: usize,
         frame: &ShadingFrame,
     ) -> impl Iterator<Item = usize> + '_ {
+        let no = self.occluders.len();
+        self.blockers_between(light, frame).filter(move |&j| j < no)
+    }
+
+    /// Number of blockers of a light: every occluder, then every light (the light itself among
+    /// them, never returned by [`Scene::blockers_between`]).
+    fn blocker_count(&self) -> usize {
+        self.occluders.len() + self.lights.len()
+    }
+
+    /// The geometry and bounding sphere of blocker `j` (occluders first, then lights).
+    fn blocker(&self, j: usize) -> (&Shape, BoundingSphere) {
+        let no = self.occluders.len();
+        if j < no {
+            (&self.occluders[j], self.occluder_bounds[j])
+        } else {
+            (&self.lights[j - no].shape, self.light_bounds[j - no])
+        }
+    }
+
+    /// Indices of the objects that may hide part of light `light` from the frame's point: the
+    /// occluders (`0..occluders().len()`) and the other lights (`occluders().len() + k` for light
+    /// `k`) that pass the culling of [`may_occlude`] (seed 000 `GetBetween`, section 3.5) and
+    /// that do not lie entirely behind the light as seen from the point (the precomputed
+    /// separating plane has the point on the light's side). An invalid light index has none.
+    pub fn blockers_between(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> impl Iterator<Item = usize> + '_ {
         let (x, n) = (frame.origin(), frame.normal());
-        // An invalid light index has no occluders in between (and no region either).
         let lb = self.light_bounds.get(light).copied();
         let count = if lb.is_some() {
-            self.occluders.len()
+            self.blocker_count()
         } else {
             0
         };
@@ -213,7 +289,18 @@ impl Scene {
             center: DVec3::ZERO,
             radius: 0.0,
         });
-        (0..count).filter(move |&o| may_occlude(x, n, lb, self.occluder_bounds[o]))
+        let no = self.occluders.len();
+        (0..count).filter(move |&j| {
+            if j == no + light {
+                return false;
+            }
+            if let Some(sep) = self.separations[light * count + j]
+                && !sep.blocker_side(x)
+            {
+                return false;
+            }
+            may_occlude(x, n, lb, self.blocker(j).1)
+        })
     }
 
     /// The outgoing radiance (RGB) at `point` towards `view`, for a surface with normal
@@ -291,25 +378,230 @@ impl Scene {
     }
 
     /// The part of light `light` visible from the frame's point, in the shading frame, clipped to
-    /// the upper hemisphere, as pieces with disjoint interiors whose integrals add up: each piece
-    /// of the light's region ([`Scene::light_region`]) minus the regions of the occluders that may
-    /// lie in between ([`Scene::subtract_occluders`]).
+    /// the upper hemisphere, as pieces with disjoint interiors whose integrals add up.
+    ///
+    /// # The exact rule
+    ///
+    /// Take a front face `f` of the light (a planar polygon facing the point `x`) and a direction
+    /// `d` in its projection: the ray from `x` meets `f` at a point `e`, and `d` is blocked iff
+    /// some opaque point lies on the ray before `e`. The ray crosses `f`'s plane only at `e`, so
+    /// the points before `e` are exactly the ray's points strictly on `x`'s side of that plane:
+    ///
+    /// `visible(f) = proj(f) - U_B proj(B n H_f)`, with `H_f` the open half-space of `f`'s plane
+    /// holding `x`, and `B` every blocker: occluders, the other lights, and, for a non-planar
+    /// mesh light, its own other triangles. The light's visible region is
+    /// the union of `visible(f)` over its front faces; with the light's own triangles among the
+    /// blockers each direction survives in at most one `visible(f)` (the face met first), so the
+    /// pieces have disjoint interiors and their integrals add up. Points of a blocker in `f`'s
+    /// plane, or touching it from behind, are met no earlier than the light and hide nothing,
+    /// as in the Monte Carlo reference.
+    ///
+    /// # How it is evaluated
+    ///
+    /// 1. Blockers that cannot be in front are culled ([`Scene::blockers_between`]).
+    /// 2. A blocker whose convex hull is disjoint from the light's has a separating plane
+    ///    (precomputed): with `x` on the blocker's side it lies in every `H_f`, since every ray
+    ///    crosses the plane once, blocker first. It is then subtracted whole from the light's
+    ///    region (seed 000 Alg. 1 lines 7-12): the silhouette path stays as fast as before.
+    ///    With `x` on the light's side it hides nothing (culled in step 1).
+    /// 3. A blocker that interpenetrates the light is tested against each front face's plane
+    ///    (its vertices, with [`FACE_TOLERANCE`] relative to the pair's size): entirely in every
+    ///    `H_f`, it is subtracted whole as in 2; in none, it is dropped.
+    /// 4. Otherwise, and for open non-planar mesh lights, the light is handled face by face: each
+    ///    front triangle's projection (seed 000 section 4.4) minus the blockers that are whole on
+    ///    its side, minus each triangle of a straddling blocker cut by the face plane to its part
+    ///    on `x`'s side (for a convex blocker seen from outside only its front triangles: a ray
+    ///    enters it through one of those first), minus, for a non-planar mesh light, its own
+    ///    other triangles cut the same way.
+    ///
+    /// A closed or planar mesh light without straddling blockers keeps the union of its front
+    /// faces ([`Scene::light_region`]): seen from outside a closed surface a ray meets a front
+    /// face first, so no triangle of the light can hide a front face that the union keeps.
     ///
     /// # Errors
     ///
-    /// As [`Scene::light_region`] and [`Scene::subtract_occluders`].
+    /// As [`Scene::light_region`], and those of [`SphericalPolygon::boolean`];
+    /// [`GeomError::OutOfRange`] for a light index past the end.
     pub fn visible_region(
         &self,
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        let mut out = self.light_region(light, frame)?;
-        for piece in &mut out {
-            let p = core::mem::take(piece);
-            *piece = self.subtract_occluders(light, frame, p)?;
+        let shape = &self.light(light)?.shape;
+        let mesh = shape.mesh();
+        let count = self.blocker_count();
+        // Step 2: separated blockers (culled ones, behind the light, are not even listed).
+        let mut whole: SmallVec<[usize; 8]> = SmallVec::new();
+        let mut overlapping: SmallVec<[usize; 4]> = SmallVec::new();
+        for j in self.blockers_between(light, frame) {
+            if self.separations[light * count + j].is_some() {
+                whole.push(j);
+            } else {
+                overlapping.push(j);
+            }
         }
-        out.retain(|p| !p.is_empty());
+        // A non-planar mesh light can hide itself: face by face, its own triangles are blockers
+        // (planar and convex lights cannot hide themselves). Closed ones need the face-by-face
+        // path only when a blocker straddles; open ones always (a back face can be met first).
+        let own_blockers = matches!(shape, Shape::Mesh(_)) && !mesh.is_planar();
+        let self_blocking = own_blockers && !mesh.is_closed();
+        // Step 3: interpenetrating blockers that still act the same on every front face.
+        let x = frame.origin();
+        let faces: SmallVec<[usize; 16]> = if overlapping.is_empty() && !self_blocking {
+            SmallVec::new()
+        } else {
+            (0..mesh.triangle_count())
+                .filter(|&t| triangle_side(mesh, t, x) > 0)
+                .collect()
+        };
+        let mut straddling: SmallVec<[usize; 4]> = SmallVec::new();
+        for &j in &overlapping {
+            let mut reach = faces.iter().map(|&f| self.reach(light, j, f));
+            let first = reach.next().unwrap_or(Reach::Nothing);
+            match (first, reach.all(|r| r == first)) {
+                (Reach::Whole, true) => whole.push(j),
+                (Reach::Nothing, true) => {}
+                _ => straddling.push(j),
+            }
+        }
+        if straddling.is_empty() && !self_blocking {
+            let mut out = self.light_region(light, frame)?;
+            if !whole.is_empty() {
+                let mut regions = Vec::new();
+                for &j in &whole {
+                    self.blocker_regions(light, j, frame, &mut regions)?;
+                }
+                for piece in &mut out {
+                    *piece = subtract_all(core::mem::take(piece), &regions)?;
+                }
+                out.retain(|p| !p.is_empty());
+            }
+            return Ok(out);
+        }
+        // Step 4: face by face.
+        let up = DVec3::Z;
+        let mut whole_regions = Vec::new();
+        for &j in &whole {
+            self.blocker_regions(light, j, frame, &mut whole_regions)?;
+        }
+        // Whole regions of the straddling blockers, built on first use.
+        let mut cached: SmallVec<[Option<Vec<SphericalPolygon>>; 4]> =
+            straddling.iter().map(|_| None).collect();
+        let mut out = Vec::new();
+        for &f in &faces {
+            let Some(piece) = triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? else {
+                continue;
+            };
+            let mut piece = subtract_all(piece.clip_to_hemisphere(up), &whole_regions)?;
+            for (k, &j) in straddling.iter().enumerate() {
+                if piece.is_empty() {
+                    break;
+                }
+                match self.reach(light, j, f) {
+                    Reach::Nothing => {}
+                    Reach::Whole => {
+                        if cached[k].is_none() {
+                            let mut r = Vec::new();
+                            self.blocker_regions(light, j, frame, &mut r)?;
+                            cached[k] = Some(r);
+                        }
+                        piece = subtract_all(piece, cached[k].as_deref().unwrap_or(&[]))?;
+                    }
+                    Reach::Straddles => {
+                        let (b, _) = self.blocker(j);
+                        let tol = self.pair_tolerance(light, j);
+                        piece = self.subtract_cut(piece, b, true, mesh, f, tol, frame)?;
+                    }
+                }
+            }
+            if own_blockers && !piece.is_empty() {
+                let tol = self.pair_tolerance(light, self.occluders.len() + light);
+                piece = self.subtract_cut(piece, shape, false, mesh, f, tol, frame)?;
+            }
+            if !piece.is_empty() {
+                out.push(piece);
+            }
+        }
         Ok(out)
+    }
+
+    /// How blocker `j` acts on front triangle `f` of light `light` (step 3 of
+    /// [`Scene::visible_region`]): the signs of its vertices' distances from `f`'s plane, with
+    /// distances within [`Scene::pair_tolerance`] taken as zero.
+    fn reach(&self, light: usize, j: usize, f: usize) -> Reach {
+        let mesh = self.lights[light].shape.mesh();
+        let (n, a) = (mesh.triangle_normal(f), mesh.triangle(f)[0]);
+        let tol = self.pair_tolerance(light, j);
+        let (mut front, mut behind) = (false, false);
+        for &v in self.blocker(j).0.mesh().vertices() {
+            let s = n.dot(v - a);
+            front |= s > tol;
+            behind |= s < -tol;
+        }
+        match (front, behind) {
+            (true, false) => Reach::Whole,
+            (false, _) => Reach::Nothing,
+            (true, true) => Reach::Straddles,
+        }
+    }
+
+    /// Distance from a light's face plane below which a blocker vertex counts as on the plane:
+    /// [`FACE_TOLERANCE`] times the pair's size. The distance `n . (v - a)` is taken from a
+    /// vertex `a` of the face, so its rounding is a few ulps of `|v - a|`, which the pair's size
+    /// bounds.
+    fn pair_tolerance(&self, light: usize, j: usize) -> f64 {
+        let lb = self.light_bounds[light];
+        let bb = self.blocker(j).1;
+        FACE_TOLERANCE * (lb.radius + bb.radius + (lb.center - bb.center).length())
+    }
+
+    /// Subtracts from `piece` (part of light face `f` of `light_mesh`) the triangles of `blocker`
+    /// cut to their parts strictly on the shading point's side of `f`'s plane (step 4 of
+    /// [`Scene::visible_region`]). `external` is false when the blocker is the light's own mesh
+    /// (then `f` itself is skipped).
+    #[allow(clippy::too_many_arguments)]
+    fn subtract_cut(
+        &self,
+        mut piece: SphericalPolygon,
+        blocker: &Shape,
+        external: bool,
+        light_mesh: &TriangleMesh,
+        f: usize,
+        tol: f64,
+        frame: &ShadingFrame,
+    ) -> Result<SphericalPolygon, GeomError> {
+        let up = DVec3::Z;
+        let (x, up_world) = (frame.origin(), frame.normal());
+        let (n, a) = (light_mesh.triangle_normal(f), light_mesh.triangle(f)[0]);
+        let face_bound = triangle_bound(light_mesh.triangle(f));
+        let bm = blocker.mesh();
+        // Seen from outside a convex blocker, a ray enters through a front triangle before it can
+        // meet a back one, so the back ones add nothing.
+        let front_only = matches!(blocker, Shape::Convex(_))
+            && (0..bm.triangle_count()).any(|t| triangle_side(bm, t, x) > 0);
+        for t in 0..bm.triangle_count() {
+            if (!external && t == f) || (front_only && triangle_side(bm, t, x) < 0) {
+                continue;
+            }
+            // Only a triangle whose cone from x meets the face's can hide part of it.
+            if !may_occlude(x, up_world, face_bound, triangle_bound(bm.triangle(t))) {
+                continue;
+            }
+            let dist = bm.triangle(t).map(|v| {
+                let s = n.dot(v - a);
+                if s.abs() <= tol { 0.0 } else { s }
+            });
+            if let Some(p) = clipped_triangle_polygon(bm, t, dist, frame)? {
+                let p = p.clip_to_hemisphere(up);
+                if !p.is_empty() {
+                    piece = piece.boolean(&p, BoolOp::Difference)?;
+                    if piece.is_empty() {
+                        break;
+                    }
+                }
+            }
+        }
+        Ok(piece)
     }
 
     /// The region covered by light `light` seen from the frame's point, clipped to the upper
@@ -363,80 +655,70 @@ impl Scene {
         Ok(alloc::vec![union])
     }
 
-    /// The occlusion step of seed 000 Alg. 1 (lines 7-12): subtracts from the light's region the
-    /// regions of the occluders that may lie between the point and the light ([`may_occlude`],
-    /// the paper's `GetBetween`), each clipped to the upper hemisphere first (Alg. 1 line 10).
-    ///
-    /// A convex occluder subtracts its silhouette (with [`Method::Silhouette`]); a mesh occluder,
-    /// or any occluder with [`Method::PerTriangle`], subtracts each of its triangles seen from
-    /// either side (seed 000 section 4.4), after a per-triangle bounding-sphere cull.
-    ///
-    /// Occluders are assumed not to interpenetrate the light: an occluder partly behind the
-    /// light (farther along some direction the light covers) is subtracted as if in front. The
-    /// culling removes occluders entirely behind the light.
-    ///
-    /// # Errors
-    ///
-    /// As [`Scene::shade`], and those of [`SphericalPolygon::boolean`];
-    /// [`GeomError::OutOfRange`] for a light index past the end.
-    pub fn subtract_occluders(
+    /// Appends to `out` the regions blocker `j` covers, clipped to the upper hemisphere (seed
+    /// 000 Alg. 1 line 10): a convex blocker's silhouette with [`Method::Silhouette`]; otherwise
+    /// each of its triangles seen from either side (seed 000 section 4.4), after a per-triangle
+    /// bounding-sphere cull against light `light`.
+    fn blocker_regions(
         &self,
         light: usize,
+        j: usize,
         frame: &ShadingFrame,
-        region: SphericalPolygon,
-    ) -> Result<SphericalPolygon, GeomError> {
+        out: &mut Vec<SphericalPolygon>,
+    ) -> Result<(), GeomError> {
         let up = DVec3::Z;
-        self.light(light)?;
-        let mut vis = region;
-        if vis.is_empty() {
-            return Ok(vis);
-        }
         let (x, n) = (frame.origin(), frame.normal());
         let lb = self.light_bounds[light];
-        for o in self.occluders_between(light, frame) {
-            match (&self.occluders[o], self.method) {
-                (Shape::Convex(p), Method::Silhouette) => {
-                    let occ = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
-                    if !occ.is_empty() {
-                        vis = vis.boolean(&occ, BoolOp::Difference)?;
-                    }
-                }
-                (shape, _) => {
-                    let mesh = shape.mesh();
-                    for t in 0..mesh.triangle_count() {
-                        let tri = mesh.triangle(t);
-                        let c = (tri[0] + tri[1] + tri[2]) / 3.0;
-                        let r = tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max)
-                            * (1.0 + 1e-12);
-                        if !may_occlude(
-                            x,
-                            n,
-                            lb,
-                            BoundingSphere {
-                                center: c,
-                                radius: r,
-                            },
-                        ) {
-                            continue;
-                        }
-                        if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Blocker)? {
-                            let p = p.clip_to_hemisphere(up);
-                            if !p.is_empty() {
-                                vis = vis.boolean(&p, BoolOp::Difference)?;
-                                if vis.is_empty() {
-                                    return Ok(vis);
-                                }
-                            }
-                        }
-                    }
+        match (self.blocker(j).0, self.method) {
+            (Shape::Convex(p), Method::Silhouette) => {
+                let occ = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+                if !occ.is_empty() {
+                    out.push(occ);
                 }
             }
-            if vis.is_empty() {
-                break;
+            (shape, _) => {
+                let mesh = shape.mesh();
+                for t in 0..mesh.triangle_count() {
+                    if !may_occlude(x, n, lb, triangle_bound(mesh.triangle(t))) {
+                        continue;
+                    }
+                    if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Blocker)? {
+                        let p = p.clip_to_hemisphere(up);
+                        if !p.is_empty() {
+                            out.push(p);
+                        }
+                    }
+                }
             }
         }
-        Ok(vis)
+        Ok(())
     }
+}
+
+/// A sphere holding a triangle (about its centroid, padded by a relative ulp margin), for the
+/// per-triangle culling.
+fn triangle_bound(tri: [DVec3; 3]) -> BoundingSphere {
+    let c = (tri[0] + tri[1] + tri[2]) / 3.0;
+    let r = tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max) * (1.0 + 1e-12);
+    BoundingSphere {
+        center: c,
+        radius: r,
+    }
+}
+
+/// `piece` minus every region of `regions`, in turn (seed 000 Alg. 1 line 12), stopping once
+/// nothing is left.
+fn subtract_all(
+    mut piece: SphericalPolygon,
+    regions: &[SphericalPolygon],
+) -> Result<SphericalPolygon, GeomError> {
+    for r in regions {
+        if piece.is_empty() {
+            break;
+        }
+        piece = piece.boolean(r, BoolOp::Difference)?;
+    }
+    Ok(piece)
 }
 
 /// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,

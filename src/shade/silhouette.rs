@@ -16,6 +16,11 @@ use smallvec::SmallVec;
 /// path, which merges them; the same tolerance as `order_directed_edges` uses for endpoints.
 const MATCH_TOLERANCE: f64 = 1e-9;
 
+/// Corners of a clipped blocker polygon whose directions are closer than this (chord length) are
+/// merged before the polygon is built: far below any feature the sphere layer resolves, far above
+/// the rounding of an interpolated cut point.
+const MERGE_TOLERANCE: f64 = 1e-13;
+
 /// The local shading frame of a point (DESIGN.md): the normal on `+z`, the view direction in the
 /// xz-plane with `x >= 0`, right-handed; directions are taken from the shading point.
 ///
@@ -265,31 +270,133 @@ pub fn triangle_polygon(
     frame: &ShadingFrame,
     role: TriangleRole,
 ) -> Result<Option<SphericalPolygon>, GeomError> {
+    let side = triangle_side(mesh, i, frame.origin());
+    if side == 0 || (side < 0 && role == TriangleRole::Emitter) {
+        return Ok(None);
+    }
+    let [a, b, c] = mesh.triangle(i).map(|v| frame.to_local(v));
+    covered_region(&[a, b, c], side)
+}
+
+/// Which side of mesh triangle `i`'s plane the point `x` lies on: `1` in front (the side the
+/// normal points to), `-1` behind, `0` within [`FACE_TOLERANCE`] (edge-on). The one facing test
+/// of the per-triangle method, shared by [`triangle_polygon`] and the per-face visibility of
+/// [`crate::shade::Scene::visible_region`], so that both agree on every face.
+pub(crate) fn triangle_side(mesh: &TriangleMesh, i: usize, x: DVec3) -> i8 {
     let [a, b, c] = mesh.triangle(i);
     let n = mesh.triangle_normal(i);
-    let x = frame.origin();
     // Relative to the triangle's centroid, so the rounding of s scales with the distance to it.
     let m = (a + b + c) / 3.0;
     let s = n.dot(x - m);
     let size = (a - m).length().max((b - m).length()).max((c - m).length());
     let tol = FACE_TOLERANCE * ((x - m).length() + size);
-    let (a, b, c) = (frame.to_local(a), frame.to_local(b), frame.to_local(c));
-    // A front-facing triangle runs counter-clockwise seen from x: clockwise on the sphere seen
-    // from outside, so its covered region is the reversed ring (see `convex_silhouette`).
-    let ring = if s > tol {
-        vec![a, c, b]
-    } else if s < -tol && role == TriangleRole::Blocker {
-        vec![a, b, c]
+    if s > tol {
+        1
+    } else if s < -tol {
+        -1
     } else {
-        return Ok(None);
+        0
+    }
+}
+
+/// The region covered by a planar convex polygon (vertices in the local frame, counter-clockwise
+/// seen from the side `side` says the point is on: `1` front, `-1` back), or `None` when its
+/// projection has no area within rounding.
+fn covered_region(local: &[DVec3], side: i8) -> Result<Option<SphericalPolygon>, GeomError> {
+    // Counter-clockwise seen from the point is clockwise on the sphere seen from outside, so a
+    // front-facing polygon covers the reversed ring (see `convex_silhouette`).
+    let ordered: SmallVec<[DVec3; 4]> = if side > 0 {
+        local.iter().rev().copied().collect()
+    } else {
+        local.iter().copied().collect()
     };
+    let mut units: SmallVec<[DVec3; 4]> = SmallVec::new();
+    for v in &ordered {
+        match v.try_normalize() {
+            Some(u) => units.push(u),
+            None => return Ok(None), // a corner at the point itself: seen edge-on
+        }
+    }
+    // Clipped polygons can carry a cut point within rounding of a corner: merge such directions
+    // (an area change far below any tolerance of the layer) rather than reject the polygon.
+    let mut keep: SmallVec<[usize; 4]> = SmallVec::new();
+    for k in 0..units.len() {
+        if keep
+            .last()
+            .is_none_or(|&j| (units[j] - units[k]).length() > MERGE_TOLERANCE)
+        {
+            keep.push(k);
+        }
+    }
+    while keep.len() > 1
+        && (units[keep[0]] - units[keep[keep.len() - 1]]).length() <= MERGE_TOLERANCE
+    {
+        keep.pop();
+    }
+    if keep.len() < 3 {
+        return Ok(None);
+    }
+    let ring: Vec<DVec3> = keep.iter().map(|&k| ordered[k]).collect();
     match SphericalPolygon::new(vec![ring]) {
         Ok(p) => Ok(Some(p)),
         // Seen so nearly edge-on that its projection has no area within rounding (its corners
         // on one great circle, or two of them in one direction): it covers nothing.
-        Err(GeomError::ZeroArea { .. } | GeomError::CoincidentVertices { .. }) => Ok(None),
+        Err(
+            GeomError::ZeroArea { .. }
+            | GeomError::CoincidentVertices { .. }
+            | GeomError::TooFewVertices { .. },
+        ) => Ok(None),
         Err(e) => Err(e),
     }
+}
+
+/// The region covered, seen from the frame's origin, by the part of blocker triangle `i` of
+/// `mesh` that lies strictly on the positive side of a plane, given the signed distances `dist`
+/// of its three corners from that plane (snapped by the caller: exactly `0` means on the plane).
+///
+/// This is the `proj(O n H)` of the exact visibility rule: a ray towards a light face meets the
+/// face's plane once, so an occluder point hides the face only if it lies on the point's side of
+/// that plane. The part strictly on that side is kept (open half-space): a triangle lying in the
+/// plane, or touching it from behind, is met no earlier than the light itself and hides nothing,
+/// as in the Monte Carlo reference. The cut is Sutherland–Hodgman against one plane (a triangle
+/// gives a triangle or a quadrilateral); cut points are interpolated in the local frame, where
+/// coordinates have the scale of the distance to the point.
+///
+/// `None` when nothing of the triangle is on the positive side, or when it is seen edge-on.
+///
+/// # Errors
+///
+/// Those of [`SphericalPolygon::new`] for a projection that rounding made degenerate.
+pub(crate) fn clipped_triangle_polygon(
+    mesh: &TriangleMesh,
+    i: usize,
+    dist: [f64; 3],
+    frame: &ShadingFrame,
+) -> Result<Option<SphericalPolygon>, GeomError> {
+    if dist.iter().all(|&d| d <= 0.0) {
+        return Ok(None);
+    }
+    let side = triangle_side(mesh, i, frame.origin());
+    if side == 0 {
+        return Ok(None);
+    }
+    let v = mesh.triangle(i).map(|p| frame.to_local(p));
+    if dist.iter().all(|&d| d >= 0.0) {
+        return covered_region(&v, side);
+    }
+    let mut out: SmallVec<[DVec3; 4]> = SmallVec::new();
+    for k in 0..3 {
+        let (u, w) = (v[k], v[(k + 1) % 3]);
+        let (du, dw) = (dist[k], dist[(k + 1) % 3]);
+        if du >= 0.0 {
+            out.push(u);
+        }
+        if (du > 0.0 && dw < 0.0) || (du < 0.0 && dw > 0.0) {
+            // Opposite strict signs: du / (du - dw) is in (0, 1) and well conditioned.
+            out.push(u + (w - u) * (du / (du - dw)));
+        }
+    }
+    covered_region(&out, side)
 }
 
 #[cfg(test)]
@@ -332,6 +439,69 @@ mod tests {
         let fg = ShadingFrame::new(DVec3::new(2.0, 0.0, 1.5), DVec3::Z, DVec3::Z).unwrap();
         let pg = convex_silhouette(&cube, &fg).unwrap();
         assert!(pg.solid_angle() > 0.0 && pg.solid_angle() < 2.0 * PI);
+    }
+
+    #[test]
+    fn a_cut_triangle_splits_its_solid_angle() {
+        // The parts of a triangle on either side of a plane cover, together, what the triangle
+        // covers: solid angles add up, for cuts through edges and through a corner, seen from
+        // both sides; a triangle in the plane, or behind it, covers nothing.
+        let f = ShadingFrame::new(DVec3::new(0.1, -0.2, 0.0), DVec3::Z, DVec3::X).unwrap();
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for case in 0..200 {
+            let c = DVec3::new(next(), next(), 2.0 + next());
+            let mut v: Vec<DVec3> = (0..3)
+                .map(|_| c + DVec3::new(next(), next(), next()))
+                .collect();
+            let n = DVec3::new(next(), next(), next()).normalize();
+            let mut a = c + DVec3::new(next(), next(), next()) * 0.3;
+            if case % 4 == 0 {
+                a = v[0]; // the plane through a corner
+            }
+            if case % 2 == 1 {
+                v.swap(1, 2); // seen from the back
+            }
+            let mesh = TriangleMesh::new(v, vec![[0, 1, 2]]).unwrap();
+            let whole = triangle_polygon(&mesh, 0, &f, TriangleRole::Blocker)
+                .unwrap()
+                .map_or(0.0, |p| p.solid_angle());
+            let d = mesh.triangle(0).map(|p| n.dot(p - a));
+            // Every corner of a part, taken back to the triangle's plane along its ray, lies on
+            // the kept side of the cutting plane (`sign` 1: n . (q - a) >= 0, -1: <= 0).
+            let (tn, t0) = (mesh.triangle_normal(0), mesh.triangle(0)[0]);
+            let on_side = |p: &SphericalPolygon, sign: f64| {
+                p.rings().flatten().all(|&l| {
+                    let w = f.dir_to_world(l);
+                    let q = f.origin() + w * (tn.dot(t0 - f.origin()) / tn.dot(w));
+                    sign * n.dot(q - a) >= -1e-12
+                })
+            };
+            let part = |d: [f64; 3], sign: f64| {
+                let p = clipped_triangle_polygon(&mesh, 0, d, &f).unwrap();
+                assert!(p.as_ref().is_none_or(|p| on_side(p, sign)), "case {case}");
+                p.map_or(0.0, |p| p.solid_angle())
+            };
+            let (pos, neg) = (part(d, 1.0), part(d.map(|x| -x), -1.0));
+            assert!(
+                (pos + neg - whole).abs() <= 1e-12 * (1.0 + whole),
+                "case {case}: {pos} + {neg} vs {whole}"
+            );
+            assert!(part([0.0; 3], 1.0) == 0.0 && part([-1.0, -2.0, 0.0], 1.0) == 0.0);
+            assert!(
+                (clipped_triangle_polygon(&mesh, 0, [1.0, 0.0, 2.0], &f)
+                    .unwrap()
+                    .map_or(0.0, |p| p.solid_angle())
+                    - whole)
+                    .abs()
+                    <= 1e-15
+            );
+        }
     }
 
     #[test]
