@@ -126,6 +126,18 @@ fn transformed_integral(
     {
         return Ok(v);
     }
+    exact_transformed(poly, m, edge)
+}
+
+/// The exact path of [`transformed_integral`], kept out of line so that the clip-free path's
+/// code stays small and needs no large stack frame.
+#[cold]
+#[inline(never)]
+fn exact_transformed(
+    poly: &SphericalPolygon,
+    m: glam::DMat3,
+    edge: impl Fn(Ray, Ray) -> f64,
+) -> Result<f64, crate::GeomError> {
     Ok(clipped_sum(&poly.transformed(m)?, edge))
 }
 
