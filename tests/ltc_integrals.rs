@@ -293,3 +293,42 @@ proptest! {
         prop_assert!((exact - rational).abs() <= bound, "{} vs {} (bound {})", exact, rational, bound);
     }
 }
+
+/// Polygons whose horizon arcs total exactly half a circle (edges crossing the horizon at
+/// antipodal points, turned about the normal): the clip-free paths take the arcs' angle from the
+/// argument of a product that lies on the negative real axis up to rounding. The rational path
+/// once clamped `sin(theta)` there and lost the whole half circle.
+#[test]
+fn horizon_arcs_of_half_a_circle() {
+    use arealight::glam::{DMat3, DQuat};
+    use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+    for (k, shift) in (0..64).flat_map(|k| [0.0, 1e-9, -1e-11, 3e-14].map(|s| (k, s))) {
+        // One crossing moved off the antipode of the other by `shift`.
+        let ring = [
+            DVec3::new(1.0, shift - 0.5, -0.5),
+            DVec3::new(1.0, shift + 0.5, 0.5),
+            DVec3::new(-1.0, 0.5, 0.5),
+            DVec3::new(-1.0, -0.5, -0.5),
+        ];
+        let turn = DQuat::from_rotation_z(k as f64 * 0.1);
+        for reverse in [false, true] {
+            let mut r: Vec<DVec3> = ring.iter().map(|&v| turn * v).collect();
+            if reverse {
+                r.reverse();
+            }
+            let p = SphericalPolygon::new(vec![r]).unwrap();
+            let exact = clamped_cosine_integral(&p);
+            assert!((clamped_cosine_integral_clip_free(&p) - exact).abs() <= 1e-12);
+            assert!((ltc_integral(&p, DMat3::IDENTITY).unwrap() - exact).abs() <= 1e-12);
+            let perimeter: f64 = boundary_edges(&p.clip_to_hemisphere(DVec3::Z))
+                .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
+                .sum();
+            let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+            let rational = ltc_integral_rational(&p, DMat3::IDENTITY).unwrap();
+            assert!(
+                (rational - exact).abs() <= bound,
+                "turn {k} shift {shift} reverse {reverse}: {rational} vs {exact}"
+            );
+        }
+    }
+}

@@ -96,9 +96,10 @@ pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, 
     transformed_integral(poly, m_inv, edge_term)
 }
 
-/// [`ltc_integral`] with the rational edge factor ([`edge_factor_rational`]): one `atan2` in total
-/// per polygon (for the horizon arcs), none per edge. Error bound as for
-/// [`clamped_cosine_integral_rational`], applied to the transformed polygon.
+/// [`ltc_integral`] with the rational edge factor ([`edge_factor_rational`]) and no `atan2` at
+/// all: the rational factor also gives the total angle of the horizon arcs. Error bound as for
+/// [`clamped_cosine_integral_rational`], applied to the transformed polygon (the horizon arcs
+/// count in its perimeter).
 ///
 /// # Errors
 ///
@@ -201,8 +202,10 @@ fn rational_edge_term(a: Ray, b: Ray) -> f64 {
     if d >= 0.0 {
         v
     } else {
-        // As in `edge_factor_rational`, sin(theta) is kept above 1e-7.
-        let s = crate::math::sqrt(a.cross(b).length_squared()).max(1e-7 * l);
+        // `cz / |a x b|` is at most 1 in magnitude, so unlike `pi / sin(theta)` alone this needs
+        // no clamp near theta = pi (a horizon arc of half a circle comes out as pi); only the
+        // zero-length cross product of antipodal endpoints (where `cz` is zero too) is guarded.
+        let s = crate::math::sqrt(a.cross(b).length_squared()).max(f64::MIN_POSITIVE);
         PI * cz / s - v
     }
 }
@@ -260,12 +263,15 @@ pub fn clamped_cosine_integral(poly: &SphericalPolygon) -> f64 {
 /// angle `theta_E - theta_X`. Summed over all of them, the angles of the entries count `+1` and
 /// those of the exits `-1`, so no pairing of crossings is needed; and by the atan2 sum identity
 /// (eq. 4.7) the whole sum is the argument of one complex product, so one `atan2` is evaluated in
-/// total. The product gives the sum modulo `2 pi`; since the horizon arcs are disjoint their total
+/// total (none in the rational variant of [`ltc_integral_rational`], which takes that argument
+/// with its rational factor). The product gives the sum modulo `2 pi`; since the horizon arcs are disjoint their total
 /// lies in `[0, 2 pi]`, which removes the ambiguity except between "none" and "all" of the circle.
 ///
 /// Configurations where that or the pairing is ambiguous (a vertex within [`HORIZON_TOLERANCE`] of
-/// the horizon, or no crossing while some vertex is below it) are delegated to the exact path, so
-/// the two agree to rounding on every valid polygon.
+/// the horizon, no crossing while some vertex is below it, or every edge above the horizon with
+/// an edge sum within rounding of zero, where its sign would decide whether the region surrounds
+/// the horizon) are delegated to the exact path, so the two agree to rounding on every valid
+/// polygon.
 #[must_use]
 pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
     if poly.is_full() {
@@ -309,7 +315,7 @@ fn ring_sum<'a>(
         }
         acc.add_edge(prev, first, edge)?;
     }
-    acc.finish()
+    acc.finish(edge)
 }
 
 /// Running state of the clip-free sum (thesis 003 eq. 4.6 and 4.7) over the edges of closed
@@ -399,9 +405,22 @@ impl ClipFree {
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
     /// (the pairing of the horizon arcs is then unknown here).
-    fn finish(self) -> Option<f64> {
+    fn finish(self, edge: impl Fn(Ray, Ray) -> f64) -> Option<f64> {
         let horizon = if self.crossings > 0 {
-            crate::math::atan2(self.im, self.re).rem_euclid(2.0 * PI)
+            // The argument of the product in [0, 2 pi), through the edge term of the horizon arc
+            // from the x-axis to the product: `theta * sign(im)` (an `atan2` for the exact term,
+            // the rational factor for the rational one, with the same relative error bound as
+            // its edges). Exactly on the negative axis the arc is a half circle, which an edge
+            // term cannot tell from a zero-length one.
+            if self.im == 0.0 {
+                if self.re < 0.0 { PI } else { 0.0 }
+            } else {
+                edge(
+                    Ray::new(DVec3::X),
+                    Ray::new(DVec3::new(self.re, self.im, 0.0)),
+                )
+                .rem_euclid(2.0 * PI)
+            }
         } else if self.edges == 0 {
             0.0
         } else if !self.any_below {
