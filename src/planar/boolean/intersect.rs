@@ -97,57 +97,184 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     ))
 }
 
-/// Makes vertices of `b` that lie within the snapping distance of a vertex of `a` identical to it
-/// (FHP's vertex-on-vertex case, made robust). Two distinct points a few ulps apart would
-/// otherwise each be inserted into the other operand's edges and produce spikes between them.
-/// Consecutive points that become equal are merged; a ring left with fewer than three points is
-/// dropped (it was a sliver thinner than the tolerance).
-pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
+/// What [`weld`] found among the operands' vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Weld {
+    /// Every two vertices are farther apart than the snapping distance.
+    Separated,
+    /// Some vertices are within the snapping distance of each other, but all such vertices are
+    /// already identical: nothing moved (shared vertices, contours touching at a point).
+    Coincident,
+    /// Some vertices were moved onto others; the rings were rebuilt.
+    Moved,
+}
+
+/// Welds the vertices of both operands: every vertex within the snapping distance
+/// ([`SNAP_REL`] times `scale`) of another vertex, in either operand, becomes the same point
+/// (FHP's vertex-on-vertex case, made robust).
+///
+/// Two distinct points a few ulps apart would otherwise each be inserted into the other's
+/// edges and produce spikes between them. Welding *within* an operand matters too: results of
+/// earlier operations (in the sphere layer, of earlier projections) can carry two copies of one
+/// vertex a few ulps apart on different contours, and an edge of the other operand welded to one
+/// copy would then overlap the edge at the other copy within rounding but not exactly, so the
+/// overlap would survive into the result.
+///
+/// Close vertices are grouped transitively (a chain of copies, each within the distance of the
+/// next, becomes one point); the group's representative is its first vertex in input order (A's
+/// before B's), so an operand that needs no welding is left bit for bit as it was. Consecutive
+/// points that become equal are merged and spikes `u, v, u` are cut back; a ring left with fewer
+/// than three points is dropped (it was a sliver thinner than the tolerance).
+pub(crate) fn weld(a: &mut Rings, b: &mut Rings, scale: f64) -> Weld {
     let snap = SNAP_REL * scale;
     let snap2 = snap * snap;
-    let mut changed = false;
-    // A's points sorted by x; each of B's points looks only at the x-window around it.
-    let mut by_x: SmallVec<[DVec2; 32]> = a.pts.iter().copied().collect();
-    by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
-    for q in b.pts.iter_mut() {
-        let lo = by_x.partition_point(|p| p.x < q.x - snap);
-        if let Some(&p) = by_x[lo..]
+    let na = a.pts.len();
+    let n = na + b.pts.len();
+    let pt = |a: &Rings, b: &Rings, k: usize| {
+        if k < na { a.pts[k] } else { b.pts[k - na] }
+    };
+    // All vertices sorted by x; each looks only at the following ones within the x-window.
+    let mut by_x: SmallVec<[(f64, u32); 64]> = SmallVec::with_capacity(n);
+    by_x.extend(
+        a.pts
             .iter()
-            .take_while(|p| p.x <= q.x + snap)
-            .find(|&&p| p != *q && (p - *q).length_squared() <= snap2)
-        {
-            *q = p;
-            changed = true;
+            .chain(b.pts.iter())
+            .enumerate()
+            .map(|(k, p)| (p.x, k as u32)),
+    );
+    by_x.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    // Union-find parents, allocated only once a pair of distinct close points is met.
+    let mut parent: SmallVec<[u32; 64]> = SmallVec::new();
+    let mut result = Weld::Separated;
+    for (s, &(x, i)) in by_x.iter().enumerate() {
+        let p = pt(a, b, i as usize);
+        for &(x2, j) in &by_x[s + 1..] {
+            if x2 - x > snap {
+                break;
+            }
+            let q = pt(a, b, j as usize);
+            if (p - q).length_squared() > snap2 {
+                continue;
+            }
+            if result == Weld::Separated {
+                result = Weld::Coincident;
+            }
+            if p == q {
+                continue;
+            }
+            if parent.is_empty() {
+                parent.extend(0..n as u32);
+            }
+            let (ri, rj) = (find_root(&mut parent, i), find_root(&mut parent, j));
+            // The smaller index (earlier in input order) represents the group.
+            let (lo, hi) = if ri < rj { (ri, rj) } else { (rj, ri) };
+            parent[hi as usize] = lo;
+            result = Weld::Moved;
         }
     }
-    if !changed {
+    if result != Weld::Moved {
+        return result;
+    }
+    for k in 0..n {
+        let r = find_root(&mut parent, k as u32) as usize;
+        if r != k {
+            let p = pt(a, b, r);
+            if k < na {
+                a.pts[k] = p;
+            } else {
+                b.pts[k - na] = p;
+            }
+        }
+    }
+    remove_spikes(a);
+    remove_spikes(b);
+    Weld::Moved
+}
+
+/// Root of `i` in the union-find forest, halving paths on the way.
+fn find_root(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let g = parent[parent[i as usize] as usize];
+        parent[i as usize] = g;
+        i = g;
+    }
+    i
+}
+
+/// Merges consecutive equal points and cuts spikes `u, v, u` (an edge followed by its own
+/// reverse, a zero-area excursion) back to `u`, repeatedly and across the seam of each ring;
+/// rings left with fewer than three points are dropped. Nothing else changes, so every edge that
+/// remains was an edge before.
+///
+/// Welding creates such rings (a ring whose vertices `u` and `w` weld in `u, v, w`), and so can
+/// splitting: a vertex of one operand within the snapping distance of an edge of the other near
+/// that edge's end is inserted there, and if the edge's end is itself a vertex inserted into the
+/// first operand's edge a few ulps away, the second operand's ring runs `u, v, u` through the two
+/// copies. Such a spike would leave a node with an incoming but no outgoing result edge.
+pub(crate) fn remove_spikes(r: &mut Rings) {
+    // Cheap scan first: most rings have neither repeats nor spikes.
+    let mut start = 0usize;
+    let mut clean = true;
+    for &end in &r.ends {
+        let end = end as usize;
+        let len = end - start;
+        for k in 0..len {
+            let p = r.pts[start + k];
+            let q = r.pts[start + (k + 1) % len];
+            let w = r.pts[start + (k + 2) % len];
+            if p == q || p == w {
+                clean = false;
+            }
+        }
+        start = end;
+    }
+    if clean {
         return;
     }
-    let mut pts: Split = SmallVec::with_capacity(b.pts.len());
+    let mut pts: Split = SmallVec::with_capacity(r.pts.len());
     let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
     let mut start = 0usize;
-    for &end in &b.ends {
+    for &end in &r.ends {
         let end = end as usize;
-        let ring_start = pts.len();
+        let s = pts.len();
         for k in start..end {
-            let p = b.pts[k];
-            if pts.len() > ring_start && pts.last() == Some(&p) {
+            let p = r.pts[k];
+            let len = pts.len() - s;
+            if len >= 1 && pts[pts.len() - 1] == p {
+                continue;
+            }
+            if len >= 2 && pts[pts.len() - 2] == p {
+                pts.pop();
                 continue;
             }
             pts.push(p);
         }
-        while pts.len() > ring_start + 1 && pts.last() == pts.get(ring_start) {
-            pts.pop();
+        // The seam: the same rules across the wrap-around (each round removes a point).
+        loop {
+            let len = pts.len() - s;
+            if len < 3 {
+                break;
+            }
+            let last = pts.len() - 1;
+            if pts[last] == pts[s] || pts[last - 1] == pts[s] {
+                // `.., u | u ..` repeats; `.., u, v | u ..` is a spike at `v`.
+                pts.pop();
+            } else if pts[last] == pts[s + 1] {
+                // `.., v | u, v ..` is a spike at `u`.
+                pts.remove(s);
+            } else {
+                break;
+            }
         }
-        if pts.len() - ring_start < 3 {
-            pts.truncate(ring_start);
+        if pts.len() - s < 3 {
+            pts.truncate(s);
         } else {
             ends.push(pts.len() as u32);
         }
         start = end;
     }
-    b.pts = pts;
-    b.ends = ends;
+    r.pts = pts;
+    r.ends = ends;
 }
 
 /// Inserts into each contour the vertices of the operand's *other* contours that lie exactly on

@@ -198,10 +198,12 @@ struct Labelled {
 impl Labelled {
     fn new(mut ra: Rings, mut rb: Rings) -> Result<Labelled, GeomError> {
         let scale = ra.scale().max(rb.scale());
-        intersect::snap_vertices(&ra, &mut rb, scale);
+        intersect::weld(&mut ra, &mut rb, scale);
         intersect::split_self_contacts(&mut ra);
         intersect::split_self_contacts(&mut rb);
         intersect::split(&mut ra, &mut rb, scale)?;
+        intersect::remove_spikes(&mut ra);
+        intersect::remove_spikes(&mut rb);
 
         let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
         let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
