@@ -70,7 +70,10 @@ mod shape;
 pub use boolean::intersect::{MAX_PASSES, SNAP_REL};
 pub use boolean::label::VertexClass;
 pub use boolean::trace::SLIVER_REL;
-pub use boolean::{BoolOp, ContactClasses, boolean, contact_classes};
+pub use boolean::{
+    BoolOp, ContactClasses, Workspace, boolean, boolean_fast, boolean_robust, boolean_with,
+    contact_classes,
+};
 pub use contour::Contour;
 pub use predicates::MAX_COORD;
 pub use shape::Shape;

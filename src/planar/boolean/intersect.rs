@@ -528,28 +528,8 @@ fn pair(
     if zq0 || zq1 || zp0 || zp1 {
         return;
     }
-    // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa. The signed
-    // distances of p0 and p1 from line q give the parameter along p.
-    //
-    // The same point is also found from the parameter along q; each coordinate is taken from the
-    // edge with the smaller extent in that coordinate, whose rounding error is proportional to
-    // that extent. In particular a crossing of an axis-parallel edge is exact in that coordinate.
-    let t = op0 / (op0 - op1);
-    let u = oq0 / (oq0 - oq1);
-    let xp = p0 + (p1 - p0) * t;
-    let xq = q0 + (q1 - q0) * u;
-    let x = DVec2::new(
-        if (p1.x - p0.x).abs() <= (q1.x - q0.x).abs() {
-            xp.x
-        } else {
-            xq.x
-        },
-        if (p1.y - p0.y).abs() <= (q1.y - q0.y).abs() {
-            xp.y
-        } else {
-            xq.y
-        },
-    ) + DVec2::ZERO;
+    // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa.
+    let x = crossing_point([p0, p1, q0, q1], [op0, op1, oq0, oq1]);
     for (v, own_a) in [(p0, true), (p1, true), (q0, false), (q1, false)] {
         if (x - v).length_squared() <= snap2 {
             // Snap to an existing vertex: insert it into the other operand's edge only.
@@ -597,9 +577,47 @@ fn pair(
     push(ins_b, j, q0, q1, x, true);
 }
 
-fn push(ins: &mut Inserts, edge: u32, e0: DVec2, e1: DVec2, p: DVec2, bent: bool) {
+/// The crossing point of edges `p0 p1` and `q0 q1`, which cross properly, from the exact
+/// orientations `[orient(q0, q1, p0), orient(q0, q1, p1), orient(p0, p1, q0), orient(p0, p1, q1)]`.
+///
+/// The signed distances of `p0` and `p1` from line `q` give the parameter along `p`, and those of
+/// `q0`, `q1` from line `p` the parameter along `q`; each coordinate is taken from the edge with
+/// the smaller extent in that coordinate, whose rounding error is proportional to that extent. In
+/// particular a crossing of an axis-parallel edge is exact in that coordinate. Both the robust
+/// path and the generic fast path compute crossings here, so they agree bit for bit.
+#[inline]
+pub(crate) fn crossing_point(
+    [p0, p1, q0, q1]: [DVec2; 4],
+    [op0, op1, oq0, oq1]: [f64; 4],
+) -> DVec2 {
+    let t = op0 / (op0 - op1);
+    let u = oq0 / (oq0 - oq1);
+    let xp = p0 + (p1 - p0) * t;
+    let xq = q0 + (q1 - q0) * u;
+    DVec2::new(
+        if (p1.x - p0.x).abs() <= (q1.x - q0.x).abs() {
+            xp.x
+        } else {
+            xq.x
+        },
+        if (p1.y - p0.y).abs() <= (q1.y - q0.y).abs() {
+            xp.y
+        } else {
+            xq.y
+        },
+    ) + DVec2::ZERO
+}
+
+/// Parameter of `p` along the edge `e0 e1` (its projection), which orders the points inserted
+/// into one edge.
+#[inline]
+pub(crate) fn edge_param(e0: DVec2, e1: DVec2, p: DVec2) -> f64 {
     let d = e1 - e0;
-    let t = (p - e0).dot(d) / d.length_squared();
+    (p - e0).dot(d) / d.length_squared()
+}
+
+fn push(ins: &mut Inserts, edge: u32, e0: DVec2, e1: DVec2, p: DVec2, bent: bool) {
+    let t = edge_param(e0, e1, p);
     // A point that projects outside the edge is a snapped vertex a few ulps beyond an endpoint;
     // inserting it would make the edge double back, so it is left out (the endpoint stands in).
     if t > 0.0 && t < 1.0 && p != e0 && p != e1 {
