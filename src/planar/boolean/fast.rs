@@ -49,7 +49,7 @@ use alloc::vec::Vec;
 use glam::DVec2;
 use smallvec::SmallVec;
 
-use super::intersect::{SNAP_REL, crossing_point, edge_param};
+use super::intersect::{SNAP_REL, crossing_point, edge_param, sort_key};
 use super::trace::regularize;
 use super::{Bbox, BoolOp, Rings};
 use crate::planar::contour::Contour;
@@ -126,11 +126,12 @@ type SplitRings = SmallVec<[Node; 48]>;
 pub(crate) struct Scratch {
     boxes_a: SmallVec<[EdgeBox; 32]>,
     boxes_b: SmallVec<[EdgeBox; 32]>,
-    events: SmallVec<[(f64, u32); 64]>,
+    /// Sort keys: a float's `sort_key` in the high bits, an index in the low 32.
+    events: SmallVec<[u128; 64]>,
     active_a: SmallVec<[u32; 16]>,
     active_b: SmallVec<[u32; 16]>,
     cross: SmallVec<[Crossing; 16]>,
-    order: SmallVec<[u32; 16]>,
+    order: SmallVec<[u128; 16]>,
     sa: SplitRings,
     sb: SplitRings,
     path: SmallVec<[DVec2; 64]>,
@@ -253,19 +254,21 @@ fn find_crossings(s: &mut Scratch, m: f64) -> Option<()> {
     const B_BIT: u32 = 1 << 31;
     let events = &mut s.events;
     events.clear();
-    events.extend(ba.iter().enumerate().map(|(i, e)| (e.b[0], i as u32)));
-    events.extend(
-        bb.iter()
-            .enumerate()
-            .map(|(j, e)| (e.b[0], j as u32 | B_BIT)),
-    );
-    events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    for (i, e) in ba.iter().enumerate() {
+        events.push(u128::from(sort_key(e.b[0])) << 32 | i as u128);
+    }
+    for (j, e) in bb.iter().enumerate() {
+        events.push(u128::from(sort_key(e.b[0])) << 32 | (j as u32 | B_BIT) as u128);
+    }
+    events.sort_unstable();
     let (active_a, active_b) = (&mut s.active_a, &mut s.active_b);
     active_a.clear();
     active_b.clear();
-    for &(x, id) in events.iter() {
+    for &ev in events.iter() {
+        let id = ev as u32;
         if id & B_BIT == 0 {
             let ea = &ba[id as usize];
+            let x = ea.b[0];
             active_b.retain(|j| bb[*j as usize].b[1] + m >= x);
             for &j in active_b.iter() {
                 let eb = &bb[j as usize];
@@ -277,6 +280,7 @@ fn find_crossings(s: &mut Scratch, m: f64) -> Option<()> {
         } else {
             let j = id & !B_BIT;
             let eb = &bb[j as usize];
+            let x = eb.b[0];
             active_a.retain(|i| ba[*i as usize].b[1] + m >= x);
             for &i in active_a.iter() {
                 let ea = &ba[i as usize];
@@ -357,7 +361,7 @@ fn pair(
 /// `None` when two crossings are within `m` of each other.
 fn crossings_apart(
     cross: &mut SmallVec<[Crossing; 16]>,
-    order: &mut SmallVec<[u32; 16]>,
+    order: &mut SmallVec<[u128; 16]>,
     m: f64,
 ) -> Option<()> {
     let m2 = m * m;
@@ -371,12 +375,14 @@ fn crossings_apart(
         return Some(());
     }
     order.clear();
-    order.extend(0..cross.len() as u32);
-    order.sort_unstable_by(|&i, &j| cross[i as usize].p.x.total_cmp(&cross[j as usize].p.x));
+    for (i, c) in cross.iter().enumerate() {
+        order.push(u128::from(sort_key(c.p.x)) << 32 | i as u128);
+    }
+    order.sort_unstable();
     for (k, &i) in order.iter().enumerate() {
-        let x = &cross[i as usize];
+        let x = &cross[i as u32 as usize];
         for &j in &order[k + 1..] {
-            let y = &cross[j as usize];
+            let y = &cross[j as u32 as usize];
             if y.p.x - x.p.x > m {
                 break;
             }
@@ -394,21 +400,21 @@ fn split(
     out: &mut SplitRings,
     r: &Rings,
     cross: &mut SmallVec<[Crossing; 16]>,
-    order: &mut SmallVec<[u32; 16]>,
+    order: &mut SmallVec<[u128; 16]>,
     side_b: bool,
 ) -> Option<()> {
     let key = |c: &Crossing| if side_b { (c.eb, c.tb) } else { (c.ea, c.ta) };
+    // Sorted by edge, then parameter: one packed integer key per crossing.
     order.clear();
-    order.extend(0..cross.len() as u32);
-    order.sort_unstable_by(|&i, &j| {
-        let (ei, ti) = key(&cross[i as usize]);
-        let (ej, tj) = key(&cross[j as usize]);
-        ei.cmp(&ej).then(ti.total_cmp(&tj))
-    });
-    // Equal parameters on one edge would leave the order to the sort; never in generic
+    for (i, c) in cross.iter().enumerate() {
+        let (e, t) = key(c);
+        order.push(u128::from(e) << 96 | u128::from(sort_key(t)) << 32 | i as u128);
+    }
+    order.sort_unstable();
+    // Equal parameters on one edge would leave the order to the index; never in generic
     // position (the crossings are apart), but checked.
     for w in order.windows(2) {
-        if key(&cross[w[0] as usize]) == key(&cross[w[1] as usize]) {
+        if w[0] >> 32 == w[1] >> 32 {
             return None;
         }
     }
@@ -430,6 +436,7 @@ fn split(
         for e in start..end {
             out.push(node(r.pts[e], NONE));
             while let Some(&c) = order.get(k) {
+                let c = c as u32;
                 let x = &mut cross[c as usize];
                 if key(x).0 as usize != e {
                     break;
