@@ -8,6 +8,11 @@
 //!    intersection vertices as crossing, bouncing, delayed crossing or delayed bouncing;
 //! 3. [`trace`]: select edges by label for the operation, link them into contours and regularize.
 //!
+//! Before phase 1, vertices of both operands within the snapping distance of each other are
+//! welded (`intersect::weld`). Operands in generic position skip the pipeline: [`fast`] runs
+//! classic Greiner–Hormann and bails out to the pipeline at the first contact that is not a
+//! clean proper crossing, so it only ever returns what the pipeline would.
+//!
 //! # References
 //!
 //! - G. Greiner, K. Hormann. *Efficient clipping of arbitrary polygons.* ACM Transactions on
