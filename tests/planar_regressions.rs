@@ -76,3 +76,62 @@ fn vertex_at_edge_midpoint_union() {
     let sd = sym_diff_vs_ioverlay(&a, &b, BoolOp::Union, &u);
     assert!(sd <= 1e-9 * (a.area() + b.area()), "{sd}: {u:?}");
 }
+
+/// Two copies of one vertex a few ulps apart within one operand (Issue 3, item 2). These are the
+/// planar shapes that the sphere layer's union in
+/// `sphere_boolean::regression_union_with_vertex_copies_ulps_apart` builds without its own
+/// weld: A's rings 1 and 3 hold `(-0.29782521525192895, 0.115230665014275)` as two copies
+/// `6e-17` apart, and B's first vertex is as close to both. B used to be snapped to one copy
+/// only, so the union kept B and ring 3 as two contours whose shared edge overlapped within
+/// rounding (valid by `Shape::validate`, wrong as an operand). Now every operand vertex within
+/// the snapping distance of another is welded, and B merges with ring 3.
+#[test]
+fn union_with_vertex_copies_ulps_apart_within_one_operand() {
+    let a = shape(
+        "0.16266618305721212:-0.1419938921647603, -0.09867456425035155:-0.337326585013314, \
+         -0.09472452487881344:-0.3409571852925808; \
+         -0.10237701828842695:-0.19757991668221594, -0.29782521525192895:0.11523066501427495, \
+         -0.2551796443306079:0.024637056767923576; \
+         -0.10237701828842695:-0.19757991668221594, 0.22285340055682282:0.03143034093338467, \
+         0.2896335641743427:0.11938596708017998; \
+         -0.29782521525192895:0.11523066501427501, 0.2896335641743427:0.11938596708017998, \
+         0.09472452487881342:0.34095718529258073",
+    );
+    let b = shape(
+        "-0.29782521525192895:0.11523066501427505, -0.10958245993469506:-0.1560882442857163, \
+         0.2896335641743429:0.11938596708017982",
+    );
+    let results = check_all(&a, &b, 1e-12).unwrap();
+    for (r, op) in results.iter().zip(OPS) {
+        well_separated(r).unwrap_or_else(|e| panic!("{}: {e}\n{r:?}", op_name(op)));
+    }
+    let u = &results[1];
+    assert_eq!(u.contours().count(), 4, "B and ring 3 merge: {u:?}");
+}
+
+/// "Result boundary does not close" on a nearly shared edge (Issue 3, item 3): the planar shapes
+/// of `shade_known_failures::difference_with_nearly_shared_edge` in the sphere layer's
+/// projection (before its weld). A's edge from vertex 4 to 5 and B's edge from 0 to 1 are the
+/// same edge up to `1.5e-15`, just over the snapping distance `1.3e-15`, so the vertices stay
+/// distinct; each is inserted into the other operand's edge, and B's closing edge, passing within
+/// the distance of A's vertex 4 near its end, gets that vertex too. B's split ring then ran
+/// `A4, B0, A4`: a spike through two copies of one point, whose node had an incoming result edge
+/// and no outgoing one. Spikes in the split rings are now cut back.
+#[test]
+fn difference_with_nearly_shared_edge() {
+    let a = shape(
+        "-0.0563820234895846:0.013684937733375214, 0.07576353856700926:-0.03276570703995642, \
+         0.09148627320009772:0.03318462560421694, 0.08427774578583314:0.03229821336503307, \
+         0.030478470630320713:0.04053336589364999, -0.021166560051795704:0.06070298847285058",
+    );
+    let b = shape(
+        "0.030478470630322215:0.04053336589365018, -0.021166560051794313:0.060702988472850966, \
+         -0.09148627320009683:-0.03318462560421653",
+    );
+    let [i, _, d, _] = check_all(&a, &b, 1e-12).unwrap();
+    assert!(d.area() > 0.0 && i.area() > 0.0);
+    for (r, op) in [(&i, BoolOp::Intersection), (&d, BoolOp::Difference)] {
+        let sd = sym_diff_vs_ioverlay(&a, &b, op, r);
+        assert!(sd <= 1e-9 * (a.area() + b.area()), "{sd}: {r:?}");
+    }
+}

@@ -15,13 +15,19 @@
 //! # Cost
 //!
 //! Inputs are small (3 to 64 vertices per shape after projection), so the pipeline favours
-//! simple arrays: a sweep over edge bounding boxes finds the candidate pairs, contacts are
-//! grouped by hashing, and tracing uses compressed adjacency rows. Scratch storage is `SmallVec`
-//! with inline room for 32 points per operand (64 nodes), so operands of up to about 32
-//! vertices *including* inserted intersection points are processed without heap allocation; the
-//! only allocations are the output contours. Larger operands spill to the heap. `Shape::new`
-//! validates in `O(n^2)` (all edge pairs), once per shape; `boolean` does not re-validate.
-//! Measured costs against i_overlay, clipper2 and geo are in `BENCHMARKS.md`.
+//! simple arrays. Operands in generic position (every contact a proper crossing, far from
+//! vertices and other crossings, in units of the snapping distance) take a fast path: classic
+//! Greiner–Hormann on buffers of a [`Workspace`], with all edge pairs tested directly for small
+//! operands and a sweep over x for larger ones. Anything else — shared or nearly shared
+//! vertices, vertices on or near edges, overlapping edges — bails out to the robust pipeline
+//! (welding, splitting to a fixpoint, exact local labelling, leftmost-turn tracing), and the fast
+//! path returns only results identical to the robust pipeline's (`tests/planar_fast.rs`).
+//! Scratch storage is `SmallVec` with inline room for about 32 points per operand, so operands
+//! of up to about 32 vertices *including* inserted intersection points are processed without
+//! heap allocation; the only allocations are the output contours. Larger operands spill to the
+//! heap (once per [`Workspace`] on the fast path, with [`boolean_with`]). `Shape::new` validates
+//! in `O(n^2)` (all edge pairs), once per shape; `boolean` does not re-validate. Measured costs
+//! against i_overlay, clipper2 and geo are in `BENCHMARKS.md`.
 //!
 //! # Testing
 //!
@@ -33,6 +39,9 @@
 //!   i_overlay and clipper2 (symmetric-difference area at most `1e-7` of the operands' area) and
 //!   the identities among our own results (`1e-9`), on random, integer-grid, copied,
 //!   sub-polygon, shared-edge, vertex-on-edge, far-from-origin and chained inputs.
+//! - `tests/planar_fast.rs`: the fast path against the robust pipeline (identical results
+//!   wherever the fast path answers; bail-out on exact and near degeneracies; taken on generic
+//!   inputs and on the benchmark inputs).
 //! - `tests/planar_regressions.rs`: every minimized failure as a named test; proptest's seeds
 //!   are in `proptest-regressions/planar_proptest.txt`.
 //! - `fuzz/fuzz_targets/planar_{intersection,union,difference,xor}.rs`: validity and identities;
@@ -70,7 +79,10 @@ mod shape;
 pub use boolean::intersect::{MAX_PASSES, SNAP_REL};
 pub use boolean::label::VertexClass;
 pub use boolean::trace::SLIVER_REL;
-pub use boolean::{BoolOp, ContactClasses, boolean, contact_classes};
+pub use boolean::{
+    BoolOp, ContactClasses, Workspace, boolean, boolean_fast, boolean_robust, boolean_with,
+    contact_classes,
+};
 pub use contour::Contour;
 pub use predicates::MAX_COORD;
 pub use shape::Shape;

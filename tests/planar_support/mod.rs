@@ -180,3 +180,21 @@ pub fn star(c: DVec2, radii: &[f64], phase: f64) -> Vec<DVec2> {
         })
         .collect()
 }
+
+/// Checks that every two distinct vertices of `s` are farther apart than the snapping distance
+/// (`SNAP_REL` times the shape's coordinate scale). Two copies of one vertex a few ulps apart
+/// pass `Shape::validate` (nothing overlaps exactly) but are one point to the next operation.
+pub fn well_separated(s: &Shape) -> Result<(), String> {
+    let snap = arealight::planar::SNAP_REL * s.scale();
+    let pts: Vec<DVec2> = s.contours().flatten().copied().collect();
+    for (i, p) in pts.iter().enumerate() {
+        for q in &pts[i + 1..] {
+            if p != q && (*p - *q).length() <= snap {
+                return Err(format!(
+                    "vertices {p:?} and {q:?} are distinct but within {snap:e}"
+                ));
+            }
+        }
+    }
+    Ok(())
+}

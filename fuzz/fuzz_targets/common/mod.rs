@@ -1,5 +1,6 @@
 //! Shared driver of the planar fuzz targets: decode two shapes, run one operation, and assert
-//! the result is valid and the area identities hold.
+//! the result is valid, equals the robust pipeline's wherever the generic-position fast path
+//! answers, and the area identities hold.
 //!
 //! Coordinates come from small integers (so shared vertices, collinear overlaps and vertices on
 //! edges are frequent), optionally scaled and offset to reach gnomonic magnitudes (`1e6`).
@@ -7,7 +8,7 @@
 //! valid inputs, not that arbitrary bytes are valid.
 
 use arealight::glam::DVec2;
-use arealight::planar::{BoolOp, Shape, boolean};
+use arealight::planar::{BoolOp, Shape, boolean, boolean_fast, boolean_robust};
 use libfuzzer_sys::arbitrary::{self, Arbitrary};
 
 /// One fuzz case. `Debug` prints the rings so a crash pastes into a regression test.
@@ -76,6 +77,13 @@ pub fn run(case: &Case, op: BoolOp) {
         .unwrap_or_else(|e| panic!("{op:?} failed on valid input: {e}\nA = {a:?}\nB = {b:?}"));
     if let Err(e) = r.validate() {
         panic!("{op:?} result invalid: {e}\nA = {a:?}\nB = {b:?}\nR = {r:?}");
+    }
+    // Wherever the generic-position fast path answers, it must equal the robust pipeline.
+    if let Ok(Some(f)) = boolean_fast(&a, &b, op) {
+        let robust = boolean_robust(&a, &b, op).unwrap_or_else(|e| {
+            panic!("{op:?}: fast path answered, robust failed: {e}\nA = {a:?}\nB = {b:?}")
+        });
+        assert_eq!(f, robust, "{op:?}: fast path differs\nA = {a:?}\nB = {b:?}");
     }
     let [i, u, d, x] = all_ops(&a, &b);
     let (aa, ab) = (a.area(), b.area());

@@ -97,57 +97,189 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     ))
 }
 
-/// Makes vertices of `b` that lie within the snapping distance of a vertex of `a` identical to it
-/// (FHP's vertex-on-vertex case, made robust). Two distinct points a few ulps apart would
-/// otherwise each be inserted into the other operand's edges and produce spikes between them.
-/// Consecutive points that become equal are merged; a ring left with fewer than three points is
-/// dropped (it was a sliver thinner than the tolerance).
-pub(crate) fn snap_vertices(a: &Rings, b: &mut Rings, scale: f64) {
+/// What [`weld`] found among the operands' vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Weld {
+    /// Every two vertices are farther apart than the snapping distance.
+    Separated,
+    /// Some vertices are within the snapping distance of each other, but all such vertices are
+    /// already identical: nothing moved (shared vertices, contours touching at a point).
+    Coincident,
+    /// Some vertices were moved onto others; the rings were rebuilt.
+    Moved,
+}
+
+/// Welds the vertices of both operands: every vertex within the snapping distance
+/// ([`SNAP_REL`] times `scale`) of another vertex, in either operand, becomes the same point
+/// (FHP's vertex-on-vertex case, made robust).
+///
+/// Two distinct points a few ulps apart would otherwise each be inserted into the other's
+/// edges and produce spikes between them. Welding *within* an operand matters too: results of
+/// earlier operations (in the sphere layer, of earlier projections) can carry two copies of one
+/// vertex a few ulps apart on different contours, and an edge of the other operand welded to one
+/// copy would then overlap the edge at the other copy within rounding but not exactly, so the
+/// overlap would survive into the result.
+///
+/// Close vertices are grouped transitively (a chain of copies, each within the distance of the
+/// next, becomes one point); the group's representative is its first vertex in input order (A's
+/// before B's), so an operand that needs no welding is left bit for bit as it was. Consecutive
+/// points that become equal are merged and spikes `u, v, u` are cut back; a ring left with fewer
+/// than three points is dropped (it was a sliver thinner than the tolerance).
+pub(crate) fn weld(a: &mut Rings, b: &mut Rings, scale: f64) -> Weld {
     let snap = SNAP_REL * scale;
     let snap2 = snap * snap;
-    let mut changed = false;
-    // A's points sorted by x; each of B's points looks only at the x-window around it.
-    let mut by_x: SmallVec<[DVec2; 32]> = a.pts.iter().copied().collect();
-    by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
-    for q in b.pts.iter_mut() {
-        let lo = by_x.partition_point(|p| p.x < q.x - snap);
-        if let Some(&p) = by_x[lo..]
-            .iter()
-            .take_while(|p| p.x <= q.x + snap)
-            .find(|&&p| p != *q && (p - *q).length_squared() <= snap2)
-        {
-            *q = p;
-            changed = true;
+    let na = a.pts.len();
+    let n = na + b.pts.len();
+    let pt = |a: &Rings, b: &Rings, k: usize| {
+        if k < na { a.pts[k] } else { b.pts[k - na] }
+    };
+    // All vertices sorted by x (ties in input order); each looks only at the following ones
+    // within the x-window. A stable merge sort on the x-keys: it finds the long monotone runs
+    // of polygon chains (measured cheaper here than an unstable sort of packed integer keys).
+    let mut by_x: SmallVec<[(u64, u32); 64]> = SmallVec::with_capacity(n);
+    for (k, p) in a.pts.iter().chain(b.pts.iter()).enumerate() {
+        by_x.push((sort_key(p.x), k as u32));
+    }
+    by_x.sort_by_key(|e| e.0);
+    // Union-find parents, allocated only once a pair of distinct close points is met.
+    let mut parent: SmallVec<[u32; 64]> = SmallVec::new();
+    let mut result = Weld::Separated;
+    for (s, &(_, i)) in by_x.iter().enumerate() {
+        let p = pt(a, b, i as usize);
+        for &(_, j) in &by_x[s + 1..] {
+            let q = pt(a, b, j as usize);
+            if q.x - p.x > snap {
+                break;
+            }
+            if (p - q).length_squared() > snap2 {
+                continue;
+            }
+            if result == Weld::Separated {
+                result = Weld::Coincident;
+            }
+            if p == q {
+                continue;
+            }
+            if parent.is_empty() {
+                parent.extend(0..n as u32);
+            }
+            let (ri, rj) = (find_root(&mut parent, i), find_root(&mut parent, j));
+            // The smaller index (earlier in input order) represents the group.
+            let (lo, hi) = if ri < rj { (ri, rj) } else { (rj, ri) };
+            parent[hi as usize] = lo;
+            result = Weld::Moved;
         }
     }
-    if !changed {
+    if result != Weld::Moved {
+        return result;
+    }
+    for k in 0..n {
+        let r = find_root(&mut parent, k as u32) as usize;
+        if r != k {
+            let p = pt(a, b, r);
+            if k < na {
+                a.pts[k] = p;
+            } else {
+                b.pts[k - na] = p;
+            }
+        }
+    }
+    remove_spikes(a);
+    remove_spikes(b);
+    Weld::Moved
+}
+
+/// A key whose unsigned integer order is the total order of the float (`f64::total_cmp`).
+#[inline]
+pub(crate) fn sort_key(f: f64) -> u64 {
+    let b = f.to_bits();
+    if b >> 63 == 1 { !b } else { b | 1 << 63 }
+}
+
+/// Root of `i` in the union-find forest, halving paths on the way.
+fn find_root(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let g = parent[parent[i as usize] as usize];
+        parent[i as usize] = g;
+        i = g;
+    }
+    i
+}
+
+/// Merges consecutive equal points and cuts spikes `u, v, u` (an edge followed by its own
+/// reverse, a zero-area excursion) back to `u`, repeatedly and across the seam of each ring;
+/// rings left with fewer than three points are dropped. Nothing else changes, so every edge that
+/// remains was an edge before.
+///
+/// Welding creates such rings (a ring whose vertices `u` and `w` weld in `u, v, w`), and so can
+/// splitting: a vertex of one operand within the snapping distance of an edge of the other near
+/// that edge's end is inserted there, and if the edge's end is itself a vertex inserted into the
+/// first operand's edge a few ulps away, the second operand's ring runs `u, v, u` through the two
+/// copies. Such a spike would leave a node with an incoming but no outgoing result edge.
+pub(crate) fn remove_spikes(r: &mut Rings) {
+    // Cheap scan first: most rings have neither repeats nor spikes.
+    let mut start = 0usize;
+    let mut clean = true;
+    for &end in &r.ends {
+        let end = end as usize;
+        let len = end - start;
+        for k in 0..len {
+            let p = r.pts[start + k];
+            let q = r.pts[start + (k + 1) % len];
+            let w = r.pts[start + (k + 2) % len];
+            if p == q || p == w {
+                clean = false;
+            }
+        }
+        start = end;
+    }
+    if clean {
         return;
     }
-    let mut pts: Split = SmallVec::with_capacity(b.pts.len());
+    let mut pts: Split = SmallVec::with_capacity(r.pts.len());
     let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
     let mut start = 0usize;
-    for &end in &b.ends {
+    for &end in &r.ends {
         let end = end as usize;
-        let ring_start = pts.len();
+        let s = pts.len();
         for k in start..end {
-            let p = b.pts[k];
-            if pts.len() > ring_start && pts.last() == Some(&p) {
+            let p = r.pts[k];
+            let len = pts.len() - s;
+            if len >= 1 && pts[pts.len() - 1] == p {
+                continue;
+            }
+            if len >= 2 && pts[pts.len() - 2] == p {
+                pts.pop();
                 continue;
             }
             pts.push(p);
         }
-        while pts.len() > ring_start + 1 && pts.last() == pts.get(ring_start) {
-            pts.pop();
+        // The seam: the same rules across the wrap-around (each round removes a point).
+        loop {
+            let len = pts.len() - s;
+            if len < 3 {
+                break;
+            }
+            let last = pts.len() - 1;
+            if pts[last] == pts[s] || pts[last - 1] == pts[s] {
+                // `.., u | u ..` repeats; `.., u, v | u ..` is a spike at `v`.
+                pts.pop();
+            } else if pts[last] == pts[s + 1] {
+                // `.., v | u, v ..` is a spike at `u`.
+                pts.remove(s);
+            } else {
+                break;
+            }
         }
-        if pts.len() - ring_start < 3 {
-            pts.truncate(ring_start);
+        if pts.len() - s < 3 {
+            pts.truncate(s);
         } else {
             ends.push(pts.len() as u32);
         }
         start = end;
     }
-    b.pts = pts;
-    b.ends = ends;
+    r.pts = pts;
+    r.ends = ends;
 }
 
 /// Inserts into each contour the vertices of the operand's *other* contours that lie exactly on
@@ -401,28 +533,8 @@ fn pair(
     if zq0 || zq1 || zp0 || zp1 {
         return;
     }
-    // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa. The signed
-    // distances of p0 and p1 from line q give the parameter along p.
-    //
-    // The same point is also found from the parameter along q; each coordinate is taken from the
-    // edge with the smaller extent in that coordinate, whose rounding error is proportional to
-    // that extent. In particular a crossing of an axis-parallel edge is exact in that coordinate.
-    let t = op0 / (op0 - op1);
-    let u = oq0 / (oq0 - oq1);
-    let xp = p0 + (p1 - p0) * t;
-    let xq = q0 + (q1 - q0) * u;
-    let x = DVec2::new(
-        if (p1.x - p0.x).abs() <= (q1.x - q0.x).abs() {
-            xp.x
-        } else {
-            xq.x
-        },
-        if (p1.y - p0.y).abs() <= (q1.y - q0.y).abs() {
-            xp.y
-        } else {
-            xq.y
-        },
-    ) + DVec2::ZERO;
+    // Proper crossing: p0 and p1 strictly on opposite sides of line q and vice versa.
+    let x = crossing_point([p0, p1, q0, q1], [op0, op1, oq0, oq1]);
     for (v, own_a) in [(p0, true), (p1, true), (q0, false), (q1, false)] {
         if (x - v).length_squared() <= snap2 {
             // Snap to an existing vertex: insert it into the other operand's edge only.
@@ -470,9 +582,47 @@ fn pair(
     push(ins_b, j, q0, q1, x, true);
 }
 
-fn push(ins: &mut Inserts, edge: u32, e0: DVec2, e1: DVec2, p: DVec2, bent: bool) {
+/// The crossing point of edges `p0 p1` and `q0 q1`, which cross properly, from the exact
+/// orientations `[orient(q0, q1, p0), orient(q0, q1, p1), orient(p0, p1, q0), orient(p0, p1, q1)]`.
+///
+/// The signed distances of `p0` and `p1` from line `q` give the parameter along `p`, and those of
+/// `q0`, `q1` from line `p` the parameter along `q`; each coordinate is taken from the edge with
+/// the smaller extent in that coordinate, whose rounding error is proportional to that extent. In
+/// particular a crossing of an axis-parallel edge is exact in that coordinate. Both the robust
+/// path and the generic fast path compute crossings here, so they agree bit for bit.
+#[inline]
+pub(crate) fn crossing_point(
+    [p0, p1, q0, q1]: [DVec2; 4],
+    [op0, op1, oq0, oq1]: [f64; 4],
+) -> DVec2 {
+    let t = op0 / (op0 - op1);
+    let u = oq0 / (oq0 - oq1);
+    let xp = p0 + (p1 - p0) * t;
+    let xq = q0 + (q1 - q0) * u;
+    DVec2::new(
+        if (p1.x - p0.x).abs() <= (q1.x - q0.x).abs() {
+            xp.x
+        } else {
+            xq.x
+        },
+        if (p1.y - p0.y).abs() <= (q1.y - q0.y).abs() {
+            xp.y
+        } else {
+            xq.y
+        },
+    ) + DVec2::ZERO
+}
+
+/// Parameter of `p` along the edge `e0 e1` (its projection), which orders the points inserted
+/// into one edge.
+#[inline]
+pub(crate) fn edge_param(e0: DVec2, e1: DVec2, p: DVec2) -> f64 {
     let d = e1 - e0;
-    let t = (p - e0).dot(d) / d.length_squared();
+    (p - e0).dot(d) / d.length_squared()
+}
+
+fn push(ins: &mut Inserts, edge: u32, e0: DVec2, e1: DVec2, p: DVec2, bent: bool) {
+    let t = edge_param(e0, e1, p);
     // A point that projects outside the edge is a snapped vertex a few ulps beyond an endpoint;
     // inserting it would make the edge double back, so it is left out (the endpoint stands in).
     if t > 0.0 && t < 1.0 && p != e0 && p != e1 {

@@ -8,6 +8,11 @@
 //!    intersection vertices as crossing, bouncing, delayed crossing or delayed bouncing;
 //! 3. [`trace`]: select edges by label for the operation, link them into contours and regularize.
 //!
+//! Before phase 1, vertices of both operands within the snapping distance of each other are
+//! welded (`intersect::weld`). Operands in generic position skip the pipeline: [`fast`] runs
+//! classic Greiner–Hormann and bails out to the pipeline at the first contact that is not a
+//! clean proper crossing, so it only ever returns what the pipeline would.
+//!
 //! # References
 //!
 //! - G. Greiner, K. Hormann. *Efficient clipping of arbitrary polygons.* ACM Transactions on
@@ -15,6 +20,7 @@
 //! - E. L. Foster, K. Hormann, R. T. Popa. *Clipping simple polygons with degenerate
 //!   intersections.* Computers & Graphics: X 2, 2019.
 
+pub(crate) mod fast;
 pub(crate) mod intersect;
 pub(crate) mod label;
 pub(crate) mod trace;
@@ -45,6 +51,7 @@ pub(crate) type Split = SmallVec<[DVec2; 32]>;
 
 /// The contours of one operand as one flat point list: ring `k` occupies
 /// `ends[k - 1]..ends[k]`.
+#[derive(Default)]
 pub(crate) struct Rings {
     pub(crate) pts: Split,
     pub(crate) ends: SmallVec<[u32; 4]>,
@@ -52,15 +59,36 @@ pub(crate) struct Rings {
 
 impl Rings {
     fn from_shape(s: &Shape) -> Rings {
-        let mut pts = Split::new();
-        let mut ends = SmallVec::new();
+        let mut r = Rings::default();
+        let _ = r.fill(s);
+        r
+    }
+
+    /// Replaces the contents with the contours of `s`, keeping the buffers' capacity; returns
+    /// the bounding box.
+    fn fill(&mut self, s: &Shape) -> Bbox {
+        self.pts.clear();
+        self.ends.clear();
+        let mut b = Bbox {
+            lo: DVec2::INFINITY,
+            hi: DVec2::NEG_INFINITY,
+        };
+        self.pts.reserve(s.vertex_count());
         for c in &s.contours {
-            // `+ 0.0` turns -0.0 into 0.0, so that bitwise-ordered lookups (which distinguish
-            // the two zeros) agree with `==` (which does not).
-            pts.extend(c.pts.iter().map(|&p| p + DVec2::ZERO));
-            ends.push(pts.len() as u32);
+            for &p in &c.pts {
+                // `+ 0.0` turns -0.0 into 0.0, so that bitwise-ordered lookups (which
+                // distinguish the two zeros) agree with `==` (which does not).
+                let p = p + DVec2::ZERO;
+                // Plain comparisons: coordinates are finite.
+                b.lo.x = if p.x < b.lo.x { p.x } else { b.lo.x };
+                b.lo.y = if p.y < b.lo.y { p.y } else { b.lo.y };
+                b.hi.x = if p.x > b.hi.x { p.x } else { b.hi.x };
+                b.hi.y = if p.y > b.hi.y { p.y } else { b.hi.y };
+                self.pts.push(p);
+            }
+            self.ends.push(self.pts.len() as u32);
         }
-        Rings { pts, ends }
+        b
     }
 
     /// For each vertex, the index of the next vertex in its ring.
@@ -93,6 +121,25 @@ impl Rings {
         self.pts
             .iter()
             .fold(0.0, |m: f64, p| m.max(p.x.abs()).max(p.y.abs()))
+    }
+}
+
+/// An axis-aligned bounding box.
+#[derive(Clone, Copy)]
+pub(crate) struct Bbox {
+    pub(crate) lo: DVec2,
+    pub(crate) hi: DVec2,
+}
+
+impl Bbox {
+    /// Largest coordinate magnitude inside the box.
+    fn scale(&self) -> f64 {
+        self.lo.abs().max(self.hi.abs()).max_element()
+    }
+
+    /// Whether the boxes are disjoint with a gap, so the operands cannot even touch.
+    fn disjoint(&self, o: &Bbox) -> bool {
+        self.hi.x < o.lo.x || o.hi.x < self.lo.x || self.hi.y < o.lo.y || o.hi.y < self.lo.y
     }
 }
 
@@ -144,9 +191,100 @@ impl Rings {
 ///   intersections.* Computers & Graphics: X 2, 2019 (labelling phase: local classification of
 ///   Table 1, overlapping chains as delayed crossings/bouncings; tracing phase).
 pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
+    boolean_with(&mut Workspace::new(), a, b, op)
+}
+
+/// Scratch storage for [`boolean_with`], kept across calls.
+///
+/// Buffers have inline room for operands of up to about 32 vertices each, so [`boolean`] (which
+/// makes a fresh workspace per call) allocates nothing but its output for small operands. For
+/// larger operands, the buffers of the generic-position fast path spill to the heap once and
+/// keep their capacity in a reused workspace; the robust path for degenerate contacts still
+/// allocates its own tables per call when operands are that large.
+///
+/// A workspace holds no results: any workspace can be used for any operation.
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec2;
+/// use arealight::planar::{BoolOp, Shape, Workspace, boolean_with};
+///
+/// let ngon = |n: usize, c: f64| {
+///     Shape::new(vec![(0..n)
+///         .map(|k| {
+///             let t = std::f64::consts::TAU * k as f64 / n as f64;
+///             DVec2::new(c + t.cos(), t.sin())
+///         })
+///         .collect()])
+/// };
+/// let mut ws = Workspace::new();
+/// let a = ngon(64, 0.0)?;
+/// for k in 1..4 {
+///     let b = ngon(64, 0.25 * k as f64)?;
+///     let d = boolean_with(&mut ws, &a, &b, BoolOp::Difference)?;
+///     assert!(d.area() > 0.0 && d.area() < a.area());
+/// }
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Default)]
+pub struct Workspace {
+    a: Rings,
+    b: Rings,
+    fast: fast::Scratch,
+}
+
+impl Workspace {
+    /// An empty workspace (no heap allocation until operands outgrow the inline buffers).
+    #[must_use]
+    pub fn new() -> Workspace {
+        Workspace::default()
+    }
+}
+
+impl core::fmt::Debug for Workspace {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("Workspace")
+    }
+}
+
+/// [`boolean`] with caller-provided scratch storage, for many operations in a row.
+///
+/// The result is identical to `boolean(a, b, op)`; only where the scratch buffers live differs.
+///
+/// # Errors
+///
+/// As [`boolean`].
+pub fn boolean_with(
+    ws: &mut Workspace,
+    a: &Shape,
+    b: &Shape,
+    op: BoolOp,
+) -> Result<Shape, GeomError> {
+    run(ws, a, b, op, Path::Auto).map(|r| r.unwrap_or_default())
+}
+
+/// Which pipeline [`run`] may use (tests compare them).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Path {
+    /// The fast path when the operands are in generic position, else the robust one.
+    Auto,
+    /// Only the fast path; `Ok(None)` when it bails out.
+    FastOnly,
+    /// Only the robust path.
+    RobustOnly,
+}
+
+fn run(
+    ws: &mut Workspace,
+    a: &Shape,
+    b: &Shape,
+    op: BoolOp,
+    path: Path,
+) -> Result<Option<Shape>, GeomError> {
     // Trivial cases first: they need no geometry and keep chains of operations cheap.
     if a.is_empty() || b.is_empty() {
-        return Ok(match op {
+        return Ok(Some(match op {
             BoolOp::Intersection => Shape::empty(),
             BoolOp::Difference => a.clone(),
             BoolOp::Union | BoolOp::Xor => {
@@ -156,12 +294,11 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
                     a.clone()
                 }
             }
-        });
+        }));
     }
-    let ra = Rings::from_shape(a);
-    let rb = Rings::from_shape(b);
-    if disjoint_boxes(&ra, &rb) {
-        return Ok(match op {
+    let (box_a, box_b) = (ws.a.fill(a), ws.b.fill(b));
+    if box_a.disjoint(&box_b) {
+        return Ok(Some(match op {
             BoolOp::Intersection => Shape::empty(),
             BoolOp::Difference => a.clone(),
             BoolOp::Union | BoolOp::Xor => {
@@ -169,15 +306,83 @@ pub fn boolean(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
                 c.extend(b.contours.iter().cloned());
                 Shape::from_contours(c)
             }
-        });
+        }));
     }
-    let l = Labelled::new(ra, rb)?;
+    let scale = box_a.scale().max(box_b.scale());
+    // The fast path needs operands in generic position, in particular no two vertices within
+    // the snapping distance (which `weld` would merge). Between the operands the fast path's own
+    // pair tests see such vertices (each is near the other's edges); within an operand, small
+    // operands are checked pair by pair, which is cheaper than `weld`'s sort.
+    let fast = path != Path::RobustOnly && op != BoolOp::Xor;
+    let mut tried = false;
+    if fast && ws.a.pts.len() <= SMALL && ws.b.pts.len() <= SMALL {
+        let snap = intersect::SNAP_REL * scale;
+        if separated(&ws.a, snap * snap) && separated(&ws.b, snap * snap) {
+            if let Some(c) = fast::run(&mut ws.fast, &ws.a, &ws.b, [box_a, box_b], op, scale) {
+                return Ok(Some(Shape::from_contours(c)));
+            }
+            tried = true;
+        }
+    }
+    let welded = intersect::weld(&mut ws.a, &mut ws.b, scale);
+    if fast
+        && !tried
+        && welded == intersect::Weld::Separated
+        && let Some(c) = fast::run(&mut ws.fast, &ws.a, &ws.b, [box_a, box_b], op, scale)
+    {
+        return Ok(Some(Shape::from_contours(c)));
+    }
+    if path == Path::FastOnly {
+        return Ok(None);
+    }
+    let (ra, rb) = (core::mem::take(&mut ws.a), core::mem::take(&mut ws.b));
+    let l = Labelled::new_welded(ra, rb, scale)?;
     let mut edges = SmallVec::new();
     trace::select(
         &l.ra, &l.a_nxt, &l.sa, &l.rb, &l.b_nxt, &l.sb, &l.nodes, op, &mut edges,
     );
     let contours = trace::trace(&edges, l.ra.pts.len() + l.rb.pts.len(), l.scale)?;
-    Ok(Shape::from_contours(contours))
+    // Give the (possibly spilled) buffers back for the next call.
+    (ws.a, ws.b) = (l.ra, l.rb);
+    Ok(Some(Shape::from_contours(contours)))
+}
+
+/// Operands of at most this many vertices have their vertex separation checked pair by pair.
+const SMALL: usize = 24;
+
+/// Whether every two vertices of `r` are farther apart than `sqrt(snap2)`.
+fn separated(r: &Rings, snap2: f64) -> bool {
+    let pts: &[DVec2] = &r.pts;
+    for (i, &p) in pts.iter().enumerate() {
+        for &q in &pts[i + 1..] {
+            if (p - q).length_squared() <= snap2 {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// [`boolean`] through the robust pipeline only, skipping the generic-position fast path; for
+/// tests that require both to agree.
+///
+/// # Errors
+///
+/// As [`boolean`].
+#[doc(hidden)]
+pub fn boolean_robust(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
+    run(&mut Workspace::new(), a, b, op, Path::RobustOnly).map(|r| r.unwrap_or_default())
+}
+
+/// [`boolean`] through the generic-position fast path only: `Ok(None)` when the operands are
+/// not in generic position (the fast path bails out); for tests.
+///
+/// # Errors
+///
+/// As [`boolean`].
+#[doc(hidden)]
+pub fn boolean_fast(a: &Shape, b: &Shape, op: BoolOp) -> Result<Option<Shape>, GeomError> {
+    run(&mut Workspace::new(), a, b, op, Path::FastOnly)
 }
 
 /// Both operands after the intersection phase (split at every contact) and the labelling phase:
@@ -198,10 +403,17 @@ struct Labelled {
 impl Labelled {
     fn new(mut ra: Rings, mut rb: Rings) -> Result<Labelled, GeomError> {
         let scale = ra.scale().max(rb.scale());
-        intersect::snap_vertices(&ra, &mut rb, scale);
+        intersect::weld(&mut ra, &mut rb, scale);
+        Labelled::new_welded(ra, rb, scale)
+    }
+
+    /// Phases 1 and 2 on operands already welded by [`intersect::weld`].
+    fn new_welded(mut ra: Rings, mut rb: Rings, scale: f64) -> Result<Labelled, GeomError> {
         intersect::split_self_contacts(&mut ra);
         intersect::split_self_contacts(&mut rb);
         intersect::split(&mut ra, &mut rb, scale)?;
+        intersect::remove_spikes(&mut ra);
+        intersect::remove_spikes(&mut rb);
 
         let (a_nxt, a_prv) = (ra.next_table(), ra.prev_table());
         let (b_nxt, b_prv) = (rb.next_table(), rb.prev_table());
@@ -223,20 +435,6 @@ impl Labelled {
             sb,
         })
     }
-}
-
-fn bbox(r: &Rings) -> (DVec2, DVec2) {
-    r.pts.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
-}
-
-/// Whether the bounding boxes are disjoint with a gap, so the operands cannot even touch.
-fn disjoint_boxes(a: &Rings, b: &Rings) -> bool {
-    let (alo, ahi) = bbox(a);
-    let (blo, bhi) = bbox(b);
-    ahi.x < blo.x || bhi.x < alo.x || ahi.y < blo.y || bhi.y < alo.y
 }
 
 /// `(point, class)` for each vertex of one split operand, as returned by [`contact_classes`].

@@ -237,7 +237,7 @@ pub(crate) fn trace(
 
 /// Removes repeated and exactly collinear points (spikes included) in one stack pass, then drops
 /// the loop if it bounds no area or only a sliver.
-fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option<Contour> {
+pub(crate) fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option<Contour> {
     // Scratch on the stack; the output contour is allocated once, at its final size, and only
     // if it survives.
     let mut out: SmallVec<[DVec2; 32]> = SmallVec::new();
