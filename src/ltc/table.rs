@@ -364,6 +364,7 @@ impl LtcTable {
     /// assert!(l.albedo > 0.0 && l.albedo <= 1.0);
     /// assert!(table.lookup(f64::NAN, 0.25).is_err());
     /// ```
+    #[inline]
     pub fn lookup(&self, cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
         if cos_theta_v.is_nan() {
             return Err(GeomError::OutOfRange {
@@ -415,6 +416,7 @@ impl LtcTable {
 /// assert!(l.m_inv.x_axis.z.abs() < 1e-3 && l.m_inv.z_axis.x.abs() < 1e-3);
 /// assert!((l.m_inv.x_axis.x - l.m_inv.y_axis.y).abs() < 1e-2);
 /// ```
+#[inline]
 pub fn lookup(cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
     GGX_TABLE.lookup(cos_theta_v, alpha)
 }
