@@ -139,121 +139,13 @@ fn min_norm_difference(a: &[DVec3], b: &[DVec3], scale: f64) -> DVec3 {
             .unwrap_or(DVec3::ZERO);
         lo_b - hi_a
     };
-    let s2 = scale * scale;
-    // The corral: points of the difference and their convex weights.
-    let mut set: SmallVec<[DVec3; 4]> = SmallVec::new();
-    let mut lam: SmallVec<[f64; 4]> = SmallVec::new();
-    let first = support(DVec3::X);
-    set.push(first);
-    lam.push(1.0);
-    let mut x = first;
-    // Each major cycle strictly decreases |x| in exact arithmetic and corrals never repeat, so
-    // the loop ends; the bound only guards against rounding cycling.
-    for _ in 0..64 + 4 * (a.len() + b.len()) {
-        let p = support(x);
-        // Wolfe's optimality test: no point of the difference improves on x beyond rounding.
-        if x.dot(x) - x.dot(p) <= 1e-14 * s2 || set.contains(&p) || set.len() == 4 {
-            break;
-        }
-        set.push(p);
-        lam.push(0.0);
-        // Minor cycles: move towards the affine minimizer of the corral until it is interior.
-        for _ in 0..5 {
-            let Some(alpha) = affine_minimizer(&set) else {
-                // Affinely dependent corral: x is already the best this corral can give.
-                set.pop();
-                lam.pop();
-                return x;
-            };
-            if alpha.iter().all(|&w| w > 0.0) {
-                lam = alpha;
-                x = combine(&set, &lam);
-                break;
-            }
-            let mut theta = 1.0f64;
-            for (l, w) in lam.iter().zip(&alpha) {
-                if *w <= 0.0 {
-                    theta = theta.min(l / (l - w));
-                }
-            }
-            for (l, w) in lam.iter_mut().zip(&alpha) {
-                *l += theta * (w - *l);
-            }
-            let mut i = 0;
-            while i < set.len() {
-                if lam[i] <= 1e-15 {
-                    set.remove(i);
-                    lam.remove(i);
-                } else {
-                    i += 1;
-                }
-            }
-            if set.is_empty() {
-                return x;
-            }
-            let total: f64 = lam.iter().sum();
-            lam.iter_mut().for_each(|l| *l /= total);
-            x = combine(&set, &lam);
-        }
-        if x.length_squared() <= 1e-30 * s2 {
-            break;
-        }
-    }
-    x
-}
-
-fn combine(set: &[DVec3], lam: &[f64]) -> DVec3 {
-    set.iter().zip(lam).map(|(&p, &l)| p * l).sum()
-}
-
-/// Weights (summing to one) of the point of the corral's affine hull nearest the origin, or
-/// `None` when the corral is affinely dependent (to within `1e-12` relative).
-fn affine_minimizer(set: &[DVec3]) -> Option<SmallVec<[f64; 4]>> {
-    let q0 = set[0];
-    let d: SmallVec<[DVec3; 3]> = set[1..].iter().map(|&p| p - q0).collect();
-    let m = d.len();
-    // Normal equations G beta = -D^T q0 with G = D^T D (m <= 3), by Cramer's rule on the
-    // zero-padded 3x3 system.
-    let mut g = [[0.0f64; 3]; 3];
-    let mut rhs = [0.0f64; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            g[i][j] = if i < m && j < m {
-                d[i].dot(d[j])
-            } else if i == j {
-                1.0
-            } else {
-                0.0
-            };
-        }
-        rhs[i] = if i < m { -d[i].dot(q0) } else { 0.0 };
-    }
-    let det3 = |g: &[[f64; 3]; 3]| {
-        g[0][0] * (g[1][1] * g[2][2] - g[1][2] * g[2][1])
-            - g[0][1] * (g[1][0] * g[2][2] - g[1][2] * g[2][0])
-            + g[0][2] * (g[1][0] * g[2][1] - g[1][1] * g[2][0])
-    };
-    let det = det3(&g);
-    let diag: f64 = (0..m)
-        .map(|i| g[i][i])
-        .product::<f64>()
-        .max(f64::MIN_POSITIVE);
-    if !(det.abs() > 1e-12 * diag) {
-        return None;
-    }
-    let mut alpha: SmallVec<[f64; 4]> = SmallVec::from_elem(0.0, m + 1);
-    let mut rest = 0.0;
-    for k in 0..m {
-        let mut gk = g;
-        for (row, r) in gk.iter_mut().zip(rhs) {
-            row[k] = r;
-        }
-        let beta = det3(&gk) / det;
-        alpha[k + 1] = beta;
-        rest += beta;
-    }
-    alpha[0] = 1.0 - rest;
-    Some(alpha)
+    crate::sphere::min_norm_point(
+        support,
+        support(DVec3::X),
+        scale * scale,
+        1e-14,
+        64 + 4 * (a.len() + b.len()),
+    )
 }
 
 #[cfg(test)]

@@ -149,127 +149,17 @@ pub fn enclosing_cap(dirs: &[DVec3]) -> Result<(DVec3, f64), GeomError> {
 
 /// Wolfe's algorithm: the point of the convex hull of `pts` (unit vectors) nearest the origin.
 fn min_norm_point(pts: &[DVec3]) -> DVec3 {
-    // The corral: indices into pts and their convex weights.
-    let mut set: SmallVec<[usize; 4]> = SmallVec::new();
-    let mut lam: SmallVec<[f64; 4]> = SmallVec::new();
-    set.push(0);
-    lam.push(1.0);
-    let mut x = pts[0];
-    // Each major cycle strictly decreases |x|, and corrals never repeat, so the loop is finite;
-    // the bound only guards against rounding cycling.
-    for _ in 0..4 * pts.len() + 16 {
-        let (k, m) = pts
-            .iter()
-            .enumerate()
-            .map(|(i, p)| (i, x.dot(*p)))
-            .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-        // Optimality (Wolfe's test): no point improves on x by more than rounding.
-        if x.dot(x) - m <= 1e-15 || set.contains(&k) {
-            break;
-        }
-        if set.len() == 4 {
-            break; // cannot happen in exact arithmetic: a full corral spans the origin.
-        }
-        set.push(k);
-        lam.push(0.0);
-        // Minor cycles: move toward the affine minimizer of the corral until it is interior.
-        for _ in 0..5 {
-            let Some(alpha) = affine_minimizer(pts, &set) else {
-                // Affinely dependent corral: drop the newcomer and stop; x is already the best.
-                set.pop();
-                lam.pop();
-                return x;
-            };
-            if alpha.iter().all(|&a| a > 0.0) {
-                lam = alpha;
-                x = combine(pts, &set, &lam);
-                break;
-            }
-            let mut theta = 1.0f64;
-            for (l, a) in lam.iter().zip(&alpha) {
-                if *a <= 0.0 {
-                    theta = theta.min(l / (l - a));
-                }
-            }
-            for (l, a) in lam.iter_mut().zip(&alpha) {
-                *l += theta * (a - *l);
-            }
-            // Drop the points whose weight reached zero (at least the one that set theta).
-            let mut i = 0;
-            while i < set.len() {
-                if lam[i] <= 1e-15 {
-                    set.remove(i);
-                    lam.remove(i);
-                } else {
-                    i += 1;
-                }
-            }
-            if set.is_empty() {
-                return x;
-            }
-            let total: f64 = lam.iter().sum();
-            lam.iter_mut().for_each(|l| *l /= total);
-            x = combine(pts, &set, &lam);
-        }
-        if x.length_squared() < 1e-30 {
-            break;
-        }
-    }
-    x
-}
-
-fn combine(pts: &[DVec3], set: &[usize], lam: &[f64]) -> DVec3 {
-    set.iter().zip(lam).map(|(&i, &l)| pts[i] * l).sum()
-}
-
-/// Weights (summing to one) of the point of the corral's affine hull nearest the origin, or `None`
-/// when the corral is affinely dependent.
-fn affine_minimizer(pts: &[DVec3], set: &[usize]) -> Option<SmallVec<[f64; 4]>> {
-    let q0 = pts[set[0]];
-    let d: SmallVec<[DVec3; 3]> = set[1..].iter().map(|&i| pts[i] - q0).collect();
-    let m = d.len();
-    // Normal equations G beta = -D^T q0 with G = D^T D, m <= 3, solved by Cramer's rule on the
-    // zero-padded 3x3 system.
-    let mut g = [[0.0f64; 3]; 3];
-    let mut rhs = [0.0f64; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            g[i][j] = if i < m && j < m {
-                d[i].dot(d[j])
-            } else if i == j {
-                1.0
-            } else {
-                0.0
-            };
-        }
-        rhs[i] = if i < m { -d[i].dot(q0) } else { 0.0 };
-    }
-    let det3 = |a: &[[f64; 3]; 3]| {
-        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    // The lowest point along x, the first one on ties.
+    let support = |x: DVec3| {
+        pts.iter()
+            .copied()
+            .fold((DVec3::ZERO, f64::INFINITY), |best, p| {
+                let m = x.dot(p);
+                if m < best.1 { (p, m) } else { best }
+            })
+            .0
     };
-    let det = det3(&g);
-    let scale: f64 = (0..m)
-        .map(|i| g[i][i])
-        .product::<f64>()
-        .max(f64::MIN_POSITIVE);
-    if !(det.abs() > 1e-12 * scale) {
-        return None;
-    }
-    let mut alpha: SmallVec<[f64; 4]> = SmallVec::from_elem(0.0, m + 1);
-    let mut rest = 0.0;
-    for k in 0..m {
-        let mut gk = g;
-        for (row, r) in gk.iter_mut().zip(rhs) {
-            row[k] = r;
-        }
-        let beta = det3(&gk) / det;
-        alpha[k + 1] = beta;
-        rest += beta;
-    }
-    alpha[0] = 1.0 - rest;
-    Some(alpha)
+    super::wolfe::min_norm_point(support, pts[0], 1.0, 1e-15, 4 * pts.len() + 16)
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ mod order;
 mod polygon;
 pub(crate) mod predicates;
 mod sample; // [shade] solid-angle sampling of spherical triangles
+mod wolfe;
 
 pub use boolean::MIN_CAP_COS;
 pub use clip::HORIZON_TOLERANCE;
@@ -19,3 +20,4 @@ pub use gnomonic::{Gnomonic, enclosing_cap};
 pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};
 pub use sample::SphericalTriangle; // [shade]
+pub(crate) use wolfe::min_norm_point;
