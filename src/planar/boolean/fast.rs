@@ -51,7 +51,7 @@ use smallvec::SmallVec;
 
 use super::BoolOp;
 use super::intersect::{SNAP_REL, crossing_point, edge_param, sort_key};
-use super::trace::regularize;
+use super::trace::regularize_slice;
 use crate::planar::contour::Contour;
 use crate::planar::predicates::{orient, winding};
 use crate::planar::shape::Shape;
@@ -84,6 +84,10 @@ struct Crossing {
     ia: u32,
     cb: u32,
     ib: u32,
+    /// The edges' numbers over all contours of their operand (contour by contour), for the
+    /// order along the operands.
+    ga: u32,
+    gb: u32,
     /// Whether A's boundary leaving the crossing runs inside B (A's far end is left of B's
     /// edge, where B's interior is).
     a_in: bool,
@@ -116,11 +120,13 @@ struct EdgeBox {
     near: f64,
     c: u32,
     i: u32,
+    /// The edge's number over all contours of its operand.
+    g: u32,
 }
 
 impl EdgeBox {
     #[inline]
-    fn new(p0: DVec2, p1: DVec2, m: f64, c: usize, i: usize) -> EdgeBox {
+    fn new(p0: DVec2, p1: DVec2, m: f64, c: usize, i: usize, g: usize) -> EdgeBox {
         // Plain comparisons: coordinates are finite, so `f64::min`'s NaN handling is waste.
         let (x0, x1) = if p0.x <= p1.x {
             (p0.x, p1.x)
@@ -140,6 +146,7 @@ impl EdgeBox {
             near: m * (d.x + d.y),
             c: c as u32,
             i: i as u32,
+            g: g as u32,
         }
     }
 }
@@ -158,8 +165,10 @@ pub(crate) struct Scratch {
     cross: SmallVec<[Crossing; 16]>,
     order: SmallVec<[u128; 16]>,
     /// The crossings in order along A's contours and along B's.
-    ord_a: SmallVec<[u32; 16]>,
-    ord_b: SmallVec<[u32; 16]>,
+    /// Packed keys: edge number in the high 32 bits, then the parameter's bits, then the
+    /// crossing's index in the low 32.
+    ord_a: SmallVec<[u128; 16]>,
+    ord_b: SmallVec<[u128; 16]>,
     path: SmallVec<[DVec2; 64]>,
 }
 
@@ -201,10 +210,12 @@ fn edge(pts: &[DVec2], i: usize) -> (DVec2, DVec2) {
 /// Fills `out` with the edges of `r` (those whose boxes come within `m` of `near`, if given).
 fn edge_boxes(r: &Shape, near: Option<[f64; 4]>, m: f64, out: &mut SmallVec<[EdgeBox; 32]>) {
     out.clear();
+    let mut g = 0;
     for (c, ring) in r.contours.iter().enumerate() {
         for i in 0..ring.pts.len() {
             let (p0, p1) = edge(&ring.pts, i);
-            let e = EdgeBox::new(p0, p1, m, c, i);
+            let e = EdgeBox::new(p0, p1, m, c, i, g);
+            g += 1;
             if near.is_none_or(|n| boxes_near(&e.b, &n, m)) {
                 out.push(e);
             }
@@ -225,10 +236,12 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
     if na * nb <= ALL_PAIRS_MAX {
         // A's edges are made on the fly: each is used once.
         let bb: &[EdgeBox] = &s.boxes_b;
+        let mut g = 0;
         for (c, ring) in a.contours.iter().enumerate() {
             for i in 0..ring.pts.len() {
                 let (p0, p1) = edge(&ring.pts, i);
-                let ea = EdgeBox::new(p0, p1, m, c, i);
+                let ea = EdgeBox::new(p0, p1, m, c, i, g);
+                g += 1;
                 if filter && !boxes_near(&ea.b, &box_b, m) {
                     continue;
                 }
@@ -329,6 +342,8 @@ fn pair(e: &EdgeBox, f: &EdgeBox, out: &mut SmallVec<[Crossing; 16]>) -> Option<
         ia: e.i,
         cb: f.c,
         ib: f.i,
+        ga: e.g,
+        gb: f.g,
         a_in: op1 > 0.0,
         b_in: oq1 > 0.0,
         na: 0,
@@ -383,63 +398,60 @@ fn crossings_apart(
 /// along its contour. `None` if two crossings share an edge parameter (never in generic
 /// position, but the order would then be arbitrary) or if the crossings along a contour do
 /// not alternate between entering and leaving the other operand.
-fn link(cross: &mut [Crossing], ord: &mut SmallVec<[u32; 16]>, side_b: bool) -> Option<()> {
-    let key = |x: &Crossing| {
-        if side_b {
-            (u64::from(x.cb) << 32 | u64::from(x.ib), x.tb)
-        } else {
-            (u64::from(x.ca) << 32 | u64::from(x.ia), x.ta)
-        }
-    };
-    let before = |x: (u64, f64), y: (u64, f64)| x.0 < y.0 || (x.0 == y.0 && x.1 < y.1);
+fn link(cross: &mut [Crossing], ord: &mut SmallVec<[u128; 16]>, side_b: bool) -> Option<()> {
     ord.clear();
-    ord.extend(0..cross.len() as u32);
+    for (k, x) in cross.iter().enumerate() {
+        let (g, t) = if side_b { (x.gb, x.tb) } else { (x.ga, x.ta) };
+        // `t` is in (0, 1), where the bits of an `f64` order as the numbers do.
+        ord.push(u128::from(g) << 96 | u128::from(t.to_bits()) << 32 | k as u128);
+    }
     if ord.len() <= 32 {
         // Insertion sort: found along A's edges, the crossings are nearly in A's order already.
         for k in 1..ord.len() {
             let x = ord[k];
-            let kx = key(&cross[x as usize]);
             let mut j = k;
-            while j > 0 && before(kx, key(&cross[ord[j - 1] as usize])) {
+            while j > 0 && x < ord[j - 1] {
                 ord[j] = ord[j - 1];
                 j -= 1;
             }
             ord[j] = x;
         }
     } else {
-        ord.sort_unstable_by(|&x, &y| {
-            let (kx, ky) = (key(&cross[x as usize]), key(&cross[y as usize]));
-            kx.0.cmp(&ky.0).then(kx.1.total_cmp(&ky.1))
-        });
+        ord.sort_unstable();
     }
+    let contour = |cross: &[Crossing], k: u128| {
+        let x = &cross[k as u32 as usize];
+        if side_b { x.cb } else { x.ca }
+    };
     let n = ord.len();
     let mut g = 0;
     while g < n {
-        let contour = key(&cross[ord[g] as usize]).0 >> 32;
+        let c = contour(cross, ord[g]);
         let mut h = g + 1;
-        while h < n && key(&cross[ord[h] as usize]).0 >> 32 == contour {
+        while h < n && contour(cross, ord[h]) == c {
             h += 1;
         }
         for k in g..h {
-            let x = ord[k];
+            let x = ord[k] as u32;
             let next = if k + 1 == h { ord[g] } else { ord[k + 1] };
-            let prev = if k == g { ord[h - 1] } else { ord[k - 1] };
-            let (kx, kn) = (key(&cross[x as usize]), key(&cross[next as usize]));
+            let prev = if k == g { ord[h - 1] } else { ord[k - 1] } as u32;
+            let (y, z) = (&cross[x as usize], &cross[next as u32 as usize]);
             let (inside, inside_next) = if side_b {
-                (cross[x as usize].b_in, cross[next as usize].b_in)
+                (y.b_in, z.b_in)
             } else {
-                (cross[x as usize].a_in, cross[next as usize].a_in)
+                (y.a_in, z.a_in)
             };
             // Statuses change only at crossings: leaving inside, the boundary must enter at
             // the next crossing, and vice versa (a lone crossing fails this too).
-            if inside == inside_next || (k + 1 < h && kx == kn) {
+            if inside == inside_next || (k + 1 < h && ord[k] >> 32 == next >> 32) {
                 return None;
             }
-            let c = &mut cross[x as usize];
+            let next = next as u32;
+            let y = &mut cross[x as usize];
             if side_b {
-                (c.nb, c.pb, c.first_b) = (next, prev, k == g);
+                (y.nb, y.pb, y.first_b) = (next, prev, k == g);
             } else {
-                (c.na, c.pa, c.first_a) = (next, prev, k == g);
+                (y.na, y.pa, y.first_a) = (next, prev, k == g);
             }
         }
         g = h;
@@ -526,24 +538,34 @@ fn walk(s: &mut Scratch, a: &Shape, b: &Shape, op: BoolOp, scale: f64) -> Option
     for (c, ring) in a.contours.iter().enumerate() {
         let h = g + ord_a[g..]
             .iter()
-            .take_while(|&&x| cross[x as usize].ca == c as u32)
+            .take_while(|&&x| cross[x as u32 as usize].ca == c as u32)
             .count();
         if g == h {
             if inside(ring.pts[0], b) == inter {
-                out.extend(regularize(ring.pts.iter().copied(), scale));
+                out.extend(regularize_slice(&ring.pts, scale));
             }
         } else {
             // The split edge from vertex 0 comes first in A's order: it belongs to the piece
             // after the contour's last crossing.
-            let last = ord_a[h - 1] as usize;
+            let last = ord_a[h - 1] as u32 as usize;
             if cross[last].a_in == inter && !cross[last].visited {
-                trace_loop(cross, a, b, inter, rev_b, Some(c as u32), ord_a[g], path)?;
-                out.extend(regularize(path.iter().copied(), scale));
+                trace_loop(
+                    cross,
+                    a,
+                    b,
+                    inter,
+                    rev_b,
+                    Some(c as u32),
+                    ord_a[g] as u32,
+                    path,
+                )?;
+                out.extend(regularize_slice(path, scale));
             }
             for &x in &ord_a[g..h] {
+                let x = x as u32;
                 if cross[x as usize].a_in == inter && !cross[x as usize].visited {
                     trace_loop(cross, a, b, inter, rev_b, None, x, path)?;
-                    out.extend(regularize(path.iter().copied(), scale));
+                    out.extend(regularize_slice(path, scale));
                 }
             }
         }
@@ -558,17 +580,18 @@ fn walk(s: &mut Scratch, a: &Shape, b: &Shape, op: BoolOp, scale: f64) -> Option
     for (c, ring) in b.contours.iter().enumerate() {
         let h = g + ord_b[g..]
             .iter()
-            .take_while(|&&x| cross[x as usize].cb == c as u32)
+            .take_while(|&&x| cross[x as u32 as usize].cb == c as u32)
             .count();
         if g == h && inside(ring.pts[0], a) == (op != BoolOp::Union) {
             let pts = &ring.pts;
             if rev_b {
                 // The robust walk of a reversed contour starts at vertex 1 (the far end of its
                 // first split edge) and runs backwards.
-                let rev = pts[..2].iter().rev().chain(pts[2..].iter().rev());
-                out.extend(regularize(rev.copied(), scale));
+                path.clear();
+                path.extend(pts[..2].iter().rev().chain(pts[2..].iter().rev()).copied());
+                out.extend(regularize_slice(path, scale));
             } else {
-                out.extend(regularize(pts.iter().copied(), scale));
+                out.extend(regularize_slice(pts, scale));
             }
         }
         g = h;
