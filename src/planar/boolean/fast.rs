@@ -51,7 +51,7 @@ use smallvec::SmallVec;
 
 use super::BoolOp;
 use super::intersect::{SNAP_REL, crossing_point, edge_param, sort_key};
-use super::trace::regularize_slice;
+use super::trace::{regularize, survives};
 use crate::planar::contour::Contour;
 use crate::planar::predicates::{orient, winding};
 use crate::planar::shape::Shape;
@@ -170,6 +170,8 @@ pub(crate) struct Scratch {
     ord_a: SmallVec<[u128; 16]>,
     ord_b: SmallVec<[u128; 16]>,
     path: SmallVec<[DVec2; 64]>,
+    /// Positions of the crossings in `path`.
+    xs: SmallVec<[u32; 16]>,
 }
 
 /// Runs `a op b` in generic position, or returns `None` when the operands need the robust path
@@ -190,8 +192,8 @@ pub(crate) fn run(
     s.cross.clear();
     find_crossings(s, a, b, m)?;
     crossings_apart(&mut s.cross, &mut s.order, m)?;
-    link(&mut s.cross, &mut s.ord_a, false)?;
-    link(&mut s.cross, &mut s.ord_b, true)?;
+    link(&mut s.cross, &mut s.ord_a, false, a.contours.len() == 1)?;
+    link(&mut s.cross, &mut s.ord_b, true, b.contours.len() == 1)?;
     transversal(&s.cross, a, b, m)?;
     walk(s, a, b, op, scale)
 }
@@ -207,16 +209,28 @@ fn edge(pts: &[DVec2], i: usize) -> (DVec2, DVec2) {
     (pts[i], pts[if i + 1 == pts.len() { 0 } else { i + 1 }])
 }
 
-/// Fills `out` with the edges of `r` (those whose boxes come within `m` of `near`, if given).
-fn edge_boxes(r: &Shape, near: Option<[f64; 4]>, m: f64, out: &mut SmallVec<[EdgeBox; 32]>) {
+/// Fills `out` with the edges of `r` (those whose boxes come within `m` of `near`, if given);
+/// with `widen`, the boxes are stored widened by `m` on every side, so that each pair test
+/// against them is four comparisons.
+fn edge_boxes(
+    r: &Shape,
+    near: Option<[f64; 4]>,
+    m: f64,
+    widen: bool,
+    out: &mut SmallVec<[EdgeBox; 32]>,
+) {
     out.clear();
+    out.reserve(r.vertex_count());
     let mut g = 0;
     for (c, ring) in r.contours.iter().enumerate() {
         for i in 0..ring.pts.len() {
             let (p0, p1) = edge(&ring.pts, i);
-            let e = EdgeBox::new(p0, p1, m, c, i, g);
+            let mut e = EdgeBox::new(p0, p1, m, c, i, g);
             g += 1;
             if near.is_none_or(|n| boxes_near(&e.b, &n, m)) {
+                if widen {
+                    e.b = [e.b[0] - m, e.b[1] + m, e.b[2] - m, e.b[3] + m];
+                }
                 out.push(e);
             }
         }
@@ -231,7 +245,8 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
     // filter costs more than the pair tests it saves).
     let filter = na * nb > FILTER_MIN;
     let (box_a, box_b) = (bbox(a), bbox(b));
-    edge_boxes(b, filter.then_some(box_a), m, &mut s.boxes_b);
+    // B's boxes are widened by the margin: a pair is tested when the boxes come within `m`.
+    edge_boxes(b, filter.then_some(box_a), m, true, &mut s.boxes_b);
     let cross = &mut s.cross;
     if na * nb <= ALL_PAIRS_MAX {
         // A's edges are made on the fly: each is used once.
@@ -246,7 +261,7 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
                     continue;
                 }
                 for eb in bb {
-                    if boxes_near(&ea.b, &eb.b, m) {
+                    if overlap(&ea.b, &eb.b) {
                         pair(&ea, eb, cross)?;
                     }
                 }
@@ -254,10 +269,10 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
         }
         return Some(());
     }
-    edge_boxes(a, filter.then_some(box_b), m, &mut s.boxes_a);
+    edge_boxes(a, filter.then_some(box_b), m, false, &mut s.boxes_a);
     let (ba, bb): (&[EdgeBox], &[EdgeBox]) = (&s.boxes_a, &s.boxes_b);
-    // Sweep: edges enter in order of their left ends; an edge leaves the active list once the
-    // sweep has passed its right end by more than the margin.
+    // Sweep: edges enter in order of their left ends (B's widened); an edge leaves the active
+    // list once the sweep has passed its right end (B's widened).
     const B_BIT: u32 = 1 << 31;
     let events = &mut s.events;
     events.clear();
@@ -276,10 +291,10 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
         if id & B_BIT == 0 {
             let ea = &ba[id as usize];
             let x = ea.b[0];
-            active_b.retain(|j| bb[*j as usize].b[1] + m >= x);
+            active_b.retain(|j| bb[*j as usize].b[1] >= x);
             for &j in active_b.iter() {
                 let eb = &bb[j as usize];
-                if boxes_near(&ea.b, &eb.b, m) {
+                if overlap(&ea.b, &eb.b) {
                     pair(ea, eb, cross)?;
                 }
             }
@@ -288,10 +303,10 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
             let j = id & !B_BIT;
             let eb = &bb[j as usize];
             let x = eb.b[0];
-            active_a.retain(|i| ba[*i as usize].b[1] + m >= x);
+            active_a.retain(|i| ba[*i as usize].b[1] >= x);
             for &i in active_a.iter() {
                 let ea = &ba[i as usize];
-                if boxes_near(&ea.b, &eb.b, m) {
+                if overlap(&ea.b, &eb.b) {
                     pair(ea, eb, cross)?;
                 }
             }
@@ -299,6 +314,12 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
         }
     }
     Some(())
+}
+
+/// Whether two boxes overlap (touching counts).
+#[inline]
+fn overlap(a: &[f64; 4], b: &[f64; 4]) -> bool {
+    a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3]
 }
 
 /// Whether two boxes come within `m` of each other.
@@ -398,13 +419,28 @@ fn crossings_apart(
 /// along its contour. `None` if two crossings share an edge parameter (never in generic
 /// position, but the order would then be arbitrary) or if the crossings along a contour do
 /// not alternate between entering and leaving the other operand.
-fn link(cross: &mut [Crossing], ord: &mut SmallVec<[u128; 16]>, side_b: bool) -> Option<()> {
-    ord.clear();
-    for (k, x) in cross.iter().enumerate() {
-        let (g, t) = if side_b { (x.gb, x.tb) } else { (x.ga, x.ta) };
-        // `t` is in (0, 1), where the bits of an `f64` order as the numbers do.
-        ord.push(u128::from(g) << 96 | u128::from(t.to_bits()) << 32 | k as u128);
+fn link(
+    cross: &mut [Crossing],
+    ord: &mut SmallVec<[u128; 16]>,
+    side_b: bool,
+    one_contour: bool,
+) -> Option<()> {
+    // The index field's top bit holds the entry flag, so the checks below read only the keys.
+    const IN: u128 = 1 << 31;
+    if cross.len() >= 1 << 31 {
+        return None;
     }
+    ord.clear();
+    ord.extend(cross.iter().enumerate().map(|(k, x)| {
+        let (g, t, inside) = if side_b {
+            (x.gb, x.tb, x.b_in)
+        } else {
+            (x.ga, x.ta, x.a_in)
+        };
+        // `t` is in (0, 1), where the bits of an `f64` order as the numbers do.
+        u128::from(g) << 96 | u128::from(t.to_bits()) << 32 | u128::from(inside) << 31 | k as u128
+    }));
+    let ord: &mut [u128] = ord;
     if ord.len() <= 32 {
         // Insertion sort: found along A's edges, the crossings are nearly in A's order already.
         for k in 1..ord.len() {
@@ -419,35 +455,36 @@ fn link(cross: &mut [Crossing], ord: &mut SmallVec<[u128; 16]>, side_b: bool) ->
     } else {
         ord.sort_unstable();
     }
-    let contour = |cross: &[Crossing], k: u128| {
-        let x = &cross[k as u32 as usize];
-        if side_b { x.cb } else { x.ca }
-    };
+    let idx = |k: u128| (k as u32 & !(IN as u32)) as usize;
     let n = ord.len();
     let mut g = 0;
     while g < n {
-        let c = contour(cross, ord[g]);
-        let mut h = g + 1;
-        while h < n && contour(cross, ord[h]) == c {
-            h += 1;
-        }
-        for k in g..h {
-            let x = ord[k] as u32;
-            let next = if k + 1 == h { ord[g] } else { ord[k + 1] };
-            let prev = if k == g { ord[h - 1] } else { ord[k - 1] } as u32;
-            let (y, z) = (&cross[x as usize], &cross[next as u32 as usize]);
-            let (inside, inside_next) = if side_b {
-                (y.b_in, z.b_in)
-            } else {
-                (y.a_in, z.a_in)
+        // The crossings of one contour form a run of the order.
+        let h = if one_contour {
+            n
+        } else {
+            let contour = |k: u128| {
+                let x = &cross[idx(k)];
+                if side_b { x.cb } else { x.ca }
             };
+            let c = contour(ord[g]);
+            g + 1
+                + ord[g + 1..]
+                    .iter()
+                    .take_while(|&&k| contour(k) == c)
+                    .count()
+        };
+        for k in g..h {
+            let next = if k + 1 == h { ord[g] } else { ord[k + 1] };
+            let prev = if k == g { ord[h - 1] } else { ord[k - 1] };
             // Statuses change only at crossings: leaving inside, the boundary must enter at
-            // the next crossing, and vice versa (a lone crossing fails this too).
-            if inside == inside_next || (k + 1 < h && ord[k] >> 32 == next >> 32) {
+            // the next crossing, and vice versa (a lone crossing fails this too). Equal
+            // parameters on one edge would leave the order to the index.
+            if (ord[k] ^ next) & IN == 0 || (k + 1 < h && ord[k] >> 32 == next >> 32) {
                 return None;
             }
-            let next = next as u32;
-            let y = &mut cross[x as usize];
+            let (next, prev) = (idx(next) as u32, idx(prev) as u32);
+            let y = &mut cross[idx(ord[k])];
             if side_b {
                 (y.nb, y.pb, y.first_b) = (next, prev, k == g);
             } else {
@@ -530,42 +567,37 @@ fn walk(s: &mut Scratch, a: &Shape, b: &Shape, op: BoolOp, scale: f64) -> Option
         ord_a,
         ord_b,
         path,
+        xs,
         ..
     } = s;
     let cross: &mut [Crossing] = cross;
+    let idx = |k: u128| (k as u32 & !(1 << 31)) as usize;
     let mut out = Vec::new();
     let mut g = 0usize;
     for (c, ring) in a.contours.iter().enumerate() {
         let h = g + ord_a[g..]
             .iter()
-            .take_while(|&&x| cross[x as u32 as usize].ca == c as u32)
+            .take_while(|&&k| cross[idx(k)].ca == c as u32)
             .count();
         if g == h {
             if inside(ring.pts[0], b) == inter {
-                out.extend(regularize_slice(&ring.pts, scale));
+                out.extend(regularize_walked(&ring.pts, &[], scale));
             }
         } else {
             // The split edge from vertex 0 comes first in A's order: it belongs to the piece
             // after the contour's last crossing.
-            let last = ord_a[h - 1] as u32 as usize;
+            let last = idx(ord_a[h - 1]);
             if cross[last].a_in == inter && !cross[last].visited {
-                trace_loop(
-                    cross,
-                    a,
-                    b,
-                    inter,
-                    rev_b,
-                    Some(c as u32),
-                    ord_a[g] as u32,
-                    path,
-                )?;
-                out.extend(regularize_slice(path, scale));
+                let w = Walk { a, b, inter, rev_b };
+                w.trace(cross, Some(c as u32), idx(ord_a[g]), path, xs)?;
+                out.extend(regularize_walked(path, xs, scale));
             }
-            for &x in &ord_a[g..h] {
-                let x = x as u32;
-                if cross[x as usize].a_in == inter && !cross[x as usize].visited {
-                    trace_loop(cross, a, b, inter, rev_b, None, x, path)?;
-                    out.extend(regularize_slice(path, scale));
+            for &k in &ord_a[g..h] {
+                let x = idx(k);
+                if cross[x].a_in == inter && !cross[x].visited {
+                    let w = Walk { a, b, inter, rev_b };
+                    w.trace(cross, None, x, path, xs)?;
+                    out.extend(regularize_walked(path, xs, scale));
                 }
             }
         }
@@ -580,7 +612,7 @@ fn walk(s: &mut Scratch, a: &Shape, b: &Shape, op: BoolOp, scale: f64) -> Option
     for (c, ring) in b.contours.iter().enumerate() {
         let h = g + ord_b[g..]
             .iter()
-            .take_while(|&&x| cross[x as u32 as usize].cb == c as u32)
+            .take_while(|&&k| cross[idx(k)].cb == c as u32)
             .count();
         if g == h && inside(ring.pts[0], a) == (op != BoolOp::Union) {
             let pts = &ring.pts;
@@ -589,9 +621,9 @@ fn walk(s: &mut Scratch, a: &Shape, b: &Shape, op: BoolOp, scale: f64) -> Option
                 // first split edge) and runs backwards.
                 path.clear();
                 path.extend(pts[..2].iter().rev().chain(pts[2..].iter().rev()).copied());
-                out.extend(regularize_slice(path, scale));
+                out.extend(regularize_walked(path, &[], scale));
             } else {
-                out.extend(regularize_slice(pts, scale));
+                out.extend(regularize_walked(pts, &[], scale));
             }
         }
         g = h;
@@ -599,78 +631,126 @@ fn walk(s: &mut Scratch, a: &Shape, b: &Shape, op: BoolOp, scale: f64) -> Option
     Some(out)
 }
 
-/// Walks one loop into `path`: from crossing `c`, or, with `from_vertex0 = Some(r)`, from vertex
-/// 0 of A's contour `r` (then `c` is that contour's first crossing). `None` if a crossing has
-/// no or two selected ways out, or the walk meets a crossing twice.
-#[allow(clippy::too_many_arguments)]
-fn trace_loop(
-    cross: &mut [Crossing],
-    a: &Shape,
-    b: &Shape,
+/// The operands and the operation of a walk.
+struct Walk<'s> {
+    a: &'s Shape,
+    b: &'s Shape,
     inter: bool,
     rev_b: bool,
-    from_vertex0: Option<u32>,
-    mut c: u32,
-    path: &mut SmallVec<[DVec2; 64]>,
-) -> Option<()> {
-    path.clear();
-    let start = c;
-    if let Some(r) = from_vertex0 {
-        path.extend_from_slice(&a.contours[r as usize].pts[..=cross[c as usize].ia as usize]);
-    }
-    loop {
-        let x = &mut cross[c as usize];
-        if x.visited {
-            return None;
+}
+
+impl Walk<'_> {
+    /// Walks one loop into `path`, with the positions of its crossings in `xs`: from crossing
+    /// `c`, or, with `from_vertex0 = Some(r)`, from vertex 0 of A's contour `r` (then `c` is
+    /// that contour's first crossing). `None` if a crossing has no or two selected ways out, or
+    /// the walk meets a crossing twice.
+    fn trace(
+        &self,
+        cross: &mut [Crossing],
+        from_vertex0: Option<u32>,
+        mut c: usize,
+        path: &mut SmallVec<[DVec2; 64]>,
+        xs: &mut SmallVec<[u32; 16]>,
+    ) -> Option<()> {
+        let (a, b, inter) = (self.a, self.b, self.inter);
+        // Runs of vertices are mostly a few points long: a plain copy loop beats `memcpy`.
+        let run = |path: &mut SmallVec<[DVec2; 64]>, pts: &[DVec2]| {
+            path.extend(pts.iter().copied());
+        };
+        path.clear();
+        xs.clear();
+        let start = c;
+        if let Some(r) = from_vertex0 {
+            run(path, &a.contours[r as usize].pts[..=cross[c].ia as usize]);
         }
-        x.visited = true;
-        let x = *x;
-        path.push(x.p);
-        let (out_a, out_b) = (x.a_in == inter, x.b_in == inter);
-        if out_a == out_b {
-            return None;
-        }
-        if out_a {
-            let y = &cross[x.na as usize];
-            let pts = &a.contours[x.ca as usize].pts;
-            let i = x.ia as usize + 1;
-            if y.first_a {
-                path.extend_from_slice(&pts[i..]);
-                if from_vertex0 == Some(x.ca) {
-                    return Some(());
+        loop {
+            let x = &mut cross[c];
+            if x.visited {
+                return None;
+            }
+            x.visited = true;
+            let x = &cross[c];
+            xs.push(path.len() as u32);
+            path.push(x.p);
+            let (out_a, out_b) = (x.a_in == inter, x.b_in == inter);
+            if out_a == out_b {
+                return None;
+            }
+            if out_a {
+                let y = &cross[x.na as usize];
+                let pts = &a.contours[x.ca as usize].pts;
+                let i = x.ia as usize + 1;
+                if y.first_a {
+                    run(path, &pts[i..]);
+                    if from_vertex0 == Some(x.ca) {
+                        return Some(());
+                    }
+                    run(path, &pts[..=y.ia as usize]);
+                } else {
+                    run(path, &pts[i..=y.ia as usize]);
                 }
-                path.extend_from_slice(&pts[..=y.ia as usize]);
+                c = x.na as usize;
+            } else if self.rev_b {
+                // Backwards along B: from the crossing down to the first vertex of its edge,
+                // and on to the vertex after the previous crossing's edge.
+                let y = &cross[x.pb as usize];
+                let pts = &b.contours[x.cb as usize].pts;
+                let (i, j) = (x.ib as usize, y.ib as usize + 1);
+                if x.first_b {
+                    path.extend(pts[..=i].iter().rev().copied());
+                    path.extend(pts[j..].iter().rev().copied());
+                } else {
+                    path.extend(pts[j..=i].iter().rev().copied());
+                }
+                c = x.pb as usize;
             } else {
-                path.extend_from_slice(&pts[i..=y.ia as usize]);
+                let y = &cross[x.nb as usize];
+                let pts = &b.contours[x.cb as usize].pts;
+                let i = x.ib as usize + 1;
+                if y.first_b {
+                    run(path, &pts[i..]);
+                    run(path, &pts[..=y.ib as usize]);
+                } else {
+                    run(path, &pts[i..=y.ib as usize]);
+                }
+                c = x.nb as usize;
             }
-            c = x.na;
-        } else if rev_b {
-            // Backwards along B: from the crossing down to the first vertex of its edge, and on
-            // to the vertex after the previous crossing's edge.
-            let y = &cross[x.pb as usize];
-            let pts = &b.contours[x.cb as usize].pts;
-            let (i, j) = (x.ib as usize, y.ib as usize + 1);
-            if x.first_b {
-                path.extend(pts[..=i].iter().rev().copied());
-                path.extend(pts[j..].iter().rev().copied());
-            } else {
-                path.extend(pts[j..=i].iter().rev().copied());
+            if from_vertex0.is_none() && c == start {
+                return Some(());
             }
-            c = x.pb;
-        } else {
-            let y = &cross[x.nb as usize];
-            let pts = &b.contours[x.cb as usize].pts;
-            let i = x.ib as usize + 1;
-            if y.first_b {
-                path.extend_from_slice(&pts[i..]);
-                path.extend_from_slice(&pts[..=y.ib as usize]);
-            } else {
-                path.extend_from_slice(&pts[i..=y.ib as usize]);
-            }
-            c = x.nb;
-        }
-        if from_vertex0.is_none() && c == start {
-            return Some(());
         }
     }
+}
+
+/// [`regularize`](super::trace::regularize) for a walked loop whose crossings are at the
+/// positions `xs` (ascending), with the same result.
+///
+/// `regularize` keeps every point of a loop in which every three cyclically consecutive
+/// points turn (exact `orient` nonzero, which also rules out repeated points), and then only
+/// the sliver test is left. Most of those turns are known here: at a crossing, `transversal`
+/// has checked the turn between the two split edges with margin; at a vertex between two
+/// vertices, the three are consecutive in an operand's contour (forwards or backwards), which a
+/// valid `Shape` never has collinear. Only a vertex next to a crossing needs its turn tested.
+fn regularize_walked(pts: &[DVec2], xs: &[u32], scale: f64) -> Option<Contour> {
+    let n = pts.len();
+    let turns = |i: usize, j: usize, k: usize| orient(pts[i], pts[j], pts[k]) != 0.0;
+    let clean = n >= 3
+        && xs.iter().enumerate().all(|(k, &j)| {
+            let j = j as usize;
+            let (next_x, prev_x) = (
+                xs.get(k + 1).copied().unwrap_or(xs[0]) as usize,
+                xs[if k == 0 { xs.len() } else { k } - 1] as usize,
+            );
+            let jn = if j + 1 == n { 0 } else { j + 1 };
+            let jp = if j == 0 { n - 1 } else { j - 1 };
+            let (jnn, jpp) = (
+                if jn + 1 == n { 0 } else { jn + 1 },
+                if jp == 0 { n - 1 } else { jp - 1 },
+            );
+            (next_x == jn || turns(j, jn, jnn)) && (prev_x == jp || turns(jpp, jp, j))
+        });
+    if !clean {
+        return regularize(pts.iter().copied(), scale);
+    }
+    survives(pts, scale).then(|| Contour { pts: pts.to_vec() })
 }

@@ -270,35 +270,17 @@ pub(crate) fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option
     survives(&out, scale).then(|| Contour { pts: out.to_vec() })
 }
 
-/// [`regularize`] for a loop given as a slice, with the same result. Loops that need no
-/// cleaning — every three cyclically consecutive points exactly non-collinear, which also
-/// rules out repeated points (`orient(a, a, c) == 0`) — are the common case on the fast path;
-/// for them the stack pass of [`regularize`] would keep every point, so only the sliver test
-/// is left, and the contour is copied once at its final size.
-pub(crate) fn regularize_slice(pts: &[DVec2], scale: f64) -> Option<Contour> {
-    let n = pts.len();
-    let clean = n >= 3 && {
-        let mut a = pts[n - 2];
-        let mut b = pts[n - 1];
-        pts.iter().all(|&c| {
-            let turns = orient(a, b, c) != 0.0;
-            (a, b) = (b, c);
-            turns
-        })
-    };
-    if !clean {
-        return regularize(pts.iter().copied(), scale);
-    }
-    survives(pts, scale).then(|| Contour { pts: pts.to_vec() })
-}
-
 /// Whether a loop without repeated or collinear consecutive points bounds more than a sliver:
 /// nonzero area, and more than [`SLIVER_REL`] times the scale per unit of perimeter.
-fn survives(out: &[DVec2], scale: f64) -> bool {
+pub(crate) fn survives(out: &[DVec2], scale: f64) -> bool {
     let area2 = signed_area2(out);
     let n = out.len();
-    let perimeter: f64 = (0..n)
-        .map(|i| sqrt((out[(i + 1) % n] - out[i]).length_squared()))
+    // Edges in order, the closing one last (no `%` per edge).
+    let perimeter: f64 = out
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .chain(core::iter::once((out[n - 1], out[0])))
+        .map(|(p, q)| sqrt((q - p).length_squared()))
         .sum();
     !(area2 == 0.0 || area2.abs() <= SLIVER_REL * scale * perimeter)
 }
