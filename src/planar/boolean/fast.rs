@@ -329,7 +329,7 @@ fn boxes_near(a: &[f64; 4], b: &[f64; 4], m: f64) -> bool {
 }
 
 /// One edge pair: nothing, a proper crossing (recorded), or `None` for anything near a contact.
-#[inline]
+#[inline(always)]
 fn pair(e: &EdgeBox, f: &EdgeBox, out: &mut SmallVec<[Crossing; 16]>) -> Option<()> {
     let (p0, p1, q0, q1) = (e.p0, e.p1, f.p0, f.p1);
     let oq0 = orient(p0, p1, q0);
@@ -431,15 +431,21 @@ fn link(
         return None;
     }
     ord.clear();
-    ord.extend(cross.iter().enumerate().map(|(k, x)| {
+    // Plain pushes: `SmallVec`'s `extend` costs more than the few elements here.
+    for (k, x) in cross.iter().enumerate() {
         let (g, t, inside) = if side_b {
             (x.gb, x.tb, x.b_in)
         } else {
             (x.ga, x.ta, x.a_in)
         };
         // `t` is in (0, 1), where the bits of an `f64` order as the numbers do.
-        u128::from(g) << 96 | u128::from(t.to_bits()) << 32 | u128::from(inside) << 31 | k as u128
-    }));
+        ord.push(
+            u128::from(g) << 96
+                | u128::from(t.to_bits()) << 32
+                | u128::from(inside) << 31
+                | k as u128,
+        );
+    }
     let ord: &mut [u128] = ord;
     if ord.len() <= 32 {
         // Insertion sort: found along A's edges, the crossings are nearly in A's order already.
@@ -653,9 +659,12 @@ impl Walk<'_> {
         xs: &mut SmallVec<[u32; 16]>,
     ) -> Option<()> {
         let (a, b, inter) = (self.a, self.b, self.inter);
-        // Runs of vertices are mostly a few points long: a plain copy loop beats `memcpy`.
+        // Runs of vertices are mostly a few points long: plain pushes beat `memcpy` and
+        // `SmallVec`'s `extend` there.
         let run = |path: &mut SmallVec<[DVec2; 64]>, pts: &[DVec2]| {
-            path.extend(pts.iter().copied());
+            for &p in pts {
+                path.push(p);
+            }
         };
         path.clear();
         xs.clear();
@@ -696,11 +705,16 @@ impl Walk<'_> {
                 let y = &cross[x.pb as usize];
                 let pts = &b.contours[x.cb as usize].pts;
                 let (i, j) = (x.ib as usize, y.ib as usize + 1);
+                let mut back = |pts: &[DVec2]| {
+                    for &p in pts.iter().rev() {
+                        path.push(p);
+                    }
+                };
                 if x.first_b {
-                    path.extend(pts[..=i].iter().rev().copied());
-                    path.extend(pts[j..].iter().rev().copied());
+                    back(&pts[..=i]);
+                    back(&pts[j..]);
                 } else {
-                    path.extend(pts[j..=i].iter().rev().copied());
+                    back(&pts[j..=i]);
                 }
                 c = x.pb as usize;
             } else {
