@@ -181,6 +181,11 @@ impl Shape {
     /// an even number of other rings becomes a counter-clockwise outer contour, one inside an odd
     /// number a clockwise hole. No rings gives the empty shape.
     ///
+    /// Besides validating, this computes once what [`boolean`](super::boolean) needs to know
+    /// about the shape alone to choose its path (bounding box, smallest distance between two
+    /// vertices, vertices lying on another contour of the shape), so that operations on the
+    /// shape do not recompute it.
+    ///
     /// # Errors
     ///
     /// - [`GeomError::NonFinite`] for a NaN or infinite coordinate;

@@ -8,15 +8,23 @@
 //! [`Workspace`](super::Workspace) keeps across calls, and *bails out* — returns `None`, so the
 //! caller runs the robust pipeline — at the first sign of anything else.
 //!
+//! It reads the operands' contours in place (no copy) and keeps only the crossings: each
+//! knows its edge and parameter on both operands and, once the crossings are ordered along
+//! each operand's contours (`link`), its neighbours there. The walk copies the runs of operand
+//! vertices between consecutive crossings straight from the contours.
+//!
 //! # The fast path never disagrees with the robust path
 //!
 //! The robust pipeline (`intersect` -> `label` -> `trace`) is the definition of the result; the
 //! fast path only skips work that is provably a no-op there, and produces the same contours bit
 //! for bit (same points, same starting points, same order). Precisely, it runs only when:
 //!
-//! - no two vertices of the operands are within the snapping distance (the caller checks this
-//!   with `intersect::weld`, which then changed nothing), and no vertex of an operand lies exactly
-//!   on an edge of another contour of the same operand (`split_self_contacts` would insert it);
+//! - no two vertices of the operands are within the snapping distance, so `intersect::weld`
+//!   would change nothing (within an operand the caller checks the shape's minimum vertex
+//!   separation, cached by `Shape::new`; across the operands such a pair is near the other's
+//!   edges and fails the next condition), and no vertex of an operand lies exactly on an edge of
+//!   another contour of the same operand (`split_self_contacts` would insert it; also a cached
+//!   fact of the shape);
 //! - for every pair of edges whose bounding boxes, widened by `MARGIN` times the snapping
 //!   distance, overlap, no endpoint of either lies within `MARGIN` snapping distances of the
 //!   other's line (by the robust path's own `|orient| <= snap * (|dx| + |dy|)` measure, widened).
@@ -30,17 +38,20 @@
 //!   by a few ulps only, so the robust pass 2, which re-tests the bent edges, finds nothing new:
 //!   the bent edges at a crossing fail its near-collinearity test with margin, and every other
 //!   edge stays `MARGIN` snapping distances away from the thin triangle the bending sweeps;
-//! - along every contour the crossings alternate between entry and exit, and every crossing
-//!   has exactly one selected outgoing edge during the walk (always true in generic position;
-//!   checked rather than assumed).
+//! - along every contour the crossings alternate between entry and exit, no two share an edge
+//!   parameter, every crossing has exactly one selected way out during the walk, and the walk
+//!   meets every crossing exactly once (always true in generic position; checked rather than
+//!   assumed).
 //!
 //! Under these conditions the robust labels equal the crossing signs used here (the local wedge
 //! test at a transversal crossing reduces to the side of the other edge's line), every node of
 //! the selected edges has one edge in and one out, so the robust walk's leftmost-turn choice is
 //! forced, and the walk here visits edges in the same order, starting each loop at the first
-//! unused selected edge in the same order (A's split edges, then B's). Both hand each loop to the
-//! same `trace::regularize`. `tests/planar_fast.rs` checks the agreement on random, degenerate
-//! and near-degenerate inputs, and that the fast path does bail out on the degenerate ones.
+//! unused selected edge in the same order (A's split edges, then B's). Each loop is then
+//! regularized with the result of `trace::regularize` (`regularize_walked` skips the turn tests
+//! that are already known to pass). `tests/planar_fast.rs` checks the agreement on random,
+//! degenerate and near-degenerate inputs, on results of earlier operations, and that the fast
+//! path does bail out on the degenerate ones.
 //!
 //! Symmetric difference is left to the robust path: all four edges at each of its crossings are
 //! selected, so its walk needs the leftmost-turn rule and the loop cutting of `trace`.
@@ -767,4 +778,48 @@ fn regularize_walked(pts: &[DVec2], xs: &[u32], scale: f64) -> Option<Contour> {
         return regularize(pts.iter().copied(), scale);
     }
     survives(pts, scale).then(|| Contour { pts: pts.to_vec() })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pts(v: &[(f64, f64)]) -> Vec<DVec2> {
+        v.iter().map(|&(x, y)| DVec2::new(x, y)).collect()
+    }
+
+    /// The turns that `regularize_walked` tests (at vertices next to a crossing) are the ones
+    /// that can vanish: a vertex collinear with a neighbouring crossing must be removed
+    /// exactly as `regularize` removes it.
+    #[test]
+    fn regularize_walked_removes_a_vertex_collinear_with_a_crossing() {
+        // Crossings at positions 0 and 3; vertex (2, 0) lies on the line from the crossing
+        // (1, 0) to the vertex (3, 0).
+        let p = pts(&[(1.0, 0.0), (2.0, 0.0), (3.0, 0.0), (3.0, 2.0), (1.0, 2.0)]);
+        let r = regularize(p.iter().copied(), 4.0).unwrap();
+        assert_eq!(r.pts.len(), 4);
+        let w = regularize_walked(&p, &[0, 3], 4.0).unwrap();
+        assert_eq!(w, r);
+        // At the seam: the crossing last, the collinear vertex first.
+        let p = pts(&[(2.0, 0.0), (3.0, 0.0), (3.0, 2.0), (1.0, 2.0), (1.0, 0.0)]);
+        let w = regularize_walked(&p, &[2, 4], 4.0).unwrap();
+        assert_eq!(w, regularize(p.iter().copied(), 4.0).unwrap());
+        assert_eq!(w.pts.len(), 4);
+    }
+
+    /// Loops that need no cleaning come back unchanged, and slivers are dropped as
+    /// `regularize` drops them.
+    #[test]
+    fn regularize_walked_matches_regularize() {
+        let p = pts(&[(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.5), (0.0, 1.0)]);
+        for xs in [&[][..], &[1, 3], &[0, 2], &[0, 1, 2, 3, 4]] {
+            assert_eq!(
+                regularize_walked(&p, xs, 2.0),
+                regularize(p.iter().copied(), 2.0)
+            );
+        }
+        let sliver = pts(&[(0.0, 0.0), (1.0, 0.0), (0.5, 1e-300)]);
+        assert_eq!(regularize_walked(&sliver, &[0, 1], 1.0), None);
+        assert_eq!(regularize(sliver.iter().copied(), 1.0), None);
+    }
 }
