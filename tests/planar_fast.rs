@@ -268,3 +268,139 @@ fn benchmark_inputs_take_the_fast_path() {
         }
     }
 }
+
+/// Two contours of one operand with vertices a few ulps apart: `Shape::new` caches the
+/// operand's minimum vertex separation, and the fast path must leave the operand to the robust
+/// path, which welds the two copies into one point (the fast path would keep both, and its
+/// result would differ).
+#[test]
+fn near_duplicate_vertices_within_an_operand_bail_out() {
+    let apex = DVec2::new(1.0, 1.0);
+    let near = DVec2::new(1.0f64.next_up().next_up(), 1.0);
+    let a = Shape::new(vec![
+        vec![DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.0), apex],
+        vec![near, DVec2::new(2.0, 2.0), DVec2::new(0.0, 2.0)],
+    ])
+    .unwrap();
+    // A band across both triangles, far from the near-duplicate pair and from every vertex.
+    let b = Shape::new(vec![vec![
+        DVec2::new(-1.0, 0.3),
+        DVec2::new(3.0, 0.35),
+        DVec2::new(3.0, 1.7),
+        DVec2::new(-1.0, 1.65),
+    ]])
+    .unwrap();
+    for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
+        assert!(
+            boolean_fast(&a, &b, op).unwrap().is_none(),
+            "{}",
+            op_name(op)
+        );
+        assert!(
+            boolean_fast(&b, &a, op).unwrap().is_none(),
+            "{}",
+            op_name(op)
+        );
+    }
+    agree(&a, &b).unwrap();
+    agree(&b, &a).unwrap();
+    // The robust path welded the copies: the apex appears once, `near` never.
+    let r = boolean(&a, &b, BoolOp::Intersection).unwrap();
+    let pts: Vec<DVec2> = r.contours().flatten().copied().collect();
+    assert!(pts.contains(&apex) && !pts.contains(&near), "{r:?}");
+
+    // The same operand as the result of an earlier operation (whose facts are computed on
+    // demand, not cached): a union with a far-away square keeps both triangles verbatim.
+    let far = shape("10:10, 11:10, 11:11, 10:11");
+    let chained = boolean(&a, &far, BoolOp::Union).unwrap();
+    assert_eq!(chained.contours().count(), 3);
+    for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
+        assert!(
+            boolean_fast(&chained, &b, op).unwrap().is_none(),
+            "{}",
+            op_name(op)
+        );
+    }
+    agree(&chained, &b).unwrap();
+}
+
+/// A hole whose vertex lies on an edge of its outer contour: `Shape::new` caches the self
+/// contact, and the fast path must leave the operand to the robust path, which inserts the
+/// vertex into the outer edge (and traces through it).
+#[test]
+fn vertex_on_an_edge_of_its_own_shape_bails_out() {
+    let a = shape("0:0, 4:0, 4:4, 0:4; 2:0, 1:2, 3:2");
+    // Crosses the outer contour's left and right edges only.
+    let b = Shape::new(vec![vec![
+        DVec2::new(-1.0, 3.0),
+        DVec2::new(5.0, 2.7),
+        DVec2::new(5.0, 5.0),
+        DVec2::new(-1.0, 5.0),
+    ]])
+    .unwrap();
+    for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
+        assert!(
+            boolean_fast(&a, &b, op).unwrap().is_none(),
+            "{}",
+            op_name(op)
+        );
+        assert!(
+            boolean_fast(&b, &a, op).unwrap().is_none(),
+            "{}",
+            op_name(op)
+        );
+    }
+    agree(&a, &b).unwrap();
+    agree(&b, &a).unwrap();
+    let far = shape("10:10, 11:10, 11:11, 10:11");
+    let chained = boolean(&a, &far, BoolOp::Union).unwrap();
+    assert!(
+        boolean_fast(&chained, &b, BoolOp::Difference)
+            .unwrap()
+            .is_none()
+    );
+    agree(&chained, &b).unwrap();
+}
+
+/// Results of earlier operations as operands (their facts are computed per operation, not
+/// cached), on random stars: the fast path still agrees with the robust path, and takes most
+/// of these operations.
+#[test]
+fn chained_results_agree() {
+    let mut rng = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut taken, mut total) = (0, 0);
+    for _ in 0..100 {
+        let mut ring = |c: DVec2| {
+            let n = 3 + (next() * 14.0) as usize;
+            let radii: Vec<f64> = (0..n).map(|_| 0.2 + 1.8 * next()).collect();
+            star(c, &radii, 6.3 * next())
+        };
+        let a = Shape::new(vec![ring(DVec2::ZERO)]).unwrap();
+        let b = Shape::new(vec![ring(DVec2::new(0.37, -0.21))]).unwrap();
+        let c = Shape::new(vec![ring(DVec2::new(-0.3, 0.4))]).unwrap();
+        for op in [BoolOp::Difference, BoolOp::Union, BoolOp::Intersection] {
+            let r = boolean(&a, &b, op).unwrap();
+            taken += agree(&r, &c).unwrap() + agree(&c, &r).unwrap();
+            total += 6;
+        }
+    }
+    assert!(taken * 10 >= total * 7, "fast path took {taken} of {total}");
+}
+
+/// Equality of shapes is equality of contours: a result equals the same contours built by
+/// `Shape::new` (which caches facts that results compute on demand).
+#[test]
+fn shape_equality_ignores_cached_facts() {
+    let a = shape("0:0, 4:0, 4:4, 0:4");
+    let b = shape("2:1, 6:1, 6:3, 2:3");
+    let r = boolean(&a, &b, BoolOp::Difference).unwrap();
+    let rebuilt = Shape::new(r.contours().map(<[DVec2]>::to_vec).collect()).unwrap();
+    assert_eq!(r, rebuilt);
+    assert_eq!(format!("{r:?}"), format!("{rebuilt:?}"));
+}

@@ -2,6 +2,7 @@
 
 use alloc::vec::Vec;
 use glam::DVec2;
+use smallvec::SmallVec;
 
 use super::contour::Contour;
 use super::predicates::{
@@ -32,18 +33,144 @@ use crate::GeomError;
 /// .unwrap();
 /// assert_eq!(square.area(), 4.0);
 /// ```
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Clone, Default)]
 pub struct Shape {
     pub(crate) contours: Vec<Contour>,
+    /// Facts derived from `contours` once, so that each boolean operation need not recompute
+    /// them; they never change what a shape is (equality and `Debug` ignore them).
+    pub(crate) facts: Facts,
+}
+
+/// What [`boolean`](super::boolean) needs to know about an operand before it decides between
+/// the generic-position fast path and the robust pipeline, computed when the shape is made.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Facts {
+    /// Bounding box (`lo > hi` for the empty shape).
+    pub(crate) lo: DVec2,
+    pub(crate) hi: DVec2,
+    /// Smallest squared distance between two vertices of the shape (any contours; `INFINITY`
+    /// below two vertices). `None` for results of `boolean`, where computing it for every
+    /// result would cost every operation, and only chained operations need it.
+    pub(crate) sep2: Option<f64>,
+    /// Whether a vertex of one contour lies exactly inside an edge of another contour (a
+    /// touching point of two contours that is a vertex of only one). `None` when not computed.
+    pub(crate) self_contacts: Option<bool>,
+}
+
+impl Default for Facts {
+    fn default() -> Facts {
+        Facts {
+            lo: DVec2::INFINITY,
+            hi: DVec2::NEG_INFINITY,
+            sep2: Some(f64::INFINITY),
+            self_contacts: Some(false),
+        }
+    }
+}
+
+impl Facts {
+    /// The bounding box only; the other facts are left to be computed on demand.
+    fn bbox(contours: &[Contour]) -> Facts {
+        let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+        for c in contours {
+            for &p in &c.pts {
+                // Plain comparisons: coordinates are finite.
+                lo.x = if p.x < lo.x { p.x } else { lo.x };
+                lo.y = if p.y < lo.y { p.y } else { lo.y };
+                hi.x = if p.x > hi.x { p.x } else { hi.x };
+                hi.y = if p.y > hi.y { p.y } else { hi.y };
+            }
+        }
+        Facts {
+            lo,
+            hi,
+            sep2: None,
+            self_contacts: None,
+        }
+    }
+
+    /// All facts.
+    fn all(contours: &[Contour]) -> Facts {
+        Facts {
+            sep2: Some(min_separation2(contours)),
+            self_contacts: Some(has_self_contacts(contours)),
+            ..Facts::bbox(contours)
+        }
+    }
+}
+
+/// Smallest squared distance between two vertices over all contours (`INFINITY` below two
+/// vertices): a sweep over the vertices sorted by x that stops looking once the x-distance
+/// alone reaches the best squared distance so far, which is exact (the computed `dx * dx` never
+/// exceeds the computed squared distance, and grows along the sorted order).
+pub(crate) fn min_separation2(contours: &[Contour]) -> f64 {
+    let mut by_x: SmallVec<[DVec2; 64]> = contours
+        .iter()
+        .flat_map(|c| c.pts.iter().copied())
+        .collect();
+    by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
+    let mut best = f64::INFINITY;
+    for (i, &p) in by_x.iter().enumerate() {
+        for &q in &by_x[i + 1..] {
+            let dx = q.x - p.x;
+            if dx * dx >= best {
+                break;
+            }
+            best = best.min((p - q).length_squared());
+        }
+    }
+    best
+}
+
+/// Whether a vertex of one contour lies exactly inside an edge of another contour.
+pub(crate) fn has_self_contacts(contours: &[Contour]) -> bool {
+    if contours.len() < 2 {
+        return false;
+    }
+    for (ci, c) in contours.iter().enumerate() {
+        let n = c.pts.len();
+        for i in 0..n {
+            let (p0, p1) = (c.pts[i], c.pts[if i + 1 == n { 0 } else { i + 1 }]);
+            let (lo, hi) = (p0.min(p1), p0.max(p1));
+            for (cj, d) in contours.iter().enumerate() {
+                if cj == ci {
+                    continue;
+                }
+                for &q in &d.pts {
+                    if q.x < lo.x || q.x > hi.x || q.y < lo.y || q.y > hi.y {
+                        continue;
+                    }
+                    if orient(p0, p1, q) == 0.0 && strictly_between(p0, p1, q) {
+                        return true;
+                    }
+                }
+            }
+        }
+    }
+    false
+}
+
+impl PartialEq for Shape {
+    /// Shapes are equal when their contours are (same points, same starting points, same
+    /// order); the cached facts follow from the contours.
+    fn eq(&self, other: &Shape) -> bool {
+        self.contours == other.contours
+    }
+}
+
+impl core::fmt::Debug for Shape {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Shape")
+            .field("contours", &self.contours)
+            .finish()
+    }
 }
 
 impl Shape {
     /// The empty shape (no contours).
     #[must_use]
     pub fn empty() -> Shape {
-        Shape {
-            contours: Vec::new(),
-        }
+        Shape::default()
     }
 
     /// Builds a shape from rings of points, validating them and fixing their orientation.
@@ -53,6 +180,11 @@ impl Shape {
     /// are removed, because they bound no area. Orientation is set by nesting depth: a ring inside
     /// an even number of other rings becomes a counter-clockwise outer contour, one inside an odd
     /// number a clockwise hole. No rings gives the empty shape.
+    ///
+    /// Besides validating, this computes once what [`boolean`](super::boolean) needs to know
+    /// about the shape alone to choose its path (bounding box, smallest distance between two
+    /// vertices, vertices lying on another contour of the shape), so that operations on the
+    /// shape do not recompute it.
     ///
     /// # Errors
     ///
@@ -94,7 +226,7 @@ impl Shape {
         }
         check_crossings(&rings)?;
         let depths = nesting_depths(&rings);
-        let contours = rings
+        let contours: Vec<Contour> = rings
             .into_iter()
             .zip(depths)
             .map(|(mut pts, depth)| {
@@ -105,7 +237,8 @@ impl Shape {
                 Contour { pts }
             })
             .collect();
-        Ok(Shape { contours })
+        let facts = Facts::all(&contours);
+        Ok(Shape { contours, facts })
     }
 
     /// Whether the shape has no contours (and so no area).
@@ -214,7 +347,8 @@ impl Shape {
 
     /// Wraps contours produced by the boolean pipeline, which establishes the invariants itself.
     pub(crate) fn from_contours(contours: Vec<Contour>) -> Shape {
-        Shape { contours }
+        let facts = Facts::bbox(&contours);
+        Shape { contours, facts }
     }
 }
 

@@ -30,7 +30,7 @@ use glam::DVec2;
 use smallvec::SmallVec;
 
 use super::contour::Contour;
-use super::shape::Shape;
+use super::shape::{Shape, has_self_contacts, min_separation2};
 use crate::GeomError;
 
 /// The four regularized set operations.
@@ -296,7 +296,17 @@ fn run(
             }
         }));
     }
-    let (box_a, box_b) = (ws.a.fill(a), ws.b.fill(b));
+    let (fa, fb) = (&a.facts, &b.facts);
+    let (box_a, box_b) = (
+        Bbox {
+            lo: fa.lo,
+            hi: fa.hi,
+        },
+        Bbox {
+            lo: fb.lo,
+            hi: fb.hi,
+        },
+    );
     if box_a.disjoint(&box_b) {
         return Ok(Some(match op {
             BoolOp::Intersection => Shape::empty(),
@@ -310,31 +320,34 @@ fn run(
     }
     let scale = box_a.scale().max(box_b.scale());
     // The fast path needs operands in generic position, in particular no two vertices within
-    // the snapping distance (which `weld` would merge). Between the operands the fast path's own
-    // pair tests see such vertices (each is near the other's edges); within an operand, small
-    // operands are checked pair by pair, which is cheaper than `weld`'s sort.
-    let fast = path != Path::RobustOnly && op != BoolOp::Xor;
-    let mut tried = false;
-    if fast && ws.a.pts.len() <= SMALL && ws.b.pts.len() <= SMALL {
+    // the snapping distance (which `weld` would merge) and no vertex of an operand on an edge
+    // of another of its contours (which `split_self_contacts` would insert). Within an operand
+    // both are facts of the shape, cached by `Shape::new` (and computed here for results of
+    // earlier operations); between the operands the fast path's own pair tests see such
+    // vertices (each is near the other's edges).
+    if path != Path::RobustOnly && op != BoolOp::Xor {
         let snap = intersect::SNAP_REL * scale;
-        if separated(&ws.a, snap * snap) && separated(&ws.b, snap * snap) {
-            if let Some(c) = fast::run(&mut ws.fast, &ws.a, &ws.b, [box_a, box_b], op, scale) {
-                return Ok(Some(Shape::from_contours(c)));
-            }
-            tried = true;
+        let generic = |s: &Shape| {
+            let sep2 = s.facts.sep2.unwrap_or_else(|| min_separation2(&s.contours));
+            sep2 > snap * snap
+                && !s
+                    .facts
+                    .self_contacts
+                    .unwrap_or_else(|| has_self_contacts(&s.contours))
+        };
+        if generic(a)
+            && generic(b)
+            && let Some(c) = fast::run(&mut ws.fast, a, b, op, scale)
+        {
+            return Ok(Some(Shape::from_contours(c)));
         }
-    }
-    let welded = intersect::weld(&mut ws.a, &mut ws.b, scale);
-    if fast
-        && !tried
-        && welded == intersect::Weld::Separated
-        && let Some(c) = fast::run(&mut ws.fast, &ws.a, &ws.b, [box_a, box_b], op, scale)
-    {
-        return Ok(Some(Shape::from_contours(c)));
     }
     if path == Path::FastOnly {
         return Ok(None);
     }
+    ws.a.fill(a);
+    ws.b.fill(b);
+    intersect::weld(&mut ws.a, &mut ws.b, scale);
     let (ra, rb) = (core::mem::take(&mut ws.a), core::mem::take(&mut ws.b));
     let l = Labelled::new_welded(ra, rb, scale)?;
     let mut edges = SmallVec::new();
@@ -345,22 +358,6 @@ fn run(
     // Give the (possibly spilled) buffers back for the next call.
     (ws.a, ws.b) = (l.ra, l.rb);
     Ok(Some(Shape::from_contours(contours)))
-}
-
-/// Operands of at most this many vertices have their vertex separation checked pair by pair.
-const SMALL: usize = 24;
-
-/// Whether every two vertices of `r` are farther apart than `sqrt(snap2)`.
-fn separated(r: &Rings, snap2: f64) -> bool {
-    let pts: &[DVec2] = &r.pts;
-    for (i, &p) in pts.iter().enumerate() {
-        for &q in &pts[i + 1..] {
-            if (p - q).length_squared() <= snap2 {
-                return false;
-            }
-        }
-    }
-    true
 }
 
 /// [`boolean`] through the robust pipeline only, skipping the generic-position fast path; for

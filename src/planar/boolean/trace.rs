@@ -267,13 +267,20 @@ pub(crate) fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option
             break;
         }
     }
-    let area2 = signed_area2(&out);
+    survives(&out, scale).then(|| Contour { pts: out.to_vec() })
+}
+
+/// Whether a loop without repeated or collinear consecutive points bounds more than a sliver:
+/// nonzero area, and more than [`SLIVER_REL`] times the scale per unit of perimeter.
+pub(crate) fn survives(out: &[DVec2], scale: f64) -> bool {
+    let area2 = signed_area2(out);
     let n = out.len();
-    let perimeter: f64 = (0..n)
-        .map(|i| sqrt((out[(i + 1) % n] - out[i]).length_squared()))
+    // Edges in order, the closing one last (no `%` per edge).
+    let perimeter: f64 = out
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .chain(core::iter::once((out[n - 1], out[0])))
+        .map(|(p, q)| sqrt((q - p).length_squared()))
         .sum();
-    if area2 == 0.0 || area2.abs() <= SLIVER_REL * scale * perimeter {
-        return None;
-    }
-    Some(Contour { pts: out.to_vec() })
+    !(area2 == 0.0 || area2.abs() <= SLIVER_REL * scale * perimeter)
 }
