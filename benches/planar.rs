@@ -17,6 +17,10 @@
 use std::hint::black_box;
 use std::time::Duration;
 
+// The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
+#[path = "../tests/planar_support/mod.rs"]
+mod planar_support;
+
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -24,17 +28,6 @@ use geo::BooleanOps;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
-
-/// `n` vertices on a circle (convex) or alternating between two radii (star-shaped, concave).
-fn polygon(n: usize, center: DVec2, phase: f64, star: bool) -> Vec<DVec2> {
-    (0..n)
-        .map(|k| {
-            let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
-            let r = if star && k % 2 == 1 { 0.55 } else { 1.0 };
-            center + DVec2::new(t.cos(), t.sin()) * r
-        })
-        .collect()
-}
 
 fn bench(c: &mut Criterion) {
     for (op, op_name) in [
@@ -50,8 +43,8 @@ fn bench(c: &mut Criterion) {
                 .warm_up_time(Duration::from_millis(300))
                 .measurement_time(Duration::from_millis(1200));
             for n in [4usize, 8, 16, 64] {
-                let pa = polygon(n, DVec2::ZERO, 0.0, star);
-                let pb = polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+                let pa = planar_support::bench_polygon(n, DVec2::ZERO, 0.0, star);
+                let pb = planar_support::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
                 let sa = Shape::new(vec![pa.clone()]).unwrap();
                 let sb = Shape::new(vec![pb.clone()]).unwrap();
                 g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {

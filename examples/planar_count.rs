@@ -6,6 +6,10 @@
 //! `arealight`, `clipper2`, `i_overlay`; OP `difference` or `intersection`; SHAPE `convex` or
 //! `star`. Inputs are those of `benches/planar.rs`.
 
+// The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
+#[path = "../tests/planar_support/mod.rs"]
+mod planar_support;
+
 use std::hint::black_box;
 
 use arealight::glam::DVec2;
@@ -13,17 +17,6 @@ use arealight::planar::{BoolOp, Shape, boolean};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
-
-/// As in `benches/planar.rs`.
-fn polygon(n: usize, center: DVec2, phase: f64, star: bool) -> Vec<DVec2> {
-    (0..n)
-        .map(|k| {
-            let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
-            let r = if star && k % 2 == 1 { 0.55 } else { 1.0 };
-            center + DVec2::new(t.cos(), t.sin()) * r
-        })
-        .collect()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -39,8 +32,8 @@ fn main() {
     let star = args[2] == "star";
     let n: usize = args[3].parse().expect("N");
     let iters: usize = args[4].parse().expect("ITERS");
-    let pa = polygon(n, DVec2::ZERO, 0.0, star);
-    let pb = polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+    let pa = planar_support::bench_polygon(n, DVec2::ZERO, 0.0, star);
+    let pb = planar_support::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
     match args[0].as_str() {
         "arealight" => {
             let sa = Shape::new(vec![pa]).unwrap();

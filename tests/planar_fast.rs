@@ -44,20 +44,6 @@ fn agree(a: &Shape, b: &Shape) -> Result<usize, TestCaseError> {
     Ok(taken)
 }
 
-fn star_ring(max: usize, spread: f64) -> impl Strategy<Value = Vec<DVec2>> {
-    (
-        -spread..spread,
-        -spread..spread,
-        prop::collection::vec(0.2f64..2.0, 3..=max),
-        0.0f64..6.3,
-    )
-        .prop_map(|(cx, cy, radii, phase)| star(DVec2::new(cx, cy), &radii, phase))
-}
-
-fn star_shape(max: usize) -> impl Strategy<Value = Shape> {
-    star_ring(max, 1.0).prop_filter_map("invalid ring", |r| Shape::new(vec![r]).ok())
-}
-
 /// A star with a star-shaped hole around its centre, or with a second outer contour.
 fn multi_shape() -> impl Strategy<Value = Shape> {
     (
@@ -186,24 +172,34 @@ proptest! {
     }
 }
 
+/// A deterministic xorshift64 generator, for the loops that count how often the fast path runs.
+struct XorShift(u64);
+
+impl XorShift {
+    /// Uniform in `[0, 1)`.
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// A star-shaped ring around `c` with `3 + floor(extra * u)` vertices.
+    fn star(&mut self, c: DVec2, extra: f64) -> Vec<DVec2> {
+        let n = 3 + (self.next() * extra) as usize;
+        let radii: Vec<f64> = (0..n).map(|_| 0.2 + 1.8 * self.next()).collect();
+        star(c, &radii, 6.3 * self.next())
+    }
+}
+
 /// The fast path is not a dead branch: on random stars in general position it takes most
 /// operations (all but the symmetric difference, which it leaves to the robust path).
 #[test]
 fn fast_path_takes_generic_inputs() {
-    let mut rng = 0x9E37_79B9_7F4A_7C15u64;
-    let mut next = || {
-        rng ^= rng << 13;
-        rng ^= rng >> 7;
-        rng ^= rng << 17;
-        (rng >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = XorShift(0x9E37_79B9_7F4A_7C15u64);
     let (mut taken, mut total) = (0, 0);
     for _ in 0..200 {
-        let mut ring = |c: DVec2| {
-            let n = 3 + (next() * 20.0) as usize;
-            let radii: Vec<f64> = (0..n).map(|_| 0.2 + 1.8 * next()).collect();
-            star(c, &radii, 6.3 * next())
-        };
+        let mut ring = |c: DVec2| rng.star(c, 20.0);
         let a = Shape::new(vec![ring(DVec2::ZERO)]).unwrap();
         let c = DVec2::new(0.37, -0.21);
         let b = Shape::new(vec![ring(c)]).unwrap();
@@ -243,19 +239,22 @@ fn fast_path_bails_out_on_exact_degeneracies() {
     }
 }
 
+/// The fast path leaves `a` op `b` and `b` op `a` to the robust path for every operation it
+/// handles, and the results agree.
+fn bails_out_both_ways(a: &Shape, b: &Shape) {
+    for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
+        assert!(boolean_fast(a, b, op).unwrap().is_none(), "{}", op_name(op));
+        assert!(boolean_fast(b, a, op).unwrap().is_none(), "{}", op_name(op));
+    }
+    agree(a, b).unwrap();
+    agree(b, a).unwrap();
+}
+
 /// The benchmark inputs (benches/planar.rs) are in generic position and take the fast path, so
 /// the benchmark measures it.
 #[test]
 fn benchmark_inputs_take_the_fast_path() {
-    let polygon = |n: usize, c: DVec2, phase: f64, star: bool| -> Vec<DVec2> {
-        (0..n)
-            .map(|k| {
-                let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
-                let r = if star && k % 2 == 1 { 0.55 } else { 1.0 };
-                c + DVec2::new(t.cos(), t.sin()) * r
-            })
-            .collect()
-    };
+    let polygon = bench_polygon;
     for star in [false, true] {
         for n in [4, 8, 16, 64] {
             let a = Shape::new(vec![polygon(n, DVec2::ZERO, 0.0, star)]).unwrap();
@@ -290,20 +289,7 @@ fn near_duplicate_vertices_within_an_operand_bail_out() {
         DVec2::new(-1.0, 1.65),
     ]])
     .unwrap();
-    for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
-        assert!(
-            boolean_fast(&a, &b, op).unwrap().is_none(),
-            "{}",
-            op_name(op)
-        );
-        assert!(
-            boolean_fast(&b, &a, op).unwrap().is_none(),
-            "{}",
-            op_name(op)
-        );
-    }
-    agree(&a, &b).unwrap();
-    agree(&b, &a).unwrap();
+    bails_out_both_ways(&a, &b);
     // The robust path welded the copies: the apex appears once, `near` never.
     let r = boolean(&a, &b, BoolOp::Intersection).unwrap();
     let pts: Vec<DVec2> = r.contours().flatten().copied().collect();
@@ -338,20 +324,7 @@ fn vertex_on_an_edge_of_its_own_shape_bails_out() {
         DVec2::new(-1.0, 5.0),
     ]])
     .unwrap();
-    for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
-        assert!(
-            boolean_fast(&a, &b, op).unwrap().is_none(),
-            "{}",
-            op_name(op)
-        );
-        assert!(
-            boolean_fast(&b, &a, op).unwrap().is_none(),
-            "{}",
-            op_name(op)
-        );
-    }
-    agree(&a, &b).unwrap();
-    agree(&b, &a).unwrap();
+    bails_out_both_ways(&a, &b);
     let far = shape("10:10, 11:10, 11:11, 10:11");
     let chained = boolean(&a, &far, BoolOp::Union).unwrap();
     assert!(
@@ -367,20 +340,10 @@ fn vertex_on_an_edge_of_its_own_shape_bails_out() {
 /// of these operations.
 #[test]
 fn chained_results_agree() {
-    let mut rng = 0x2545_F491_4F6C_DD1Du64;
-    let mut next = || {
-        rng ^= rng << 13;
-        rng ^= rng >> 7;
-        rng ^= rng << 17;
-        (rng >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = XorShift(0x2545_F491_4F6C_DD1Du64);
     let (mut taken, mut total) = (0, 0);
     for _ in 0..100 {
-        let mut ring = |c: DVec2| {
-            let n = 3 + (next() * 14.0) as usize;
-            let radii: Vec<f64> = (0..n).map(|_| 0.2 + 1.8 * next()).collect();
-            star(c, &radii, 6.3 * next())
-        };
+        let mut ring = |c: DVec2| rng.star(c, 14.0);
         let a = Shape::new(vec![ring(DVec2::ZERO)]).unwrap();
         let b = Shape::new(vec![ring(DVec2::new(0.37, -0.21))]).unwrap();
         let c = Shape::new(vec![ring(DVec2::new(-0.3, 0.4))]).unwrap();

@@ -65,21 +65,6 @@ fn check(a: &Shape, b: &Shape) -> Result<(), TestCaseError> {
     Ok(())
 }
 
-/// A star-shaped (hence simple) polygon with 3..=max vertices.
-fn star_ring(max: usize, spread: f64) -> impl Strategy<Value = Vec<DVec2>> {
-    (
-        -spread..spread,
-        -spread..spread,
-        prop::collection::vec(0.2f64..2.0, 3..=max),
-        0.0f64..6.3,
-    )
-        .prop_map(|(cx, cy, radii, phase)| star(DVec2::new(cx, cy), &radii, phase))
-}
-
-fn star_shape(max: usize) -> impl Strategy<Value = Shape> {
-    star_ring(max, 1.0).prop_filter_map("invalid ring", |r| Shape::new(vec![r]).ok())
-}
-
 /// A star with a hole (a smaller star around the same centre, inside the kernel disk), or two
 /// stars that may overlap (rejected by `Shape::new` when they cross, so then only one).
 fn multi_shape() -> impl Strategy<Value = Shape> {

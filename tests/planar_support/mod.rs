@@ -7,6 +7,7 @@ use arealight::planar::{BoolOp, Shape, boolean};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
+use proptest::prelude::*;
 
 pub const OPS: [BoolOp; 4] = [
     BoolOp::Intersection,
@@ -197,4 +198,33 @@ pub fn well_separated(s: &Shape) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A star-shaped (hence simple) polygon with 3..=max vertices around a centre drawn from
+/// `[-spread, spread]^2`: a proptest strategy.
+pub fn star_ring(max: usize, spread: f64) -> impl Strategy<Value = Vec<DVec2>> {
+    (
+        -spread..spread,
+        -spread..spread,
+        prop::collection::vec(0.2f64..2.0, 3..=max),
+        0.0f64..6.3,
+    )
+        .prop_map(|(cx, cy, radii, phase)| star(DVec2::new(cx, cy), &radii, phase))
+}
+
+/// A one-contour shape from [`star_ring`].
+pub fn star_shape(max: usize) -> impl Strategy<Value = Shape> {
+    star_ring(max, 1.0).prop_filter_map("invalid ring", |r| Shape::new(vec![r]).ok())
+}
+
+/// The benchmark inputs of `benches/planar.rs`: `n` vertices on a circle (convex) or alternating
+/// between two radii (star-shaped, concave).
+pub fn bench_polygon(n: usize, center: DVec2, phase: f64, star: bool) -> Vec<DVec2> {
+    (0..n)
+        .map(|k| {
+            let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
+            let r = if star && k % 2 == 1 { 0.55 } else { 1.0 };
+            center + DVec2::new(t.cos(), t.sin()) * r
+        })
+        .collect()
 }
