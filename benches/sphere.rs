@@ -6,6 +6,7 @@ mod common;
 
 use arealight::glam::DVec3;
 use arealight::planar::BoolOp;
+use arealight::shade::{ConvexPolyhedron, ShadingFrame, convex_silhouette};
 use arealight::sphere::{SphericalPolygon, order_edges};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::f64::consts::PI;
@@ -63,23 +64,10 @@ fn visibility(c: &mut Criterion) {
     ]])
     .unwrap();
     // A cube of half-size 0.3 at (0.2, 0.1, 1.5) seen from the origin: its silhouette hexagon.
-    let center = DVec3::new(0.2, 0.1, 1.5);
-    let corner = |sx: f64, sy: f64, sz: f64| center + DVec3::new(sx, sy, sz) * 0.3;
-    let hexagon: Vec<DVec3> = [
-        (1.0, -1.0, -1.0),
-        (1.0, 1.0, -1.0),
-        (-1.0, 1.0, -1.0),
-        (-1.0, 1.0, 1.0),
-        (-1.0, -1.0, 1.0),
-        (1.0, -1.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| corner(x, y, z))
-    .collect();
-    let mut sil = SphericalPolygon::new(vec![hexagon]).unwrap();
-    if sil.solid_angle() > 2.0 * PI {
-        sil = sil.complement();
-    }
+    // The frame (normal +z, view +x) is the identity, so the silhouette is in world directions.
+    let cube = ConvexPolyhedron::cuboid(DVec3::new(0.2, 0.1, 1.5), DVec3::splat(0.3)).unwrap();
+    let frame = ShadingFrame::new(DVec3::ZERO, DVec3::Z, DVec3::X).unwrap();
+    let sil = convex_silhouette(&cube, &frame).unwrap();
     c.bench_function("sphere/boolean/quad light - cube silhouette", |b| {
         b.iter(|| {
             black_box(&light)

@@ -342,45 +342,34 @@ fn class_at(a: &str, b: &str, p: (f64, f64)) -> VertexClass {
 
 #[test]
 fn fhp_vertex_classes() {
-    // Proper crossings of two overlapping squares.
-    assert_eq!(
-        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (4.0, 2.0)),
-        VertexClass::Crossing
-    );
-    assert_eq!(
-        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (2.0, 4.0)),
-        VertexClass::Crossing
-    );
-    // Corner to corner: touching without crossing.
-    assert_eq!(
-        class_at(SQ, "4:4, 6:4, 6:6, 4:6", (4.0, 4.0)),
-        VertexClass::Bouncing
-    );
-    // Vertex of B on A's edge from outside.
-    assert_eq!(
-        class_at(SQ, "4:2, 6:0, 6:4", (4.0, 2.0)),
-        VertexClass::Bouncing
-    );
-    // A shared stretch with A outside B on both sides: delayed bouncing, classified at the
-    // chain's start; the chain's end is on the chain.
-    assert_eq!(
-        class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 1.0)),
-        VertexClass::DelayedBouncing
-    );
-    assert_eq!(
-        class_at(SQ, "4:1, 6:1, 6:3, 4:3", (4.0, 3.0)),
-        VertexClass::OnChain
-    );
-    // A shared stretch that A enters from outside and leaves into B: delayed crossing.
-    assert_eq!(
-        class_at(SQ, "2:2, 4:2, 4:4, 6:4, 6:6, 2:6", (4.0, 2.0)),
-        VertexClass::DelayedCrossing
-    );
-    // Vertices off the other boundary are plain.
-    assert_eq!(
-        class_at(SQ, "2:2, 6:2, 6:6, 2:6", (0.0, 0.0)),
-        VertexClass::Plain
-    );
+    let cases = [
+        // Proper crossings of two overlapping squares.
+        ("2:2, 6:2, 6:6, 2:6", (4.0, 2.0), VertexClass::Crossing),
+        ("2:2, 6:2, 6:6, 2:6", (2.0, 4.0), VertexClass::Crossing),
+        // Corner to corner: touching without crossing.
+        ("4:4, 6:4, 6:6, 4:6", (4.0, 4.0), VertexClass::Bouncing),
+        // Vertex of B on A's edge from outside.
+        ("4:2, 6:0, 6:4", (4.0, 2.0), VertexClass::Bouncing),
+        // A shared stretch with A outside B on both sides: delayed bouncing, classified at the
+        // chain's start; the chain's end is on the chain.
+        (
+            "4:1, 6:1, 6:3, 4:3",
+            (4.0, 1.0),
+            VertexClass::DelayedBouncing,
+        ),
+        ("4:1, 6:1, 6:3, 4:3", (4.0, 3.0), VertexClass::OnChain),
+        // A shared stretch that A enters from outside and leaves into B: delayed crossing.
+        (
+            "2:2, 4:2, 4:4, 6:4, 6:6, 2:6",
+            (4.0, 2.0),
+            VertexClass::DelayedCrossing,
+        ),
+        // Vertices off the other boundary are plain.
+        ("2:2, 6:2, 6:6, 2:6", (0.0, 0.0), VertexClass::Plain),
+    ];
+    for (b, at, class) in cases {
+        assert_eq!(class_at(SQ, b, at), class, "B = {b}, at {at:?}");
+    }
 }
 
 #[test]

@@ -225,7 +225,19 @@ fn boundary_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 
 
 /// The exact path: clip to the upper hemisphere, then the boundary sum.
 fn clipped_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
-    boundary_sum(&poly.clip_to_hemisphere(DVec3::Z), edge).clamp(0.0, 1.0)
+    upper_sum(&poly.clip_to_hemisphere(DVec3::Z), edge)
+}
+
+/// The boundary sum of a region inside the closed upper hemisphere, where it is the integral.
+fn upper_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
+    boundary_sum(poly, edge).clamp(0.0, 1.0)
+}
+
+/// [`clamped_cosine_integral`] of a region already inside the closed upper hemisphere (a result
+/// of [`SphericalPolygon::clip_to_hemisphere`] about `+z`, or a part of one): Baum's edge sum
+/// without clipping it a second time. For other regions it is not the integral.
+pub(crate) fn clamped_cosine_integral_upper(poly: &SphericalPolygon) -> f64 {
+    upper_sum(poly, edge_term)
 }
 
 /// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform

@@ -14,7 +14,7 @@ use super::silhouette::{
     triangle_side,
 };
 use crate::GeomError;
-use crate::ltc::{clamped_cosine_integral, lookup, ltc_integral};
+use crate::ltc::{clamped_cosine_integral_upper, lookup, ltc_integral};
 use crate::planar::BoolOp;
 use crate::sphere::SphericalPolygon;
 
@@ -365,7 +365,8 @@ impl Scene {
         }
         let (mut diffuse, mut specular) = (0.0, 0.0);
         for vis in self.visible_region(i, frame)? {
-            diffuse += clamped_cosine_integral(&vis);
+            // The visible pieces are already clipped to the upper hemisphere.
+            diffuse += clamped_cosine_integral_upper(&vis);
             if let Some((m_inv, _)) = spec {
                 specular += ltc_integral(&vis, m_inv)?;
             }
@@ -454,14 +455,17 @@ impl Scene {
                 .filter(|&t| triangle_side(mesh, t, x) > 0)
                 .collect()
         };
-        let mut straddling: SmallVec<[usize; 4]> = SmallVec::new();
+        // Straddling blockers keep how they act on each front face (in the order of `faces`),
+        // for step 4.
+        let mut straddling: SmallVec<[(usize, SmallVec<[Reach; 16]>); 4]> = SmallVec::new();
         for &j in &overlapping {
-            let mut reach = faces.iter().map(|&f| self.reach(light, j, f));
-            let first = reach.next().unwrap_or(Reach::Nothing);
-            match (first, reach.all(|r| r == first)) {
+            let reach: SmallVec<[Reach; 16]> =
+                faces.iter().map(|&f| self.reach(light, j, f)).collect();
+            let first = reach.first().copied().unwrap_or(Reach::Nothing);
+            match (first, reach.iter().all(|&r| r == first)) {
                 (Reach::Whole, true) => whole.push(j),
                 (Reach::Nothing, true) => {}
-                _ => straddling.push(j),
+                _ => straddling.push((j, reach)),
             }
         }
         if straddling.is_empty() && !self_blocking {
@@ -488,16 +492,17 @@ impl Scene {
         let mut cached: SmallVec<[Option<Vec<SphericalPolygon>>; 4]> =
             straddling.iter().map(|_| None).collect();
         let mut out = Vec::new();
-        for &f in &faces {
+        for (fi, &f) in faces.iter().enumerate() {
             let Some(piece) = triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? else {
                 continue;
             };
             let mut piece = subtract_all(piece.clip_to_hemisphere(up), &whole_regions)?;
-            for (k, &j) in straddling.iter().enumerate() {
+            for (k, (j, reach)) in straddling.iter().enumerate() {
+                let j = *j;
                 if piece.is_empty() {
                     break;
                 }
-                match self.reach(light, j, f) {
+                match reach[fi] {
                     Reach::Nothing => {}
                     Reach::Whole => {
                         if cached[k].is_none() {

@@ -155,8 +155,12 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
 const WELD_TOLERANCE: f64 = 1e-12;
 
 /// Both operands with every vertex replaced by the first vertex (in either operand) within
-/// [`WELD_TOLERANCE`] of it; repeats that this creates along a ring are dropped.
-fn weld(a: &SphericalPolygon, b: &SphericalPolygon) -> (SphericalPolygon, SphericalPolygon) {
+/// [`WELD_TOLERANCE`] of it; repeats that this creates along a ring are dropped. `None` when no
+/// two vertices are that close (the common case), so the operands are used as they are.
+fn weld(
+    a: &SphericalPolygon,
+    b: &SphericalPolygon,
+) -> Option<(SphericalPolygon, SphericalPolygon)> {
     let all: Vec<DVec3> = a.rings().chain(b.rings()).flatten().copied().collect();
     // Sort by x so that each vertex is compared only with those within the tolerance window.
     let mut order: Vec<usize> = (0..all.len()).collect();
@@ -175,6 +179,9 @@ fn weld(a: &SphericalPolygon, b: &SphericalPolygon) -> (SphericalPolygon, Spheri
                 rep[j] = r;
             }
         }
+    }
+    if rep.iter().enumerate().all(|(i, &r)| r == i) {
+        return None;
     }
     let mut at = 0usize;
     let mut rebuild = |p: &SphericalPolygon| {
@@ -196,7 +203,7 @@ fn weld(a: &SphericalPolygon, b: &SphericalPolygon) -> (SphericalPolygon, Spheri
     };
     let wa = rebuild(a);
     let wb = rebuild(b);
-    (wa, wb)
+    Some((wa, wb))
 }
 
 /// Splits a ring that visits a vertex more than once (a pinch, valid on the sphere) into simple
@@ -233,8 +240,9 @@ fn projected(
     c: DVec3,
 ) -> Result<SphericalPolygon, GeomError> {
     let g = Gnomonic::new(c)?;
-    let (a, b) = weld(a, b);
-    let (pa, pb) = (to_plane(&a, &g)?, to_plane(&b, &g)?);
+    let welded = weld(a, b);
+    let (a, b) = welded.as_ref().map_or((a, b), |(wa, wb)| (wa, wb));
+    let (pa, pb) = (to_plane(a, &g)?, to_plane(b, &g)?);
     let (ca, cb) = (pa.complemented, pb.complemented);
     let (sa, sb) = (&pa.shape, &pb.shape);
     // Rewrite the operation on possibly complemented operands as one on bounded shapes, with

@@ -191,16 +191,9 @@ mod tests {
 
     #[test]
     fn no_open_hemisphere() {
-        let octahedron = [
-            DVec3::X,
-            DVec3::Y,
-            DVec3::Z,
-            DVec3::NEG_X,
-            DVec3::NEG_Y,
-            DVec3::NEG_Z,
-        ];
+        // The octahedron's vertices.
         assert_eq!(
-            enclosing_cap(&octahedron),
+            enclosing_cap(&crate::sphere::predicates::AXES),
             Err(GeomError::NotInOpenHemisphere)
         );
         // A great circle: a closed but not an open hemisphere.
