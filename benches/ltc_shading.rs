@@ -41,6 +41,12 @@ fn shading(c: &mut Criterion) {
                 l.norm * ltc_integral_rational(black_box(&q), l.m_inv).unwrap()
             })
         });
+        // The integral alone, for a lookup made once: what a renderer pays per extra light at the
+        // same shading point.
+        let l = lookup(cos_v, alpha).unwrap();
+        c.bench_function(&format!("ltc/quad {name}/integral only rational"), |b| {
+            b.iter(|| ltc_integral_rational(black_box(&q), black_box(l.m_inv)).unwrap())
+        });
     }
 }
 

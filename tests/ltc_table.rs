@@ -29,6 +29,7 @@ fn lookup_at_nodes_returns_stored_values() {
             let (c, a) = t.node(j, k).unwrap();
             let got = channels(&t.lookup(c, a).unwrap());
             let want = channels(&t.node_lookup(j, k).unwrap());
+            assert_eq!(got, channels(&lookup(c, a).unwrap()));
             for (g, w) in got.iter().zip(want) {
                 assert!(
                     (g - w).abs() <= 1e-9 * w.abs().max(1.0),
@@ -38,6 +39,36 @@ fn lookup_at_nodes_returns_stored_values() {
         }
     }
     assert!(t.node(n, 0).is_none() && t.node_lookup(0, n).is_none());
+}
+
+#[test]
+fn shortcut_lookup_agrees_with_the_table_method() {
+    // `lookup` runs the same interpolation with the committed grid's constants folded in; it must
+    // give the very same bits, at nodes, between them, at the ends and outside the ranges.
+    let t = LtcTable::ggx();
+    let mut rng = Rng(21);
+    let mut inputs = vec![
+        (1.0, 1.0),
+        (0.0, 0.0),
+        (-0.5, -1.0),
+        (2.0, 3.0),
+        (f64::INFINITY, f64::NEG_INFINITY),
+        (f64::NEG_INFINITY, f64::INFINITY),
+        (t.cos_min(), t.alpha_min()),
+        (1.0 - 1e-17, 1e-300),
+    ];
+    for k in 0..t.size() {
+        inputs.push(t.node(k, k).unwrap());
+        inputs.push(t.node(t.size() - 1 - k, k).unwrap());
+    }
+    for _ in 0..2000 {
+        inputs.push((rng.range(-0.1, 1.1), rng.range(-0.1, 1.1)));
+    }
+    for (c, a) in inputs {
+        let (got, want) = (lookup(c, a).unwrap(), t.lookup(c, a).unwrap());
+        let bits = |l: &LtcLookup| channels(l).map(f64::to_bits);
+        assert_eq!(bits(&got), bits(&want), "({c}, {a})");
+    }
 }
 
 #[test]

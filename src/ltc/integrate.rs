@@ -104,6 +104,7 @@ pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, 
 /// # Errors
 ///
 /// As [`ltc_integral`].
+#[inline]
 pub fn ltc_integral_rational(
     poly: &SphericalPolygon,
     m_inv: glam::DMat3,
@@ -122,8 +123,7 @@ fn transformed_integral(
 ) -> Result<f64, crate::GeomError> {
     if !poly.is_full()
         && !poly.is_empty()
-        && m.determinant() > 0.0
-        && let Some(v) = transformed_clip_free(poly, m, edge)
+        && let Some(v) = transformed_clip_free(poly, &m, edge)
     {
         return Ok(v);
     }
@@ -373,6 +373,31 @@ impl ClipFree {
         }
     }
 
+    /// The horizon's part of the sum when every edge lies strictly above it: the horizon is then
+    /// wholly inside or wholly outside the region. Outside, the region lies in the upper
+    /// hemisphere and the edge sum is 2 pi times its (positive) integral; inside, the complement
+    /// does and the sum is minus 2 pi times the complement's integral. So the sign decides, unless
+    /// it is within the rounding (or the rational edge factor's error) of zero: a region of almost
+    /// no integral on one side or the other, left to the exact path (`None`).
+    #[inline(always)]
+    fn horizon_if_all_above(sum: f64, magnitude: f64, edges: usize) -> Option<f64> {
+        let margin = Self::SIGN_MARGIN * magnitude + Self::TERM_ROUNDING * edges as f64;
+        if sum < -margin {
+            Some(2.0 * PI)
+        } else if sum > margin {
+            Some(0.0)
+        } else {
+            None
+        }
+    }
+
+    /// Whether `a` is strictly above the horizon by more than [`HORIZON_TOLERANCE`] (false for
+    /// NaN and infinite components too).
+    #[inline(always)]
+    fn clearly_above(a: Ray) -> bool {
+        a.v.z > 0.0 && a.v.z * a.v.z > Self::ON_HORIZON2 * a.len2
+    }
+
     /// Adds the edge `a -> b` (vectors of any positive length); `None` when `a` lies on the
     /// horizon (or is zero or not finite), where the exact path must decide.
     #[inline(always)]
@@ -436,47 +461,101 @@ impl ClipFree {
         } else if self.edges == 0 {
             0.0
         } else if !self.any_below {
-            // Every edge strictly above: the horizon is wholly inside or wholly outside. Outside,
-            // the region lies in the upper hemisphere and the edge sum is 2 pi times its
-            // (positive) integral; inside, the complement does and the sum is minus 2 pi times
-            // the complement's integral. So the sign decides, unless it is within the rounding
-            // (or the rational edge factor's error) of zero: a region of almost no integral on
-            // one side or the other, left to the exact path.
-            let margin =
-                Self::SIGN_MARGIN * self.magnitude + Self::TERM_ROUNDING * self.edges as f64;
-            if self.sum < -margin {
-                2.0 * PI
-            } else if self.sum > margin {
-                0.0
-            } else {
-                return None;
-            }
+            Self::horizon_if_all_above(self.sum, self.magnitude, self.edges)?
         } else {
             return None;
         };
-        Some(((self.sum + horizon) / (2.0 * PI)).clamp(0.0, 1.0))
+        Some(integral_of_sum(self.sum + horizon))
     }
+}
+
+/// [`ring_sum`] for one ring under a map of the tables' form, betting that the whole ring is
+/// clearly above the horizon (the usual light): then each edge term is taken without the
+/// crossing bookkeeping, in one pass with no buffer. `None` when the bet fails or the sign of the
+/// sum is too close to call; the caller then takes the general path.
+#[inline(always)]
+fn above_ring_sum(
+    ring: &[DVec3],
+    map: impl Fn(DVec3) -> DVec3,
+    edge: impl Fn(Ray, Ray) -> f64,
+) -> Option<f64> {
+    let (&first, rest) = ring.split_first()?;
+    let first = Ray::new(map(first));
+    let mut above = ClipFree::clearly_above(first);
+    let (mut sum, mut magnitude) = (0.0, 0.0);
+    let mut prev = first;
+    for &v in rest {
+        let cur = Ray::new(map(v));
+        // Not short-circuiting: no branch in the loop, the terms of edges below the horizon are
+        // simply discarded with the whole sum.
+        above &= ClipFree::clearly_above(cur);
+        let t = edge(prev, cur);
+        sum += t;
+        magnitude += t.abs();
+        prev = cur;
+    }
+    let t = edge(prev, first);
+    sum += t;
+    magnitude += t.abs();
+    if !above {
+        return None;
+    }
+    let horizon = ClipFree::horizon_if_all_above(sum, magnitude, ring.len())?;
+    Some(integral_of_sum(sum + horizon))
+}
+
+/// The integral from Baum's edge sum including the horizon's part: `sum / 2 pi`, clamped to the
+/// integral's range against rounding.
+#[inline(always)]
+fn integral_of_sum(sum: f64) -> f64 {
+    const INV_2PI: f64 = 0.5 * core::f64::consts::FRAC_1_PI;
+    (sum * INV_2PI).clamp(0.0, 1.0)
 }
 
 /// Runs the clip-free sum on the images of the polygon's vertices under `m`; `None` when the
 /// exact path is needed.
+///
+/// The matrix is read entry by entry: a caller's freshly stored matrix read back with wide loads
+/// at other offsets stalls store-to-load forwarding, which cost more than the rest of a quad.
+#[inline(always)]
 fn transformed_clip_free(
     poly: &SphericalPolygon,
-    m: glam::DMat3,
+    m: &glam::DMat3,
     edge: impl Fn(Ray, Ray) -> f64 + Copy,
 ) -> Option<f64> {
-    let (x, y, z) = (m.x_axis, m.y_axis, m.z_axis);
-    if y == DVec3::Y && x.y == 0.0 && z.y == 0.0 {
+    let (x, y, z) = (&m.x_axis, &m.y_axis, &m.z_axis);
+    if y.x == 0.0 && y.y == 1.0 && y.z == 0.0 && x.y == 0.0 && z.y == 0.0 {
         // The form of the fitted tables' matrices (HDHN16 §4.1): `y` passes unchanged, so four
         // products per vertex instead of nine; the images are the same.
-        ring_sum(
-            poly.rings(),
-            |v| DVec3::new(x.x * v.x + z.x * v.z, v.y, x.z * v.x + z.z * v.z),
-            edge,
-        )
+        let (m00, m02, m20, m22) = (x.x, z.x, x.z, z.z);
+        if !(m00 * m22 - m02 * m20 > 0.0) {
+            return None;
+        }
+        let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, v.y, m20 * v.x + m22 * v.z);
+        if let Some(ring) = poly.single_ring()
+            && let Some(v) = above_ring_sum(ring, map, edge)
+        {
+            return Some(v);
+        }
+        ring_sum(poly.rings(), map, edge)
     } else {
-        ring_sum(poly.rings(), |v| m * v, edge)
+        general_clip_free(poly, m, edge)
     }
+}
+
+/// [`transformed_clip_free`] for a matrix of any form, out of line so that the common form's
+/// path reads no more of the matrix than it uses.
+#[inline(never)]
+fn general_clip_free(
+    poly: &SphericalPolygon,
+    m: &glam::DMat3,
+    edge: impl Fn(Ray, Ray) -> f64 + Copy,
+) -> Option<f64> {
+    if !(m.determinant() > 0.0) {
+        return None;
+    }
+    let m = *m;
+    ring_sum(poly.rings(), |v| m * v, edge)
 }
 
 #[cfg(test)]

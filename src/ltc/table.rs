@@ -366,40 +366,72 @@ impl LtcTable {
     /// ```
     #[inline]
     pub fn lookup(&self, cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
-        if cos_theta_v.is_nan() {
-            return Err(GeomError::OutOfRange {
-                what: "cos_theta_v",
-                value: cos_theta_v,
-                limit: 1.0,
-            });
-        }
-        if alpha.is_nan() {
-            return Err(GeomError::OutOfRange {
-                what: "alpha",
-                value: alpha,
-                limit: 1.0,
-            });
-        }
-        let n = self.grid.n;
-        let x = self.grid.view_coord(cos_theta_v);
-        let y = self.grid.rough_coord(alpha);
-        let j0 = (x as usize).min(n - 2);
-        let k0 = (y as usize).min(n - 2);
-        let tx = x - j0 as f64;
-        let ty = y - k0 as f64;
-        // The four corner nodes lie in one window of the node array: (j0, k0) at its start,
-        // (j0, k0 + 1) one row of `n` nodes later.
-        let base = k0 * n + j0;
-        let window = &self.nodes[base..base + n + 2];
-        let (c00, c10, c01, c11) = (&window[0].0, &window[1].0, &window[n].0, &window[n + 1].0);
-        // Exact at the nodes: all weights but one are zero there.
-        let (w00, w10) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty));
-        let (w01, w11) = ((1.0 - tx) * ty, tx * ty);
-        let v: [f64; 8] = core::array::from_fn(|ch| {
-            w00 * c00[ch] + w10 * c10[ch] + w01 * c01[ch] + w11 * c11[ch]
-        });
-        Ok(LtcLookup::from_channels(&v))
+        check_inputs(cos_theta_v, alpha)?;
+        Ok(interpolate(&self.grid, &self.nodes, cos_theta_v, alpha))
     }
+}
+
+/// The lookups' only failure: a NaN input.
+#[inline(always)]
+fn check_inputs(cos_theta_v: f64, alpha: f64) -> Result<(), GeomError> {
+    if cos_theta_v.is_nan() {
+        return Err(GeomError::OutOfRange {
+            what: "cos_theta_v",
+            value: cos_theta_v,
+            limit: 1.0,
+        });
+    }
+    if alpha.is_nan() {
+        return Err(GeomError::OutOfRange {
+            what: "alpha",
+            value: alpha,
+            limit: 1.0,
+        });
+    }
+    Ok(())
+}
+
+/// Splits a continuous grid coordinate `x` in `[0, last]` (with `last >= 1` a whole number, the
+/// index of the last node) into the cell `j` in `[0, last - 1]` and the offset `x - j` in
+/// `[0, 1]`.
+///
+/// Rounding `x - 1/2` to the nearest whole number by adding `1.5 * 2^52` gives the cell with no
+/// float-to-integer conversion and its float value with no conversion back, which shortens the
+/// lookup's dependency chain. At a node both neighbouring cells are valid and the offset is then
+/// exactly `0` or `1`, so a lookup at a node still returns the node's values exactly.
+#[inline(always)]
+fn cell(x: f64, last: usize) -> (usize, f64) {
+    // 1.5 * 2^52: for sums within 2^51 of it the unit in the last place is exactly 1 (and the
+    // integers' bit patterns are consecutive), on both sides of it.
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let shifted = (x - 0.5) + SHIFT;
+    // `x - 1/2 >= -1/2` rounds to `0` or more (a tie goes to the even `SHIFT`), so the bits are
+    // at least those of `SHIFT`.
+    let j = (shifted.to_bits().wrapping_sub(SHIFT.to_bits()) as usize).min(last - 1);
+    (j, x - (shifted - SHIFT).min((last - 1) as f64))
+}
+
+/// Bilinear interpolation of the nodes at `(cos_theta_v, alpha)` (both not NaN).
+///
+/// Shared by [`LtcTable::lookup`] and, with the committed grid's constants known at compile time,
+/// [`lookup`]; the latter then needs no bounds checks and no loads of the grid's parameters.
+#[inline(always)]
+fn interpolate(grid: &Grid, nodes: &[Node], cos_theta_v: f64, alpha: f64) -> LtcLookup {
+    let n = grid.n;
+    let (j0, tx) = cell(grid.view_coord(cos_theta_v), n - 1);
+    let (k0, ty) = cell(grid.rough_coord(alpha), n - 1);
+    // The four corner nodes lie in one window of the node array: (j0, k0) at its start,
+    // (j0, k0 + 1) one row of `n` nodes later.
+    let base = k0 * n + j0;
+    let window = &nodes[base..base + n + 2];
+    let (c00, c10, c01, c11) = (&window[0].0, &window[1].0, &window[n].0, &window[n + 1].0);
+    // Exact at the nodes: all weights but one are zero there.
+    let (w00, w10) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty));
+    let (w01, w11) = ((1.0 - tx) * ty, tx * ty);
+    let v: [f64; 8] = core::array::from_fn(|ch| {
+        (w00 * c00[ch] + w10 * c10[ch]) + (w01 * c01[ch] + w11 * c11[ch])
+    });
+    LtcLookup::from_channels(&v)
 }
 
 /// Looks up the GGX LTC table: shorthand for `LtcTable::ggx().lookup(cos_theta_v, alpha)`.
@@ -418,5 +450,6 @@ impl LtcTable {
 /// ```
 #[inline]
 pub fn lookup(cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
-    GGX_TABLE.lookup(cos_theta_v, alpha)
+    check_inputs(cos_theta_v, alpha)?;
+    Ok(interpolate(&GGX_GRID, &GGX_NODES, cos_theta_v, alpha))
 }

@@ -178,6 +178,12 @@ impl SphericalPolygon {
         self.ends.len()
     }
 
+    /// The vertices of the only ring, when there is exactly one (the common shape of a light).
+    #[inline]
+    pub(crate) fn single_ring(&self) -> Option<&[DVec3]> {
+        (self.ends.len() == 1).then(|| &self.verts[..])
+    }
+
     /// Total number of vertices over all rings.
     #[must_use]
     pub fn vertex_count(&self) -> usize {
