@@ -452,11 +452,13 @@ impl ClipFree {
             if self.im == 0.0 {
                 if self.re < 0.0 { PI } else { 0.0 }
             } else {
-                edge(
+                // `theta` with the sign of `im`, in [-pi, pi]: one turn added to a negative one
+                // (no `rem_euclid`, which would be a call to `fmod`).
+                let t = edge(
                     Ray::new(DVec3::X),
                     Ray::new(DVec3::new(self.re, self.im, 0.0)),
-                )
-                .rem_euclid(2.0 * PI)
+                );
+                if self.im < 0.0 { t + 2.0 * PI } else { t }
             }
         } else if self.edges == 0 {
             0.0
@@ -469,39 +471,53 @@ impl ClipFree {
     }
 }
 
-/// [`ring_sum`] for one ring under a map of the tables' form, betting that the whole ring is
-/// clearly above the horizon (the usual light): then each edge term is taken without the
-/// crossing bookkeeping, in one pass with no buffer. `None` when the bet fails or the sign of the
-/// sum is too close to call; the caller then takes the general path.
+/// [`ring_sum`] for a single ring, with the edges between vertices clearly above the horizon (all
+/// of them for most lights) taken without the crossing bookkeeping; from the first vertex that is
+/// not, the general running state takes over with the sum so far. Each image is computed once
+/// and nothing is buffered.
 #[inline(always)]
-fn above_ring_sum(
+fn single_ring_sum(
     ring: &[DVec3],
     map: impl Fn(DVec3) -> DVec3,
-    edge: impl Fn(Ray, Ray) -> f64,
+    edge: impl Fn(Ray, Ray) -> f64 + Copy,
 ) -> Option<f64> {
     let (&first, rest) = ring.split_first()?;
     let first = Ray::new(map(first));
-    let mut above = ClipFree::clearly_above(first);
-    let (mut sum, mut magnitude) = (0.0, 0.0);
+    let mut acc = ClipFree::new();
     let mut prev = first;
-    for &v in rest {
-        let cur = Ray::new(map(v));
-        // Not short-circuiting: no branch in the loop, the terms of edges below the horizon are
-        // simply discarded with the whole sum.
-        above &= ClipFree::clearly_above(cur);
-        let t = edge(prev, cur);
-        sum += t;
-        magnitude += t.abs();
+    let mut rest = rest.iter();
+    if ClipFree::clearly_above(first) {
+        let (mut sum, mut magnitude) = (0.0, 0.0);
+        let mut handover = None;
+        for &v in &mut rest {
+            let cur = Ray::new(map(v));
+            if !ClipFree::clearly_above(cur) {
+                handover = Some(cur);
+                break;
+            }
+            let t = edge(prev, cur);
+            sum += t;
+            magnitude += t.abs();
+            acc.edges += 1;
+            prev = cur;
+        }
+        let Some(cur) = handover else {
+            let t = edge(prev, first);
+            let (sum, magnitude) = (sum + t, magnitude + t.abs());
+            let horizon = ClipFree::horizon_if_all_above(sum, magnitude, ring.len())?;
+            return Some(integral_of_sum(sum + horizon));
+        };
+        (acc.sum, acc.magnitude) = (sum, magnitude);
+        acc.add_edge(prev, cur, edge)?;
         prev = cur;
     }
-    let t = edge(prev, first);
-    sum += t;
-    magnitude += t.abs();
-    if !above {
-        return None;
+    for &v in rest {
+        let cur = Ray::new(map(v));
+        acc.add_edge(prev, cur, edge)?;
+        prev = cur;
     }
-    let horizon = ClipFree::horizon_if_all_above(sum, magnitude, ring.len())?;
-    Some(integral_of_sum(sum + horizon))
+    acc.add_edge(prev, first, edge)?;
+    acc.finish(edge)
 }
 
 /// The integral from Baum's edge sum including the horizon's part: `sum / 2 pi`, clamped to the
@@ -532,12 +548,10 @@ fn transformed_clip_free(
             return None;
         }
         let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, v.y, m20 * v.x + m22 * v.z);
-        if let Some(ring) = poly.single_ring()
-            && let Some(v) = above_ring_sum(ring, map, edge)
-        {
-            return Some(v);
+        match poly.single_ring() {
+            Some(ring) => single_ring_sum(ring, map, edge),
+            None => ring_sum(poly.rings(), map, edge),
         }
-        ring_sum(poly.rings(), map, edge)
     } else {
         general_clip_free(poly, m, edge)
     }
