@@ -247,6 +247,32 @@ proptest! {
         prop_assert!((exact - ltc_integral_rational(&p, m).unwrap()).abs() <= bound);
     }
 
+    /// The integral depends on the map only up to a positive factor: scaling it by anything from
+    /// 1e-300 to 1e300 changes nothing (the clip-free path once overflowed in its crossing points
+    /// and products of squared lengths beyond about 1e60, returning garbage or NaN, and the
+    /// exact path rejected maps whose determinant underflowed).
+    #[test]
+    fn ltc_integrals_ignore_the_scale_of_the_map(seed in any::<u64>(), exponent in -300i32..=300) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+        let Some(p) = polygon(seed) else { return Ok(()); };
+        let mut rng = Rng::new(seed ^ 0x5CA1E);
+        let (a, d) = (rng.range(1e-3, 3.0), rng.range(1e-3, 3.0));
+        let (b, c) = (rng.range(-2.0, 2.0), rng.range(-2.0, 2.0));
+        let m = DMat3::from_cols(DVec3::new(a, 0.0, c), DVec3::Y, DVec3::new(b, 0.0, d));
+        let Ok(t) = p.transformed(m) else { return Ok(()); };
+        let exact = clamped_cosine_integral(&t);
+        let perimeter: f64 = boundary_edges(&t.clip_to_hemisphere(DVec3::Z))
+            .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
+            .sum();
+        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+        let scaled = m * 10f64.powi(exponent);
+        let got = ltc_integral(&p, scaled);
+        prop_assert!(matches!(got, Ok(v) if (v - exact).abs() <= 1e-12), "{:?} vs {}", got, exact);
+        let got = ltc_integral_rational(&p, scaled);
+        prop_assert!(matches!(got, Ok(v) if (v - exact).abs() <= bound), "{:?} vs {}", got, exact);
+    }
+
     /// Regions whose boundary lies wholly above the horizon, from tiny (down to 1e-12 rad) to
     /// large, and their complements: the clip-free path decides whether the horizon is inside
     /// from the sign of the edge sum, or leaves a too-close call to the exact path.

@@ -139,6 +139,14 @@ fn exact_transformed(
     m: glam::DMat3,
     edge: impl Fn(Ray, Ray) -> f64,
 ) -> Result<f64, crate::GeomError> {
+    // Directions only depend on the map up to a positive factor; scaled to entries of at most 1,
+    // a map that is far from singular is not rejected for its determinant's overflow or underflow.
+    let largest = m.abs().to_cols_array().into_iter().fold(0.0, f64::max);
+    let m = if largest > 0.0 && largest.is_finite() {
+        m * (1.0 / largest)
+    } else {
+        m
+    };
     Ok(clipped_sum(&poly.transformed(m)?, edge))
 }
 
@@ -544,8 +552,10 @@ fn transformed_clip_free(
         // The form of the fitted tables' matrices (HDHN16 §4.1): `y` passes unchanged, so four
         // products per vertex instead of nine; the images are the same.
         let (m00, m02, m20, m22) = (x.x, z.x, x.z, z.z);
-        if !(m00 * m22 - m02 * m20 > 0.0) {
-            return None;
+        let largest = m00.abs().max(m02.abs()).max(m20.abs()).max(m22.abs());
+        if !(m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && largest <= CLIP_FREE_RANGE) {
+            // Far from the tables' matrices (or NaN): let the general path rescale it.
+            return general_clip_free(poly, m, edge);
         }
         let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, v.y, m20 * v.x + m22 * v.z);
         match poly.single_ring() {
@@ -557,6 +567,13 @@ fn transformed_clip_free(
     }
 }
 
+/// Bound on the entries (at most this) and the determinant (at least its inverse) of the maps the
+/// clip-free path takes: the images of unit vectors then have lengths within about `2^±92`, so
+/// the crossing points (products of two images) and the edge terms' products of squared lengths
+/// stay far from overflow and underflow. The fitted tables' matrices lie well inside (entries up
+/// to about `1 / alpha_min = 1e4`).
+const CLIP_FREE_RANGE: f64 = 1_073_741_824.0; // 2^30
+
 /// [`transformed_clip_free`] for a matrix of any form, out of line so that the common form's
 /// path reads no more of the matrix than it uses.
 #[inline(never)]
@@ -565,10 +582,18 @@ fn general_clip_free(
     m: &glam::DMat3,
     edge: impl Fn(Ray, Ray) -> f64 + Copy,
 ) -> Option<f64> {
-    if !(m.determinant() > 0.0) {
+    // Every quantity of the sum is invariant under positive scaling of the map, so it is scaled
+    // to entries of at most 1; then a determinant of at least `1 / CLIP_FREE_RANGE` bounds the
+    // images' lengths away from zero too. Worse conditioned maps go to the exact path, which
+    // normalizes every image.
+    let largest = m.abs().to_cols_array().into_iter().fold(0.0, f64::max);
+    if !(largest > 0.0 && largest.is_finite()) {
         return None;
     }
-    let m = *m;
+    let m = *m * (1.0 / largest);
+    if !(m.determinant() >= 1.0 / CLIP_FREE_RANGE) {
+        return None;
+    }
     ring_sum(poly.rings(), |v| m * v, edge)
 }
 
