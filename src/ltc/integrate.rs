@@ -425,27 +425,66 @@ impl ClipFree {
             (false, false) => self.any_below = true,
             (up_a, _) => {
                 self.any_below = true;
-                // The crossing point, as a positive combination of a and b on the horizon.
-                let x = if up_a {
-                    b * a.z - a * b.z
-                } else {
-                    a * b.z - b * a.z
-                };
-                let x = Ray::new(DVec3::new(x.x, x.y, 0.0));
-                let (pr, pi) = (x.v.x, if up_a { -x.v.y } else { x.v.y });
-                let (re, im) = (self.re * pr - self.im * pi, self.re * pi + self.im * pr);
-                // Only the argument matters: keep the product's magnitude in range.
-                let size = re.abs() + im.abs();
-                (self.re, self.im) = if (1e-100..=1e100).contains(&size) {
-                    (re, im)
-                } else {
-                    (re / size, im / size)
-                };
-                self.crossings += 1;
-                self.sum += if up_a { edge(ra, x) } else { edge(x, rb) };
+                self.cross(ra, rb, up_a, edge);
             }
         }
         Some(())
+    }
+
+    /// Adds the edge `a -> b` that crosses the horizon (`a` above it when `up_a`, else `b`): the
+    /// part above and the crossing's factor of the product (thesis 003 eq. 4.6 and 4.7).
+    #[inline(always)]
+    fn cross(&mut self, ra: Ray, rb: Ray, up_a: bool, edge: impl Fn(Ray, Ray) -> f64) {
+        let (a, b) = (ra.v, rb.v);
+        // The crossing point, as a positive combination of a and b on the horizon.
+        let x = if up_a {
+            b * a.z - a * b.z
+        } else {
+            a * b.z - b * a.z
+        };
+        let x = Ray::new(DVec3::new(x.x, x.y, 0.0));
+        let (pr, pi) = (x.v.x, if up_a { -x.v.y } else { x.v.y });
+        // The first factor starts the product (a multiplication by 1 would only lengthen
+        // the chain of dependent operations up to the horizon's term).
+        let (re, im) = if self.crossings == 0 {
+            (pr, pi)
+        } else {
+            (self.re * pr - self.im * pi, self.re * pi + self.im * pr)
+        };
+        // Only the argument matters: keep the product's magnitude in range by a factor
+        // (a multiplication; a division here would sit on every crossing's path). The
+        // factors lie within about 2^±200 (see `CLIP_FREE_RANGE`), so a product within
+        // 1e±100 before each one never leaves the range of f64.
+        let size = re.abs() + im.abs();
+        let k = if size > 1e100 {
+            1e-100
+        } else if size < 1e-100 {
+            1e100
+        } else {
+            1.0
+        };
+        (self.re, self.im) = (re * k, im * k);
+        self.crossings += 1;
+        // One call site, so that the edge term is inlined.
+        let (p, q) = if up_a { (ra, x) } else { (x, rb) };
+        self.sum += edge(p, q);
+    }
+
+    /// The total angle of the horizon arcs, the argument of the crossings' product, given at
+    /// least one crossing.
+    #[inline(always)]
+    fn horizon_arcs(&self, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
+        if self.im == 0.0 {
+            if self.re < 0.0 { PI } else { 0.0 }
+        } else {
+            // `theta` with the sign of `im`, in [-pi, pi]: one turn added to a negative one
+            // (no `rem_euclid`, which would be a call to `fmod`).
+            let t = edge(
+                Ray::new(DVec3::X),
+                Ray::new(DVec3::new(self.re, self.im, 0.0)),
+            );
+            if self.im < 0.0 { t + 2.0 * PI } else { t }
+        }
     }
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
@@ -457,17 +496,7 @@ impl ClipFree {
             // the rational factor for the rational one, with the same relative error bound as
             // its edges). Exactly on the negative axis the arc is a half circle, which an edge
             // term cannot tell from a zero-length one.
-            if self.im == 0.0 {
-                if self.re < 0.0 { PI } else { 0.0 }
-            } else {
-                // `theta` with the sign of `im`, in [-pi, pi]: one turn added to a negative one
-                // (no `rem_euclid`, which would be a call to `fmod`).
-                let t = edge(
-                    Ray::new(DVec3::X),
-                    Ray::new(DVec3::new(self.re, self.im, 0.0)),
-                );
-                if self.im < 0.0 { t + 2.0 * PI } else { t }
-            }
+            self.horizon_arcs(edge)
         } else if self.edges == 0 {
             0.0
         } else if !self.any_below {
@@ -552,8 +581,9 @@ fn transformed_clip_free(
         // The form of the fitted tables' matrices (HDHN16 §4.1): `y` passes unchanged, so four
         // products per vertex instead of nine; the images are the same.
         let (m00, m02, m20, m22) = (x.x, z.x, x.z, z.z);
-        let largest = m00.abs().max(m02.abs()).max(m20.abs()).max(m22.abs());
-        if !(m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && largest <= CLIP_FREE_RANGE) {
+        let small = |e: f64| e.abs() <= CLIP_FREE_RANGE;
+        let in_range = small(m00) & small(m02) & small(m20) & small(m22);
+        if !(m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && in_range) {
             // Far from the tables' matrices (or NaN): let the general path rescale it.
             return general_clip_free(poly, m, edge);
         }

@@ -152,12 +152,14 @@ impl SphericalPolygon {
 
     /// Whether this is the empty region.
     #[must_use]
+    #[inline]
     pub fn is_empty(&self) -> bool {
         !self.full && self.ends.is_empty()
     }
 
     /// Whether this is the full sphere.
     #[must_use]
+    #[inline]
     pub fn is_full(&self) -> bool {
         self.full
     }
