@@ -83,3 +83,12 @@ pub fn powf(x: f64, y: f64) -> f64 {
 pub fn sin_cos(x: f64) -> (f64, f64) {
     (sin(x), cos(x))
 }
+
+/// `m` scaled by a positive factor to entries of at most 1 in magnitude, or `None` when it has no
+/// finite nonzero entry to scale by. Maps of directions depend on their matrix only up to such a
+/// factor; scaled, their determinants and products of images stay clear of overflow and
+/// underflow.
+pub(crate) fn unit_scaled(m: glam::DMat3) -> Option<glam::DMat3> {
+    let largest = m.abs().to_cols_array().into_iter().fold(0.0, f64::max);
+    (largest > 0.0 && largest.is_finite()).then(|| m * (1.0 / largest))
+}

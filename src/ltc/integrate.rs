@@ -139,14 +139,6 @@ fn exact_transformed(
     m: glam::DMat3,
     edge: impl Fn(Ray, Ray) -> f64,
 ) -> Result<f64, crate::GeomError> {
-    // Directions only depend on the map up to a positive factor; scaled to entries of at most 1,
-    // a map that is far from singular is not rejected for its determinant's overflow or underflow.
-    let largest = m.abs().to_cols_array().into_iter().fold(0.0, f64::max);
-    let m = if largest > 0.0 && largest.is_finite() {
-        m * (1.0 / largest)
-    } else {
-        m
-    };
     Ok(clipped_sum(&poly.transformed(m)?, edge))
 }
 
@@ -616,11 +608,7 @@ fn general_clip_free(
     // to entries of at most 1; then a determinant of at least `1 / CLIP_FREE_RANGE` bounds the
     // images' lengths away from zero too. Worse conditioned maps go to the exact path, which
     // normalizes every image.
-    let largest = m.abs().to_cols_array().into_iter().fold(0.0, f64::max);
-    if !(largest > 0.0 && largest.is_finite()) {
-        return None;
-    }
-    let m = *m * (1.0 / largest);
+    let m = crate::math::unit_scaled(*m)?;
     if !(m.determinant() >= 1.0 / CLIP_FREE_RANGE) {
         return None;
     }

@@ -221,6 +221,9 @@ impl SphericalPolygon {
     /// [`GeomError::Degenerate`] when `m` is singular (or nearly so: `|det m|` below `1e-12`
     /// times the product of its column lengths) or not finite.
     pub fn transformed(&self, m: glam::DMat3) -> Result<SphericalPolygon, GeomError> {
+        // Only directions matter, so the map is first scaled to entries of at most 1: a map far
+        // from singular is then not rejected for its determinant's overflow or underflow.
+        let m = crate::math::unit_scaled(m).unwrap_or(m);
         let det = m.determinant();
         let scale = m.x_axis.length() * m.y_axis.length() * m.z_axis.length();
         if !det.is_finite() || !(det.abs() > 1e-12 * scale) {
