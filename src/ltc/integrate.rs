@@ -81,7 +81,7 @@ pub const EDGE_FACTOR_RATIONAL_MAX_ERROR: f64 = 6.1e-7;
 /// convex polygon, whose perimeter inside a hemisphere is below `2 pi`).
 #[must_use]
 pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
-    clipped_sum(poly, rational_edge_term)
+    clipped_sum(poly, Rational)
 }
 
 /// Integral of a linearly transformed cosine over a polygon in the shading frame: the polygon is
@@ -93,7 +93,7 @@ pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
 ///
 /// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
 pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
-    transformed_integral(poly, m_inv, edge_term)
+    transformed_integral(poly, m_inv, Exact)
 }
 
 /// [`ltc_integral`] with the rational edge factor ([`edge_factor_rational`]) and no `atan2` at
@@ -109,7 +109,7 @@ pub fn ltc_integral_rational(
     poly: &SphericalPolygon,
     m_inv: glam::DMat3,
 ) -> Result<f64, crate::GeomError> {
-    transformed_integral(poly, m_inv, rational_edge_term)
+    transformed_integral(poly, m_inv, Rational)
 }
 
 /// The clamped-cosine integral of `m` applied to `poly`, with the given edge term: the stack-only
@@ -119,7 +119,7 @@ pub fn ltc_integral_rational(
 fn transformed_integral(
     poly: &SphericalPolygon,
     m: glam::DMat3,
-    edge: impl Fn(Ray, Ray) -> f64 + Copy,
+    edge: impl EdgeTerm,
 ) -> Result<f64, crate::GeomError> {
     if !poly.is_full()
         && !poly.is_empty()
@@ -137,7 +137,7 @@ fn transformed_integral(
 fn exact_transformed(
     poly: &SphericalPolygon,
     m: glam::DMat3,
-    edge: impl Fn(Ray, Ray) -> f64,
+    edge: impl EdgeTerm,
 ) -> Result<f64, crate::GeomError> {
     Ok(clipped_sum(&poly.transformed(m)?, edge))
 }
@@ -210,26 +210,78 @@ fn rational_edge_term(a: Ray, b: Ray) -> f64 {
     }
 }
 
+/// The two ways of evaluating Baum's edge terms: exactly ([`Exact`]) or with the rational edge
+/// factor ([`Rational`]).
+trait EdgeTerm: Copy {
+    /// The edge term of the edge `a -> b`, for endpoints of any positive length.
+    fn term(self, a: Ray, b: Ray) -> f64;
+
+    /// The edge term of the horizon arc from the x-axis to `(re, im, 0)` (not both zero): the
+    /// argument of `re + i im` in `[-pi, pi]`, with the same error as [`EdgeTerm::term`].
+    fn arg(self, re: f64, im: f64) -> f64;
+}
+
+/// Edge terms with `atan2` ([`edge_term`]).
+#[derive(Clone, Copy)]
+struct Exact;
+
+impl EdgeTerm for Exact {
+    #[inline(always)]
+    fn term(self, a: Ray, b: Ray) -> f64 {
+        edge_term(a, b)
+    }
+
+    #[inline(always)]
+    fn arg(self, re: f64, im: f64) -> f64 {
+        crate::math::atan2(im, re)
+    }
+}
+
+/// Edge terms with the rational edge factor ([`rational_edge_term`]).
+#[derive(Clone, Copy)]
+struct Rational;
+
+impl EdgeTerm for Rational {
+    #[inline(always)]
+    fn term(self, a: Ray, b: Ray) -> f64 {
+        rational_edge_term(a, b)
+    }
+
+    /// [`rational_edge_term`] from `(1, 0, 0)` to `(re, im, 0)`, where `|a x b| = |im|` needs no
+    /// root: the reflection for an argument beyond a quarter turn costs no root and no division.
+    #[inline(always)]
+    fn arg(self, re: f64, im: f64) -> f64 {
+        let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
+        let l2 = re * re + im * im;
+        let l = crate::math::sqrt(l2);
+        let y = re.abs();
+        let num = p0 * l2 + (p1 * l + p2 * y) * y;
+        let den = (q0 * l2 + (q1 * l + y) * y) * l;
+        let v = num * im / den;
+        if re >= 0.0 { v } else { PI.copysign(im) - v }
+    }
+}
+
 /// Signed integral of `z / pi` over the region bounded by the rings, by Stokes' theorem
 /// (Baum, Rushmeier and Winget 1989; HDHN16 eq. 11): `(1 / 2 pi) sum theta_e n_e . z`.
-fn boundary_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
+fn boundary_sum(poly: &SphericalPolygon, edge: impl EdgeTerm) -> f64 {
     let mut sum = 0.0;
     for ring in poly.rings() {
         let n = ring.len();
         for i in 0..n {
-            sum += edge(Ray::new(ring[i]), Ray::new(ring[(i + 1) % n]));
+            sum += edge.term(Ray::new(ring[i]), Ray::new(ring[(i + 1) % n]));
         }
     }
     sum / (2.0 * PI)
 }
 
 /// The exact path: clip to the upper hemisphere, then the boundary sum.
-fn clipped_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
+fn clipped_sum(poly: &SphericalPolygon, edge: impl EdgeTerm) -> f64 {
     upper_sum(&poly.clip_to_hemisphere(DVec3::Z), edge)
 }
 
 /// The boundary sum of a region inside the closed upper hemisphere, where it is the integral.
-fn upper_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
+fn upper_sum(poly: &SphericalPolygon, edge: impl EdgeTerm) -> f64 {
     boundary_sum(poly, edge).clamp(0.0, 1.0)
 }
 
@@ -237,7 +289,7 @@ fn upper_sum(poly: &SphericalPolygon, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
 /// of [`SphericalPolygon::clip_to_hemisphere`] about `+z`, or a part of one): Baum's edge sum
 /// without clipping it a second time. For other regions it is not the integral.
 pub(crate) fn clamped_cosine_integral_upper(poly: &SphericalPolygon) -> f64 {
-    upper_sum(poly, edge_term)
+    upper_sum(poly, Exact)
 }
 
 /// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform
@@ -264,7 +316,7 @@ pub(crate) fn clamped_cosine_integral_upper(poly: &SphericalPolygon) -> f64 {
 /// ```
 #[must_use]
 pub fn clamped_cosine_integral(poly: &SphericalPolygon) -> f64 {
-    clipped_sum(poly, edge_term)
+    clipped_sum(poly, Exact)
 }
 
 /// The same integral as [`clamped_cosine_integral`] without building the clipped polygon: the
@@ -289,16 +341,13 @@ pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
     if poly.is_full() {
         return 1.0;
     }
-    clip_free_sum(poly.rings(), edge_term).unwrap_or_else(|| clamped_cosine_integral(poly))
+    clip_free_sum(poly.rings(), Exact).unwrap_or_else(|| clamped_cosine_integral(poly))
 }
 
 /// The clip-free sum of [`clamped_cosine_integral_clip_free`] over rings of unit vectors, with
 /// the edge term given; `None` where the exact path must decide (a vertex on the horizon, or no
 /// crossing while some vertex is below).
-fn clip_free_sum<'a>(
-    rings: impl Iterator<Item = &'a [DVec3]>,
-    edge: impl Fn(Ray, Ray) -> f64 + Copy,
-) -> Option<f64> {
+fn clip_free_sum<'a>(rings: impl Iterator<Item = &'a [DVec3]>, edge: impl EdgeTerm) -> Option<f64> {
     ring_sum(rings, |v| v, edge)
 }
 
@@ -311,7 +360,7 @@ fn clip_free_sum<'a>(
 fn ring_sum<'a>(
     rings: impl Iterator<Item = &'a [DVec3]>,
     map: impl Fn(DVec3) -> DVec3,
-    edge: impl Fn(Ray, Ray) -> f64 + Copy,
+    edge: impl EdgeTerm,
 ) -> Option<f64> {
     let mut acc = ClipFree::new();
     for ring in rings {
@@ -401,7 +450,7 @@ impl ClipFree {
     /// Adds the edge `a -> b` (vectors of any positive length); `None` when `a` lies on the
     /// horizon (or is zero or not finite), where the exact path must decide.
     #[inline(always)]
-    fn add_edge(&mut self, ra: Ray, rb: Ray, edge: impl Fn(Ray, Ray) -> f64) -> Option<()> {
+    fn add_edge(&mut self, ra: Ray, rb: Ray, edge: impl EdgeTerm) -> Option<()> {
         let (a, b) = (ra.v, rb.v);
         // Written so that NaN and infinite components also bail out.
         if !(a.z * a.z > Self::ON_HORIZON2 * ra.len2) {
@@ -410,7 +459,7 @@ impl ClipFree {
         self.edges += 1;
         match (a.z > 0.0, b.z > 0.0) {
             (true, true) => {
-                let t = edge(ra, rb);
+                let t = edge.term(ra, rb);
                 self.sum += t;
                 self.magnitude += t.abs();
             }
@@ -426,7 +475,7 @@ impl ClipFree {
     /// Adds the edge `a -> b` that crosses the horizon (`a` above it when `up_a`, else `b`): the
     /// part above and the crossing's factor of the product (thesis 003 eq. 4.6 and 4.7).
     #[inline(always)]
-    fn cross(&mut self, ra: Ray, rb: Ray, up_a: bool, edge: impl Fn(Ray, Ray) -> f64) {
+    fn cross(&mut self, ra: Ray, rb: Ray, up_a: bool, edge: impl EdgeTerm) {
         let (a, b) = (ra.v, rb.v);
         // The crossing point, as a positive combination of a and b on the horizon.
         let x = if up_a {
@@ -459,29 +508,26 @@ impl ClipFree {
         self.crossings += 1;
         // One call site, so that the edge term is inlined.
         let (p, q) = if up_a { (ra, x) } else { (x, rb) };
-        self.sum += edge(p, q);
+        self.sum += edge.term(p, q);
     }
 
     /// The total angle of the horizon arcs, the argument of the crossings' product, given at
     /// least one crossing.
     #[inline(always)]
-    fn horizon_arcs(&self, edge: impl Fn(Ray, Ray) -> f64) -> f64 {
+    fn horizon_arcs(&self, edge: impl EdgeTerm) -> f64 {
         if self.im == 0.0 {
             if self.re < 0.0 { PI } else { 0.0 }
         } else {
-            // `theta` with the sign of `im`, in [-pi, pi]: one turn added to a negative one
-            // (no `rem_euclid`, which would be a call to `fmod`).
-            let t = edge(
-                Ray::new(DVec3::X),
-                Ray::new(DVec3::new(self.re, self.im, 0.0)),
-            );
+            // One turn added to a negative argument (no `rem_euclid`, which would be a call to
+            // `fmod`).
+            let t = edge.arg(self.re, self.im);
             if self.im < 0.0 { t + 2.0 * PI } else { t }
         }
     }
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
     /// (the pairing of the horizon arcs is then unknown here).
-    fn finish(self, edge: impl Fn(Ray, Ray) -> f64) -> Option<f64> {
+    fn finish(self, edge: impl EdgeTerm) -> Option<f64> {
         let horizon = if self.crossings > 0 {
             // The argument of the product in [0, 2 pi), through the edge term of the horizon arc
             // from the x-axis to the product: `theta * sign(im)` (an `atan2` for the exact term,
@@ -508,7 +554,7 @@ impl ClipFree {
 fn single_ring_sum(
     ring: &[DVec3],
     map: impl Fn(DVec3) -> DVec3,
-    edge: impl Fn(Ray, Ray) -> f64 + Copy,
+    edge: impl EdgeTerm,
 ) -> Option<f64> {
     let (&first, rest) = ring.split_first()?;
     let first = Ray::new(map(first));
@@ -524,14 +570,14 @@ fn single_ring_sum(
                 handover = Some(cur);
                 break;
             }
-            let t = edge(prev, cur);
+            let t = edge.term(prev, cur);
             sum += t;
             magnitude += t.abs();
             acc.edges += 1;
             prev = cur;
         }
         let Some(cur) = handover else {
-            let t = edge(prev, first);
+            let t = edge.term(prev, first);
             let (sum, magnitude) = (sum + t, magnitude + t.abs());
             let horizon = ClipFree::horizon_if_all_above(sum, magnitude, ring.len())?;
             return Some(integral_of_sum(sum + horizon));
@@ -566,7 +612,7 @@ fn integral_of_sum(sum: f64) -> f64 {
 fn transformed_clip_free(
     poly: &SphericalPolygon,
     m: &glam::DMat3,
-    edge: impl Fn(Ray, Ray) -> f64 + Copy,
+    edge: impl EdgeTerm,
 ) -> Option<f64> {
     let (x, y, z) = (&m.x_axis, &m.y_axis, &m.z_axis);
     if y.x == 0.0 && y.y == 1.0 && y.z == 0.0 && x.y == 0.0 && z.y == 0.0 {
@@ -599,11 +645,7 @@ const CLIP_FREE_RANGE: f64 = 1_073_741_824.0; // 2^30
 /// [`transformed_clip_free`] for a matrix of any form, out of line so that the common form's
 /// path reads no more of the matrix than it uses.
 #[inline(never)]
-fn general_clip_free(
-    poly: &SphericalPolygon,
-    m: &glam::DMat3,
-    edge: impl Fn(Ray, Ray) -> f64 + Copy,
-) -> Option<f64> {
+fn general_clip_free(poly: &SphericalPolygon, m: &glam::DMat3, edge: impl EdgeTerm) -> Option<f64> {
     // Every quantity of the sum is invariant under positive scaling of the map, so it is scaled
     // to entries of at most 1; then a determinant of at least `1 / CLIP_FREE_RANGE` bounds the
     // images' lengths away from zero too. Worse conditioned maps go to the exact path, which
