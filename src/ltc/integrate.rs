@@ -181,6 +181,18 @@ pub fn ggx_polygon_integral(
     Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
 }
 
+/// [`edge_factor_rational`] of `y / l` divided by `l`, as a fraction `num / den` of
+/// homogeneous polynomials in `l = sqrt(l2)` and `y` (the endpoints' length product and `|a . b|`
+/// for an edge of any scale): one root and, by the caller, one division.
+#[inline(always)]
+fn rational_ratio(l2: f64, y: f64) -> (f64, f64) {
+    let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
+    let l = crate::math::sqrt(l2);
+    let num = p0 * l2 + (p1 * l + p2 * y) * y;
+    let den = (q0 * l2 + (q1 * l + y) * y) * l;
+    (num, den)
+}
+
 /// The edge term with [`edge_factor_rational`] in place of `theta / sin(theta)`, for endpoints of
 /// any positive length (the clip-free path does not normalize).
 ///
@@ -189,15 +201,11 @@ pub fn ggx_polygon_integral(
 /// a quarter circle add the reflection term `pi / sin(theta)` with `l sin(theta) = |a x b|`.
 #[inline]
 fn rational_edge_term(a: Ray, b: Ray) -> f64 {
-    let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
     let l2 = a.len2 * b.len2;
     let (a, b) = (a.v, b.v);
-    let l = crate::math::sqrt(l2);
     let d = a.dot(b);
-    let y = d.abs();
     let cz = a.x * b.y - a.y * b.x;
-    let num = p0 * l2 + (p1 * l + p2 * y) * y;
-    let den = (q0 * l2 + (q1 * l + y) * y) * l;
+    let (num, den) = rational_ratio(l2, d.abs());
     let v = num * cz / den;
     if d >= 0.0 {
         v
@@ -251,12 +259,7 @@ impl EdgeTerm for Rational {
     /// root: the reflection for an argument beyond a quarter turn costs no root and no division.
     #[inline(always)]
     fn arg(self, re: f64, im: f64) -> f64 {
-        let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
-        let l2 = re * re + im * im;
-        let l = crate::math::sqrt(l2);
-        let y = re.abs();
-        let num = p0 * l2 + (p1 * l + p2 * y) * y;
-        let den = (q0 * l2 + (q1 * l + y) * y) * l;
+        let (num, den) = rational_ratio(re * re + im * im, re.abs());
         let v = num * im / den;
         if re >= 0.0 { v } else { PI.copysign(im) - v }
     }
