@@ -488,26 +488,28 @@ impl ClipFree {
         };
         let x = Ray::new(DVec3::new(x.x, x.y, 0.0));
         let (pr, pi) = (x.v.x, if up_a { -x.v.y } else { x.v.y });
-        // The first factor starts the product (a multiplication by 1 would only lengthen
-        // the chain of dependent operations up to the horizon's term).
-        let (re, im) = if self.crossings == 0 {
+        // The first factor starts the product (a multiplication by 1 would only lengthen the
+        // chain of dependent operations up to the horizon's term). Only the argument matters,
+        // so the product so far is brought within 1e±60 by a factor before each further one
+        // (a multiplication; a division would sit on every crossing's path), while the next
+        // crossing point is still being computed. The factors lie within about 2^-240 to 2^64
+        // (images within 2^±92, see `CLIP_FREE_RANGE`, vertices off the horizon by
+        // `HORIZON_TOLERANCE`, edges shorter than half a circle), so neither the products nor
+        // the final squared length leave the normal range of f64.
+        (self.re, self.im) = if self.crossings == 0 {
             (pr, pi)
         } else {
-            (self.re * pr - self.im * pi, self.re * pi + self.im * pr)
+            let size = self.re.abs() + self.im.abs();
+            let k = if size > 1e60 {
+                1e-60
+            } else if size < 1e-60 {
+                1e60
+            } else {
+                1.0
+            };
+            let (re, im) = (self.re * k, self.im * k);
+            (re * pr - im * pi, re * pi + im * pr)
         };
-        // Only the argument matters: keep the product's magnitude in range by a factor
-        // (a multiplication; a division here would sit on every crossing's path). The
-        // factors lie within about 2^±200 (see `CLIP_FREE_RANGE`), so a product within
-        // 1e±100 before each one never leaves the range of f64.
-        let size = re.abs() + im.abs();
-        let k = if size > 1e100 {
-            1e-100
-        } else if size < 1e-100 {
-            1e100
-        } else {
-            1.0
-        };
-        (self.re, self.im) = (re * k, im * k);
         self.crossings += 1;
         // One call site, so that the edge term is inlined.
         let (p, q) = if up_a { (ra, x) } else { (x, rb) };
