@@ -446,3 +446,42 @@ fn ill_conditioned_maps_and_edges_agree_within_their_conditioning() {
         "{got} vs {exact}"
     );
 }
+
+/// Maps with a NaN or infinite entry, or singular ones, are an error on every path (the
+/// clip-free path's range checks must not let them through to a silent NaN).
+#[test]
+fn non_finite_and_singular_maps_are_errors() {
+    use arealight::glam::DMat3;
+    use arealight::ltc::{ltc_integral, ltc_integral_rational};
+    let above = SphericalPolygon::new(vec![vec![
+        DVec3::new(0.2, -0.3, 1.0),
+        DVec3::new(0.2, 0.3, 1.0),
+        DVec3::new(-0.3, 0.0, 1.0),
+    ]])
+    .unwrap();
+    let crossing = SphericalPolygon::new(vec![vec![
+        DVec3::new(1.0, -0.4, -0.3),
+        DVec3::new(1.0, 0.4, -0.3),
+        DVec3::new(0.6, 0.4, 0.7),
+        DVec3::new(0.6, -0.4, 0.7),
+    ]])
+    .unwrap();
+    let tables_form = |a: f64, b: f64, c: f64, d: f64| {
+        DMat3::from_cols(DVec3::new(a, 0.0, c), DVec3::Y, DVec3::new(b, 0.0, d))
+    };
+    let bad = [
+        tables_form(f64::NAN, 0.0, 0.0, 1.0),
+        tables_form(1.0, f64::INFINITY, 0.0, 1.0),
+        tables_form(1.0, 0.0, f64::NEG_INFINITY, 1.0),
+        tables_form(1.0, 2.0, 0.5, 1.0), // singular: det = 1 - 1 = 0
+        DMat3::from_cols(DVec3::X, DVec3::new(0.0, f64::NAN, 0.0), DVec3::Z),
+        DMat3::ZERO,
+        DMat3::from_cols(DVec3::X, DVec3::X, DVec3::Z),
+    ];
+    for m in bad {
+        for p in [&above, &crossing] {
+            assert!(ltc_integral(p, m).is_err(), "{m:?}");
+            assert!(ltc_integral_rational(p, m).is_err(), "{m:?}");
+        }
+    }
+}
