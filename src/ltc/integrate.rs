@@ -256,7 +256,8 @@ impl EdgeTerm for Rational {
     }
 
     /// [`rational_edge_term`] from `(1, 0, 0)` to `(re, im, 0)`, where `|a x b| = |im|` needs no
-    /// root: the reflection for an argument beyond a quarter turn costs no root and no division.
+    /// root: the reflection for an argument beyond a quarter turn adds no second root and no
+    /// second division.
     #[inline(always)]
     fn arg(self, re: f64, im: f64) -> f64 {
         let (num, den) = rational_ratio(re * re + im * im, re.abs());
