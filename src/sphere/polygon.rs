@@ -214,7 +214,8 @@ impl SphericalPolygon {
     /// becomes `m v / |m v|`. Great circles map to great circles, so the rings stay valid; a map
     /// with negative determinant mirrors the sphere, and the rings are reversed to keep the
     /// interior on the left. This is how a polygon enters the space of a linearly transformed
-    /// cosine (HDHN16 section 3).
+    /// cosine (HDHN16 section 3). Any positive multiple of `m` gives the same polygon, however
+    /// large or small its entries.
     ///
     /// # Errors
     ///
