@@ -250,6 +250,12 @@ fn bails_out_both_ways(a: &Shape, b: &Shape) {
     agree(b, a).unwrap();
 }
 
+/// `a` as the result of an earlier operation (whose facts are computed on demand, not cached):
+/// its union with a far-away unit square, which keeps `a`'s contours verbatim.
+fn with_far_square(a: &Shape) -> Shape {
+    boolean(a, &shape("10:10, 11:10, 11:11, 10:11"), BoolOp::Union).unwrap()
+}
+
 /// The benchmark inputs (benches/planar.rs) are in generic position and take the fast path, so
 /// the benchmark measures it.
 #[test]
@@ -297,8 +303,7 @@ fn near_duplicate_vertices_within_an_operand_bail_out() {
 
     // The same operand as the result of an earlier operation (whose facts are computed on
     // demand, not cached): a union with a far-away square keeps both triangles verbatim.
-    let far = shape("10:10, 11:10, 11:11, 10:11");
-    let chained = boolean(&a, &far, BoolOp::Union).unwrap();
+    let chained = with_far_square(&a);
     assert_eq!(chained.contours().count(), 3);
     for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference] {
         assert!(
@@ -325,8 +330,7 @@ fn vertex_on_an_edge_of_its_own_shape_bails_out() {
     ]])
     .unwrap();
     bails_out_both_ways(&a, &b);
-    let far = shape("10:10, 11:10, 11:11, 10:11");
-    let chained = boolean(&a, &far, BoolOp::Union).unwrap();
+    let chained = with_far_square(&a);
     assert!(
         boolean_fast(&chained, &b, BoolOp::Difference)
             .unwrap()

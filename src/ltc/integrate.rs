@@ -345,14 +345,23 @@ pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
     if poly.is_full() {
         return 1.0;
     }
-    clip_free_sum(poly.rings(), Exact).unwrap_or_else(|| clamped_cosine_integral(poly))
+    clip_free_sum(poly, |v| v, Exact).unwrap_or_else(|| clamped_cosine_integral(poly))
 }
 
-/// The clip-free sum of [`clamped_cosine_integral_clip_free`] over rings of unit vectors, with
-/// the edge term given; `None` where the exact path must decide (a vertex on the horizon, or no
-/// crossing while some vertex is below).
-fn clip_free_sum<'a>(rings: impl Iterator<Item = &'a [DVec3]>, edge: impl EdgeTerm) -> Option<f64> {
-    ring_sum(rings, |v| v, edge)
+/// The clip-free sum of [`clamped_cosine_integral_clip_free`] over the images of the polygon's
+/// vertices under `map`, with the edge term given: a single ring through [`single_ring_sum`],
+/// several through [`ring_sum`]. `None` where the exact path must decide (a vertex on the
+/// horizon, or no crossing while some vertex is below).
+#[inline(always)]
+fn clip_free_sum(
+    poly: &SphericalPolygon,
+    map: impl Fn(DVec3) -> DVec3,
+    edge: impl EdgeTerm,
+) -> Option<f64> {
+    match poly.single_ring() {
+        Some(ring) => single_ring_sum(ring, map, edge),
+        None => ring_sum(poly.rings(), map, edge),
+    }
 }
 
 /// The clip-free sum over the images of the rings' vertices under `map`, which need not be unit
@@ -632,10 +641,7 @@ fn transformed_clip_free(
             return general_clip_free(poly, m, edge);
         }
         let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, v.y, m20 * v.x + m22 * v.z);
-        match poly.single_ring() {
-            Some(ring) => single_ring_sum(ring, map, edge),
-            None => ring_sum(poly.rings(), map, edge),
-        }
+        clip_free_sum(poly, map, edge)
     } else {
         general_clip_free(poly, m, edge)
     }
@@ -660,7 +666,7 @@ fn general_clip_free(poly: &SphericalPolygon, m: &glam::DMat3, edge: impl EdgeTe
     if !(m.determinant() >= 1.0 / CLIP_FREE_RANGE) {
         return None;
     }
-    ring_sum(poly.rings(), |v| m * v, edge)
+    clip_free_sum(poly, |v| m * v, edge)
 }
 
 #[cfg(test)]

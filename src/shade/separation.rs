@@ -72,22 +72,23 @@ pub(crate) fn separating_plane(light: &TriangleMesh, blocker: &TriangleMesh) -> 
     // whatever the coordinates' offset.
     let a: SmallVec<[DVec3; 32]> = light.vertices().iter().map(|&v| v - ca).collect();
     let b: SmallVec<[DVec3; 32]> = blocker.vertices().iter().map(|&v| v - ca).collect();
-    // Gap along a unit direction n: how far the blocker's lowest vertex lies above the light's
-    // highest one.
-    let gap = |n: DVec3| -> f64 {
+    // Along a unit direction n: the blocker's lowest vertex and the light's highest one.
+    let extent = |n: DVec3| -> (f64, f64) {
         let lo_b = b.iter().map(|&v| n.dot(v)).fold(f64::INFINITY, f64::min);
         let hi_a = a
             .iter()
             .map(|&v| n.dot(v))
             .fold(f64::NEG_INFINITY, f64::max);
+        (lo_b, hi_a)
+    };
+    // How far the blocker lies above the light along n.
+    let gap = |n: DVec3| -> f64 {
+        let (lo_b, hi_a) = extent(n);
         lo_b - hi_a
     };
+    // The plane halfway between them.
     let plane = |n: DVec3| -> Separation {
-        let lo_b = b.iter().map(|&v| n.dot(v)).fold(f64::INFINITY, f64::min);
-        let hi_a = a
-            .iter()
-            .map(|&v| n.dot(v))
-            .fold(f64::NEG_INFINITY, f64::max);
+        let (lo_b, hi_a) = extent(n);
         Separation {
             normal: n,
             origin: ca,

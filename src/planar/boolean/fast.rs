@@ -294,6 +294,9 @@ fn find_crossings(s: &mut Scratch, a: &Shape, b: &Shape, m: f64) -> Option<()> {
         events.push(u128::from(sort_key(e.b[0])) << 32 | (j as u32 | B_BIT) as u128);
     }
     events.sort_unstable();
+    // The two branches below mirror each other (an edge of A meets the active edges of B, and
+    // the other way round); written out twice so that each keeps `pair`'s argument order fixed
+    // without a runtime swap in this inner loop.
     let (active_a, active_b) = (&mut s.active_a, &mut s.active_b);
     active_a.clear();
     active_b.clear();
