@@ -199,7 +199,7 @@ fn rational_ratio(l2: f64, y: f64) -> (f64, f64) {
 /// With `l = |a| |b|` and `d = a . b`, the (2, 2) rational function of `|d| / l` is evaluated in
 /// homogeneous form, so the whole term costs one square root and one division; edges longer than
 /// a quarter circle add the reflection term `pi / sin(theta)` with `l sin(theta) = |a x b|`.
-#[inline]
+#[inline(always)]
 fn rational_edge_term(a: Ray, b: Ray) -> f64 {
     let l2 = a.len2 * b.len2;
     let (a, b) = (a.v, b.v);
@@ -542,6 +542,7 @@ impl ClipFree {
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
     /// (the pairing of the horizon arcs is then unknown here).
+    #[inline(always)]
     fn finish(self, edge: impl EdgeTerm) -> Option<f64> {
         let horizon = if self.crossings > 0 {
             // The argument of the product in [0, 2 pi), through the edge term of the horizon arc
