@@ -27,7 +27,7 @@ impl Ray {
 /// Baum's edge term for the edge `a -> b`: `theta * (a x b)_z / |a x b|`, with the angle taken as
 /// `atan2(|a x b|, a . b)`, which stays accurate for tiny edges (no `acos` of a rounded dot
 /// product near 1) and for edges near pi long. For a tiny edge `theta / |a x b| -> 1`.
-#[inline]
+#[inline(always)]
 fn edge_term(a: Ray, b: Ray) -> f64 {
     // Invariant under positive scaling of `a` and `b`, so the endpoints need not be unit vectors.
     let (a, b) = (a.v, b.v);
