@@ -41,6 +41,17 @@ fn shading(c: &mut Criterion) {
                 l.norm * ltc_integral_rational(black_box(&q), l.m_inv).unwrap()
             })
         });
+        // The same behind a function pointer, which nothing can inline: a renderer's shading
+        // function that calls the integral out of line (the case the `inline(always)` on the
+        // integral's parts is for).
+        let shade: fn(&SphericalPolygon, f64, f64) -> f64 = |q, cos_v, alpha| {
+            let l = lookup(cos_v, alpha).unwrap();
+            l.norm * ltc_integral_rational(q, l.m_inv).unwrap()
+        };
+        c.bench_function(
+            &format!("ltc/quad {name}/clip-free rational via fn pointer"),
+            |b| b.iter(|| black_box(shade)(black_box(&q), black_box(cos_v), black_box(alpha))),
+        );
         // The integral alone, for a lookup made once: what a renderer pays per extra light at the
         // same shading point.
         let l = lookup(cos_v, alpha).unwrap();
