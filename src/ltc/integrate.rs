@@ -27,6 +27,11 @@ impl Ray {
 /// Baum's edge term for the edge `a -> b`: `theta * (a x b)_z / |a x b|`, with the angle taken as
 /// `atan2(|a x b|, a . b)`, which stays accurate for tiny edges (no `acos` of a rounded dot
 /// product near 1) and for edges near pi long. For a tiny edge `theta / |a x b| -> 1`.
+///
+/// Always inlined, like [`rational_edge_term`] and [`ClipFree::finish`]: out of line (the
+/// compiler's choice in callers that do not inline the whole integral) the rays and the running
+/// state went through memory, and the reloads of separately stored fields stalled store-to-load
+/// forwarding (see BENCHMARKS.md, "ltc shading", session 4).
 #[inline(always)]
 fn edge_term(a: Ray, b: Ray) -> f64 {
     // Invariant under positive scaling of `a` and `b`, so the endpoints need not be unit vectors.
