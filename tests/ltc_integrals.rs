@@ -36,6 +36,17 @@ fn polygon(seed: u64) -> Option<SphericalPolygon> {
     }
 }
 
+/// The documented error bound of the rational edge factor on `p`, plus `slack` for rounding:
+/// [`EDGE_FACTOR_RATIONAL_MAX_ERROR`] times the perimeter of `p` clipped to the upper hemisphere,
+/// over `2 pi`.
+fn rational_bound(p: &SphericalPolygon, slack: f64) -> f64 {
+    use arealight::ltc::EDGE_FACTOR_RATIONAL_MAX_ERROR;
+    let perimeter: f64 = boundary_edges(&p.clip_to_hemisphere(DVec3::Z))
+        .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
+        .sum();
+    EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + slack
+}
+
 /// A random polygon, a random map of the fitted tables' form (`y` unchanged), the exact
 /// clamped-cosine integral of the mapped polygon and the documented error bound of the rational
 /// edge factor on it.
@@ -44,7 +55,6 @@ fn ltc_form_case(
     salt: u64,
 ) -> Option<(SphericalPolygon, arealight::glam::DMat3, f64, f64)> {
     use arealight::glam::DMat3;
-    use arealight::ltc::EDGE_FACTOR_RATIONAL_MAX_ERROR;
     let p = polygon(seed)?;
     let mut rng = Rng::new(seed ^ salt);
     let (a, d) = (rng.range(1e-3, 3.0), rng.range(1e-3, 3.0));
@@ -52,11 +62,7 @@ fn ltc_form_case(
     let m = DMat3::from_cols(DVec3::new(a, 0.0, c), DVec3::Y, DVec3::new(b, 0.0, d));
     let t = p.transformed(m).ok()?;
     let exact = clamped_cosine_integral(&t);
-    let perimeter: f64 = boundary_edges(&t.clip_to_hemisphere(DVec3::Z))
-        .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
-        .sum();
-    let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
-    Some((p, m, exact, bound))
+    Some((p, m, exact, rational_bound(&t, 1e-12)))
 }
 
 #[test]
@@ -208,11 +214,9 @@ proptest! {
     /// The rational variant stays within its documented error of the exact integral.
     #[test]
     fn rational_integral_within_bound(seed in any::<u64>()) {
-        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral_rational};
+        use arealight::ltc::clamped_cosine_integral_rational;
         let Some(p) = polygon(seed) else { return Ok(()); };
-        let clipped = p.clip_to_hemisphere(DVec3::Z);
-        let perimeter: f64 = boundary_edges(&clipped).map(|(a, b)| a.cross(b).length().atan2(a.dot(b))).sum();
-        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-14;
+        let bound = rational_bound(&p, 1e-14);
         let (a, b) = (clamped_cosine_integral(&p), clamped_cosine_integral_rational(&p));
         prop_assert!((a - b).abs() <= bound, "{} vs {} (bound {})", a, b, bound);
     }
@@ -304,7 +308,7 @@ proptest! {
     #[test]
     fn fast_ltc_paths_agree_with_exact(seed in any::<u64>()) {
         use arealight::glam::DMat3;
-        use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+        use arealight::ltc::{ltc_integral, ltc_integral_rational};
         let Some(p) = polygon(seed) else { return Ok(()); };
         let mut rng = Rng::new(seed ^ 0x17C);
         let m = DMat3::from_cols(rng.dir() * rng.range(0.2, 3.0), rng.dir(), rng.dir() * rng.range(0.2, 3.0));
@@ -312,11 +316,8 @@ proptest! {
         let exact = clamped_cosine_integral(&t);
         let fast = ltc_integral(&p, m).unwrap();
         prop_assert!((exact - fast).abs() <= 1e-12, "{} vs {}", exact, fast);
-        let perimeter: f64 = boundary_edges(&t.clip_to_hemisphere(DVec3::Z))
-            .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
-            .sum();
         let rational = ltc_integral_rational(&p, m).unwrap();
-        let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+        let bound = rational_bound(&t, 1e-12);
         prop_assert!((exact - rational).abs() <= bound, "{} vs {} (bound {})", exact, rational, bound);
     }
 }
@@ -328,7 +329,7 @@ proptest! {
 #[test]
 fn horizon_arcs_of_half_a_circle() {
     use arealight::glam::{DMat3, DQuat};
-    use arealight::ltc::{EDGE_FACTOR_RATIONAL_MAX_ERROR, ltc_integral, ltc_integral_rational};
+    use arealight::ltc::{ltc_integral, ltc_integral_rational};
     for (k, shift) in (0..64).flat_map(|k| [0.0, 1e-9, -1e-11, 3e-14].map(|s| (k, s))) {
         // One crossing moved off the antipode of the other by `shift`.
         let ring = [
@@ -347,10 +348,7 @@ fn horizon_arcs_of_half_a_circle() {
             let exact = clamped_cosine_integral(&p);
             assert!((clamped_cosine_integral_clip_free(&p) - exact).abs() <= 1e-12);
             assert!((ltc_integral(&p, DMat3::IDENTITY).unwrap() - exact).abs() <= 1e-12);
-            let perimeter: f64 = boundary_edges(&p.clip_to_hemisphere(DVec3::Z))
-                .map(|(a, b)| a.cross(b).length().atan2(a.dot(b)))
-                .sum();
-            let bound = EDGE_FACTOR_RATIONAL_MAX_ERROR * perimeter / (2.0 * PI) + 1e-12;
+            let bound = rational_bound(&p, 1e-12);
             let rational = ltc_integral_rational(&p, DMat3::IDENTITY).unwrap();
             assert!(
                 (rational - exact).abs() <= bound,

@@ -476,11 +476,7 @@ impl ClipFree {
         }
         self.edges += 1;
         match (a.z > 0.0, b.z > 0.0) {
-            (true, true) => {
-                let t = edge.term(ra, rb);
-                self.sum += t;
-                self.magnitude += t.abs();
-            }
+            (true, true) => self.add_above(ra, rb, edge),
             (false, false) => self.any_below = true,
             (up_a, _) => {
                 self.any_below = true;
@@ -488,6 +484,15 @@ impl ClipFree {
             }
         }
         Some(())
+    }
+
+    /// Adds the term of the edge `a -> b` that lies wholly above the horizon (the caller counts
+    /// the edge).
+    #[inline(always)]
+    fn add_above(&mut self, ra: Ray, rb: Ray, edge: impl EdgeTerm) {
+        let t = edge.term(ra, rb);
+        self.sum += t;
+        self.magnitude += t.abs();
     }
 
     /// Adds the edge `a -> b` that crosses the horizon (`a` above it when `up_a`, else `b`): the
@@ -568,9 +573,9 @@ impl ClipFree {
 }
 
 /// [`ring_sum`] for a single ring, with the edges between vertices clearly above the horizon (all
-/// of them for most lights) taken without the crossing bookkeeping; from the first vertex that is
-/// not, the general running state takes over with the sum so far. Each image is computed once
-/// and nothing is buffered.
+/// of them for most lights) taken without the horizon tests of [`ClipFree::add_edge`]; from the
+/// first vertex that is not, that takes over. Each image is computed once and nothing is
+/// buffered.
 #[inline(always)]
 fn single_ring_sum(
     ring: &[DVec3],
@@ -583,7 +588,6 @@ fn single_ring_sum(
     let mut prev = first;
     let mut rest = rest.iter();
     if ClipFree::clearly_above(first) {
-        let (mut sum, mut magnitude) = (0.0, 0.0);
         let mut handover = None;
         for &v in &mut rest {
             let cur = Ray::new(map(v));
@@ -591,19 +595,15 @@ fn single_ring_sum(
                 handover = Some(cur);
                 break;
             }
-            let t = edge.term(prev, cur);
-            sum += t;
-            magnitude += t.abs();
             acc.edges += 1;
+            acc.add_above(prev, cur, edge);
             prev = cur;
         }
         let Some(cur) = handover else {
-            let t = edge.term(prev, first);
-            let (sum, magnitude) = (sum + t, magnitude + t.abs());
-            let horizon = ClipFree::horizon_if_all_above(sum, magnitude, ring.len())?;
-            return Some(integral_of_sum(sum + horizon));
+            acc.edges += 1;
+            acc.add_above(prev, first, edge);
+            return acc.finish(edge);
         };
-        (acc.sum, acc.magnitude) = (sum, magnitude);
         acc.add_edge(prev, cur, edge)?;
         prev = cur;
     }
