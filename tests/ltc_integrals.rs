@@ -8,8 +8,8 @@ use arealight::glam::DVec3;
 use arealight::ltc::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
 use arealight::sphere::SphericalPolygon;
 use common::{
-    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_integral, star_ring,
-    triangle_quadrature,
+    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_integral, polar,
+    star_ring, triangle_quadrature,
 };
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -326,6 +326,59 @@ proptest! {
 /// antipodal points, turned about the normal): the clip-free paths take the arcs' angle from the
 /// argument of a product that lies on the negative real axis up to rounding. The rational path
 /// once clamped `sin(theta)` there and lost the whole half circle.
+/// Single rings whose first vertex is clearly above the horizon go through the paired loop of the
+/// clip-free path (two edges per step, the second ending at the first vertex again at the end of
+/// the ring), which hands over to the crossing bookkeeping at the first pair with a vertex that is
+/// not clearly above. Every handover position, for rings of odd and even length, with one or two
+/// consecutive vertices below the horizon or none, against the exact clip.
+#[test]
+fn paired_above_loop_hands_over_at_every_position() {
+    use arealight::glam::DMat3;
+    use arealight::ltc::{lookup, ltc_integral, ltc_integral_rational};
+    let c = DVec3::new(0.35f64.cos(), 0.0, 0.35f64.sin());
+    let table_map = lookup(0.6, 0.2).unwrap().m_inv;
+    let mut handovers = 0;
+    for n in 3..=9 {
+        // Vertices 0 and 1 straddle the azimuth of the ring's lowest point (that of `polar`'s
+        // frame), so that they dip below the horizon when pushed out.
+        let (u, v) = c.any_orthonormal_pair();
+        let step = 2.0 * PI / n as f64;
+        let theta = |j: usize| (-v.z).atan2(-u.z) + step * (j as f64 - 0.5);
+        for dipped in 0..=2 {
+            let ring: Vec<DVec3> = (0..n)
+                .map(|j| polar(c, if j < dipped { 1.2 } else { 0.3 }, theta(j)))
+                .collect();
+            let below = ring.iter().filter(|v| v.z < -0.05).count();
+            assert_eq!(
+                below, dipped,
+                "n = {n}: the dipped vertices must be below the horizon"
+            );
+            for start in 0..n {
+                let mut r = ring.clone();
+                r.rotate_left(start);
+                handovers += usize::from(r[0].z > 0.0 && dipped > 0);
+                let p = SphericalPolygon::new(vec![r]).unwrap();
+                for m in [DMat3::IDENTITY, table_map] {
+                    let t = p.transformed(m).unwrap();
+                    let exact = clamped_cosine_integral(&t);
+                    let fast = ltc_integral(&p, m).unwrap();
+                    let rational = ltc_integral_rational(&p, m).unwrap();
+                    assert!(
+                        (fast - exact).abs() < 1e-12,
+                        "n {n} start {start}: {fast} vs {exact}"
+                    );
+                    let bound = rational_bound(&t, 1e-12);
+                    assert!(
+                        (rational - exact).abs() <= bound,
+                        "n {n} start {start}: {rational} vs {exact} (bound {bound})"
+                    );
+                }
+            }
+        }
+    }
+    assert!(handovers > 40, "only {handovers} rings handed over");
+}
+
 #[test]
 fn horizon_arcs_of_half_a_circle() {
     use arealight::glam::{DMat3, DQuat};

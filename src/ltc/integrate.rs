@@ -223,6 +223,35 @@ fn rational_edge_term(a: Ray, b: Ray) -> f64 {
     }
 }
 
+/// [`rational_edge_term`] of the two edges `a[k] -> b[k]`, written lane by lane with one branch
+/// for both, so that the compiler evaluates them with two-lane operations (one packed square root
+/// and one packed division for two edges): two edge terms side by side instead of two chains of
+/// scalar ones in a row (see BENCHMARKS.md, session 5). Edges longer than a quarter circle take
+/// the scalar terms.
+#[inline(always)]
+fn rational_edge_term_pair(a: [Ray; 2], b: [Ray; 2]) -> [f64; 2] {
+    let d = lanes(|k| a[k].v.dot(b[k].v));
+    if !(d[0] >= 0.0 && d[1] >= 0.0) {
+        return [
+            rational_edge_term(a[0], b[0]),
+            rational_edge_term(a[1], b[1]),
+        ];
+    }
+    let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
+    let l2 = lanes(|k| a[k].len2 * b[k].len2);
+    let cz = lanes(|k| a[k].v.x * b[k].v.y - a[k].v.y * b[k].v.x);
+    let l = lanes(|k| crate::math::sqrt(l2[k]));
+    let num = lanes(|k| p0 * l2[k] + (p1 * l[k] + p2 * d[k]) * d[k]);
+    let den = lanes(|k| (q0 * l2[k] + (q1 * l[k] + d[k]) * d[k]) * l[k]);
+    lanes(|k| num[k] * cz[k] / den[k])
+}
+
+/// `[f(0), f(1)]`: one value per lane of [`rational_edge_term_pair`].
+#[inline(always)]
+fn lanes(f: impl Fn(usize) -> f64) -> [f64; 2] {
+    [f(0), f(1)]
+}
+
 /// The two ways of evaluating Baum's edge terms: exactly ([`Exact`]) or with the rational edge
 /// factor ([`Rational`]).
 trait EdgeTerm: Copy {
@@ -232,6 +261,13 @@ trait EdgeTerm: Copy {
     /// The edge term of the horizon arc from the x-axis to `(re, im, 0)` (not both zero): the
     /// argument of `re + i im` in `[-pi, pi]`, with the same error as [`EdgeTerm::term`].
     fn arg(self, re: f64, im: f64) -> f64;
+
+    /// The terms of the two edges `a[k] -> b[k]`: for the rational factor, evaluated side by side
+    /// so that the compiler can pair them into two-lane operations.
+    #[inline(always)]
+    fn term_pair(self, a: [Ray; 2], b: [Ray; 2]) -> [f64; 2] {
+        [self.term(a[0], b[0]), self.term(a[1], b[1])]
+    }
 }
 
 /// Edge terms with `atan2` ([`edge_term`]).
@@ -268,6 +304,11 @@ impl EdgeTerm for Rational {
         let (num, den) = rational_ratio(re * re + im * im, re.abs());
         let v = num * im / den;
         if re >= 0.0 { v } else { PI.copysign(im) - v }
+    }
+
+    #[inline(always)]
+    fn term_pair(self, a: [Ray; 2], b: [Ray; 2]) -> [f64; 2] {
+        rational_edge_term_pair(a, b)
     }
 }
 
@@ -495,6 +536,15 @@ impl ClipFree {
         self.magnitude += t.abs();
     }
 
+    /// Adds the terms of the edges `a[k] -> b[k]`, both wholly above the horizon (the caller
+    /// counts the edges).
+    #[inline(always)]
+    fn add_above_pair(&mut self, a: [Ray; 2], b: [Ray; 2], edge: impl EdgeTerm) {
+        let [t0, t1] = edge.term_pair(a, b);
+        self.sum += t0 + t1;
+        self.magnitude += t0.abs() + t1.abs();
+    }
+
     /// Adds the edge `a -> b` that crosses the horizon (`a` above it when `up_a`, else `b`): the
     /// part above and the crossing's factor of the product (thesis 003 eq. 4.6 and 4.7).
     #[inline(always)]
@@ -573,9 +623,9 @@ impl ClipFree {
 }
 
 /// [`ring_sum`] for a single ring, with the edges between vertices clearly above the horizon (all
-/// of them for most lights) taken without the horizon tests of [`ClipFree::add_edge`]; from the
-/// first vertex that is not, that takes over. Each image is computed once and nothing is
-/// buffered.
+/// of them for most lights) taken two at a time ([`EdgeTerm::term_pair`]) and without the horizon
+/// tests of [`ClipFree::add_edge`]; from the first pair with a vertex that is not, that takes
+/// over. Each image is computed once and nothing is buffered.
 #[inline(always)]
 fn single_ring_sum(
     ring: &[DVec3],
@@ -588,24 +638,35 @@ fn single_ring_sum(
     let mut prev = first;
     let mut rest = rest.iter();
     if ClipFree::clearly_above(first) {
-        let mut handover = None;
-        for &v in &mut rest {
-            let cur = Ray::new(map(v));
-            if !ClipFree::clearly_above(cur) {
-                handover = Some(cur);
-                break;
+        // Two edges per step, `prev -> c1 -> c2`, with `c2` the first vertex again at the end of
+        // the ring, so that their terms can be evaluated side by side.
+        loop {
+            let Some(&v1) = rest.next() else {
+                acc.edges += 1;
+                acc.add_above(prev, first, edge);
+                return acc.finish(edge);
+            };
+            let c1 = Ray::new(map(v1));
+            let (c2, closing) = match rest.next() {
+                Some(&v2) => (Ray::new(map(v2)), false),
+                None => (first, true),
+            };
+            if ClipFree::clearly_above(c1) && ClipFree::clearly_above(c2) {
+                acc.edges += 2;
+                acc.add_above_pair([prev, c1], [c1, c2], edge);
+            } else {
+                acc.add_edge(prev, c1, edge)?;
+                acc.add_edge(c1, c2, edge)?;
+                if !closing {
+                    prev = c2;
+                    break;
+                }
             }
-            acc.edges += 1;
-            acc.add_above(prev, cur, edge);
-            prev = cur;
+            if closing {
+                return acc.finish(edge);
+            }
+            prev = c2;
         }
-        let Some(cur) = handover else {
-            acc.edges += 1;
-            acc.add_above(prev, first, edge);
-            return acc.finish(edge);
-        };
-        acc.add_edge(prev, cur, edge)?;
-        prev = cur;
     }
     for &v in rest {
         let cur = Ray::new(map(v));
