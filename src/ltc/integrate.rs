@@ -237,13 +237,10 @@ fn rational_edge_term_pair(a: [Ray; 2], b: [Ray; 2]) -> [f64; 2] {
             rational_edge_term(a[1], b[1]),
         ];
     }
-    let [p0, p1, p2, q0, q1] = EDGE_FACTOR_COEFFS;
     let l2 = lanes(|k| a[k].len2 * b[k].len2);
     let cz = lanes(|k| a[k].v.x * b[k].v.y - a[k].v.y * b[k].v.x);
-    let l = lanes(|k| crate::math::sqrt(l2[k]));
-    let num = lanes(|k| p0 * l2[k] + (p1 * l[k] + p2 * d[k]) * d[k]);
-    let den = lanes(|k| (q0 * l2[k] + (q1 * l[k] + d[k]) * d[k]) * l[k]);
-    lanes(|k| num[k] * cz[k] / den[k])
+    let [(n0, d0), (n1, d1)] = [rational_ratio(l2[0], d[0]), rational_ratio(l2[1], d[1])];
+    [n0 * cz[0] / d0, n1 * cz[1] / d1]
 }
 
 /// `[f(0), f(1)]`: one value per lane of [`rational_edge_term_pair`].
