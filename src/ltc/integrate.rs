@@ -648,21 +648,21 @@ fn single_ring_sum(
                 Some(&v2) => (Ray::new(map(v2)), false),
                 None => (first, true),
             };
-            if ClipFree::clearly_above(c1) && ClipFree::clearly_above(c2) {
+            let above = ClipFree::clearly_above(c1) && ClipFree::clearly_above(c2);
+            if above {
                 acc.edges += 2;
                 acc.add_above_pair([prev, c1], [c1, c2], edge);
             } else {
                 acc.add_edge(prev, c1, edge)?;
                 acc.add_edge(c1, c2, edge)?;
-                if !closing {
-                    prev = c2;
-                    break;
-                }
             }
             if closing {
                 return acc.finish(edge);
             }
             prev = c2;
+            if !above {
+                break;
+            }
         }
     }
     for &v in rest {
