@@ -35,15 +35,19 @@ use crate::math::sqrt;
 /// Number of stored channels per cell (see [`Channel`]).
 pub(crate) const CHANNELS: usize = 7;
 
-/// The per-cell quantities, in storage order.
+/// The per-cell quantities, in storage order: `M^-1`'s first column `(M00, M20)`, its last column
+/// `(M02, M22)`, then the scalars. The columns are what a vertex's `x` and `z` are multiplied by,
+/// so each comes out of the bilinear lookup as one two-lane value that the transform uses as it
+/// is; with the rows stored together the compiler shuffled them apart on every lookup (28 more
+/// instructions per shaded quad, see BENCHMARKS.md, session 6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Channel {
     /// `M^-1[0][0]` (row, column), with `M^-1` scaled so that `M^-1[1][1] = 1`.
     M00 = 0,
-    /// `M^-1[0][2]`.
-    M02 = 1,
     /// `M^-1[2][0]`.
-    M20 = 2,
+    M20 = 1,
+    /// `M^-1[0][2]`.
+    M02 = 2,
     /// `M^-1[2][2]`.
     M22 = 3,
     /// Scale of the clamped-cosine integral, see [`LtcLookup::norm`].
@@ -52,6 +56,21 @@ pub(crate) enum Channel {
     Albedo = 5,
     /// Fresnel weight.
     Fresnel = 6,
+}
+
+impl Channel {
+    /// Every channel with the name of its array in the generated table source (`table_data.rs`),
+    /// in that file's order.
+    #[cfg_attr(not(feature = "fit"), allow(dead_code))]
+    pub(crate) const ALL: [(Channel, &'static str); CHANNELS] = [
+        (Channel::M00, "M_INV_00"),
+        (Channel::M02, "M_INV_02"),
+        (Channel::M20, "M_INV_20"),
+        (Channel::M22, "M_INV_22"),
+        (Channel::Norm, "NORM"),
+        (Channel::Albedo, "ALBEDO"),
+        (Channel::Fresnel, "FRESNEL"),
+    ];
 }
 
 /// The sampling grid of a table: node positions and the input -> grid-coordinate maps.
@@ -248,10 +267,11 @@ const fn interleave<const N: usize>(channels: [&[f64; N]; CHANNELS]) -> [Node; N
     out
 }
 
+/// The generated arrays in storage order ([`Channel`]'s values; checked by a test).
 static GGX_NODES: [Node; data::SIZE * data::SIZE] = interleave([
     &data::M_INV_00,
-    &data::M_INV_02,
     &data::M_INV_20,
+    &data::M_INV_02,
     &data::M_INV_22,
     &data::NORM,
     &data::ALBEDO,
@@ -457,4 +477,30 @@ fn interpolate(grid: &Grid, nodes: &[Node], cos_theta_v: f64, alpha: f64) -> Ltc
 pub fn lookup(cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
     check_inputs(cos_theta_v, alpha)?;
     Ok(interpolate(&GGX_GRID, &GGX_NODES, cos_theta_v, alpha))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each generated array lands in its channel's slot of the nodes.
+    #[test]
+    fn nodes_hold_each_array_in_its_channel() {
+        let arrays: [(Channel, &[f64]); CHANNELS] = [
+            (Channel::M00, &data::M_INV_00),
+            (Channel::M02, &data::M_INV_02),
+            (Channel::M20, &data::M_INV_20),
+            (Channel::M22, &data::M_INV_22),
+            (Channel::Norm, &data::NORM),
+            (Channel::Albedo, &data::ALBEDO),
+            (Channel::Fresnel, &data::FRESNEL),
+        ];
+        for (ch, values) in arrays {
+            for (node, &v) in GGX_NODES.iter().zip(values) {
+                assert_eq!(node.0[ch as usize].to_bits(), v.to_bits(), "{ch:?}");
+            }
+        }
+        // Otherwise a swap of the two off-diagonal channels would go unnoticed.
+        assert_ne!(data::M_INV_02, data::M_INV_20);
+    }
 }
