@@ -3,7 +3,7 @@
 mod ltc_common;
 
 use arealight::glam::{DVec2, DVec3};
-use arealight::ltc::{ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf};
+use arealight::ltc::{ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight};
 use ltc_common::{Rng, histogram_sigma, sphere_quad, view};
 
 fn mirror(v: DVec3) -> DVec3 {
@@ -36,10 +36,7 @@ fn albedo_by_quadrature_is_at_most_one_and_matches_sampler_weights() {
                         (i as f64 + rng.f64()) / n as f64,
                         (j as f64 + rng.f64()) / n as f64,
                     );
-                    let l = ggx_sample_vndf(v, alpha, u);
-                    let pdf = ggx_vndf_pdf(v, l, alpha);
-                    if pdf > 0.0 {
-                        let w = ggx_brdf_cos(v, l, alpha) / pdf;
+                    if let Some((_, w)) = ggx_vndf_weight(v, alpha, u) {
                         assert!((0.0..=1.0 + 1e-12).contains(&w), "weight {w}");
                         mc += w;
                     }

@@ -4,7 +4,7 @@
 mod common;
 
 use arealight::glam::{DVec2, DVec3};
-use arealight::ltc::{ggx_brdf_cos, ggx_polygon_integral, ggx_sample_vndf, ggx_vndf_pdf, lookup};
+use arealight::ltc::{ggx_polygon_integral, ggx_vndf_weight, lookup};
 use arealight::sphere::SphericalPolygon;
 use common::Rng;
 
@@ -49,12 +49,9 @@ fn brute_force(
                 (i as f64 + rng.f64()) / n as f64,
                 (j as f64 + rng.f64()) / n as f64,
             );
-            let l = ggx_sample_vndf(v, alpha, u);
-            let pdf = ggx_vndf_pdf(v, l, alpha);
-            if pdf.is_nan() || pdf <= 0.0 || l.z <= 0.0 {
+            let Some((l, w)) = ggx_vndf_weight(v, alpha, u) else {
                 continue;
-            }
-            let w = ggx_brdf_cos(v, l, alpha) / pdf;
+            };
             all += w;
             if quad.contains(l) {
                 hit += w;

@@ -53,7 +53,7 @@ use std::vec::Vec;
 use glam::{DMat3, DVec2, DVec3};
 
 use super::distribution::Ltc;
-use super::ggx::{ggx_brdf_cos, ggx_sample_vndf, ggx_vndf_pdf};
+use super::ggx::{ggx_brdf_cos, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight};
 use super::table::{CHANNELS, Channel, Grid, LtcTable};
 use crate::GeomError;
 
@@ -223,13 +223,7 @@ impl Cell {
         let v = DVec3::new((1.0 - c * c).max(0.0).sqrt(), 0.0, c);
         // Albedo, Fresnel weight and average direction by VNDF sampling: weight f cos / pdf.
         let (mut a, mut fr, mut dir) = (0.0, 0.0, DVec3::ZERO);
-        for &u in stats {
-            let l = ggx_sample_vndf(v, alpha, u);
-            let pdf = ggx_vndf_pdf(v, l, alpha);
-            if pdf <= 0.0 || l.z <= 0.0 {
-                continue;
-            }
-            let w = ggx_brdf_cos(v, l, alpha) / pdf;
+        for (l, w) in stats.iter().filter_map(|&u| ggx_vndf_weight(v, alpha, u)) {
             let h = (v + l).normalize();
             a += w;
             fr += w * (1.0 - v.dot(h).clamp(0.0, 1.0)).powi(5);
@@ -809,12 +803,9 @@ pub fn quad_shading_errors(
                     (i as f64 + rng.next_f64()) / n as f64,
                     (j as f64 + rng.next_f64()) / n as f64,
                 );
-                let l = ggx_sample_vndf(v, alpha, u);
-                let pdf = ggx_vndf_pdf(v, l, alpha);
-                if pdf <= 0.0 || l.z <= 0.0 {
+                let Some((l, w)) = ggx_vndf_weight(v, alpha, u) else {
                     continue;
-                }
-                let w = ggx_brdf_cos(v, l, alpha) / pdf;
+                };
                 albedo += w;
                 if hits_quad(&quad, l) {
                     hit += w;

@@ -191,3 +191,32 @@ pub fn ggx_vndf_pdf(v: DVec3, l: DVec3, alpha: f64) -> f64 {
     }
     ggx_ndf(h, alpha) / (2.0 * (v.z + smith_s(v.z, alpha * alpha)))
 }
+
+/// One sample of the GGX reflectance estimator for view `v`: the direction `l` that
+/// [`ggx_sample_vndf`] draws from `u`, with its weight `f(v, l) cos(theta_l) / pdf(l)` (which is
+/// `G2 / G1`, in `[0, 1]`, \[Hei18\]). `None` when `l` is below the horizon or has no density:
+/// its weight is zero there.
+///
+/// With `u` uniform on the unit square, the mean of `w g(l)` (counting `None` as zero) is the
+/// integral of `f cos g` over the hemisphere: for `g = 1` the directional albedo, for the
+/// indicator of a light the brute-force reflectance the LTC tables are checked against.
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::{DVec2, DVec3};
+/// use arealight::ltc::ggx_vndf_weight;
+/// let v = DVec3::new(0.6, 0.0, 0.8);
+/// let (l, w) = ggx_vndf_weight(v, 0.3, DVec2::new(0.25, 0.75)).unwrap();
+/// assert!(l.z > 0.0 && (0.0..=1.0).contains(&w));
+/// ```
+#[must_use]
+pub fn ggx_vndf_weight(v: DVec3, alpha: f64, u: DVec2) -> Option<(DVec3, f64)> {
+    let l = ggx_sample_vndf(v, alpha, u);
+    let pdf = ggx_vndf_pdf(v, l, alpha);
+    // Written so that a NaN density is skipped too.
+    if !(pdf > 0.0 && l.z > 0.0) {
+        return None;
+    }
+    Some((l, ggx_brdf_cos(v, l, alpha) / pdf))
+}

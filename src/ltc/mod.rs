@@ -47,7 +47,9 @@ mod table;
 mod table_data;
 
 pub use distribution::Ltc;
-pub use ggx::{GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf};
+pub use ggx::{
+    GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight,
+};
 pub(crate) use integrate::clamped_cosine_integral_upper;
 pub use integrate::{
     EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral, clamped_cosine_integral_clip_free,
