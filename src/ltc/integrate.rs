@@ -402,6 +402,7 @@ fn clip_free_sum(
     edge: impl EdgeTerm,
 ) -> Option<f64> {
     match poly.single_ring() {
+        Some(ring) if ring.len() == 4 => quad_sum(ring, map, edge),
         Some(ring) => single_ring_sum(ring, map, edge),
         None => ring_sum(poly.rings(), map, edge),
     }
@@ -619,6 +620,110 @@ impl ClipFree {
     }
 }
 
+/// The crossing point of the edge between `above` (above the horizon) and `below` (below it), in
+/// either direction: a positive combination of the two on the horizon (thesis 003 eq. 4.6), of
+/// any positive length.
+#[inline(always)]
+fn crossing_point(above: Ray, below: Ray) -> Ray {
+    let (a, b) = (above.v, below.v);
+    let x = b * a.z - a * b.z;
+    Ray::new(DVec3::new(x.x, x.y, 0.0))
+}
+
+/// [`single_ring_sum`] for a quad, the most common light, without loops and without the running
+/// product of crossings: the vertices are classified at once, and when one run of them lies
+/// above the horizon (two crossings, the common case for a light cut by the horizon), the
+/// clipped quad's edges and its horizon arc, from the exit point to the entry point, are
+/// evaluated as two pairs of terms ([`EdgeTerm::term_pair`]). Four crossings take the general
+/// loop; a vertex on the horizon, or every vertex below it, the exact path, as there.
+#[inline(always)]
+fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+    let (p0, p1, p2, p3) = (quad[0], quad[1], quad[2], quad[3]);
+    let v = [
+        Ray::new(map(p0)),
+        Ray::new(map(p1)),
+        Ray::new(map(p2)),
+        Ray::new(map(p3)),
+    ];
+    // Every vertex off the horizon (written so that NaN and infinite images bail out).
+    let off = |r: Ray| r.v.z * r.v.z > ClipFree::ON_HORIZON2 * r.len2;
+    if !(off(v[0]) & off(v[1]) & off(v[2]) & off(v[3])) {
+        return None;
+    }
+    // Bit k: vertex k above the horizon.
+    let bit = |k: usize| usize::from(v[k].v.z > 0.0) << k;
+    let up = bit(0) | bit(1) | bit(2) | bit(3);
+    if up == 0b1111 {
+        // Every edge above the horizon (the same terms and sums as the paired loop).
+        let [t0, t1] = edge.term_pair([v[0], v[1]], [v[1], v[2]]);
+        let [t2, t3] = edge.term_pair([v[2], v[3]], [v[3], v[0]]);
+        let sum = (t0 + t1) + (t2 + t3);
+        let magnitude = (t0.abs() + t1.abs()) + (t2.abs() + t3.abs());
+        let horizon = ClipFree::horizon_if_all_above(sum, magnitude, 4)?;
+        return Some(integral_of_sum(sum + horizon));
+    }
+    if up == 0 {
+        // Wholly below: the exact path decides whether the region surrounds the upper hemisphere.
+        return None;
+    }
+    // The first vertex of the run above the horizon (its predecessor is below), by mask; 4 where
+    // there is no single run.
+    const FIRST: [usize; 16] = [4, 0, 1, 0, 2, 4, 1, 0, 3, 3, 4, 3, 2, 2, 1, 4];
+    let first = FIRST[up];
+    if first == 4 {
+        return single_ring_sum(quad, map, edge);
+    }
+    // The images again, from the polygon's storage in the run's order: the array of images
+    // indexed by a computed index went through memory, and reloading parts of its stores
+    // stalled store-to-load forwarding.
+    let a0 = Ray::new(map(quad[first]));
+    let a1 = Ray::new(map(quad[(first + 1) & 3]));
+    let a2 = Ray::new(map(quad[(first + 2) & 3]));
+    let a3 = Ray::new(map(quad[(first + 3) & 3]));
+    let run = up.count_ones();
+    let x_in = crossing_point(a0, a3);
+    let x_out = match run {
+        1 => crossing_point(a0, a1),
+        2 => crossing_point(a1, a2),
+        _ => crossing_point(a2, a3),
+    };
+    // The horizon arc's term on the crossing points' own scale: a product of two of them, which
+    // must stay far from underflow in the edge term (extreme maps and near-horizon vertices).
+    if !(x_in.len2 * x_out.len2 >= 1e-180) {
+        return single_ring_sum(quad, map, edge);
+    }
+    // The clipped quad: x_in -> a0 -> ... -> a[run - 1] -> x_out, then the horizon arc.
+    let (t, arc) = match run {
+        1 => {
+            let [t0, t1] = edge.term_pair([x_in, a0], [a0, x_out]);
+            (t0 + t1, edge.term(x_out, x_in))
+        }
+        2 => {
+            let [t0, t1] = edge.term_pair([x_in, a0], [a0, a1]);
+            let [t2, arc] = edge.term_pair([a1, x_out], [x_out, x_in]);
+            (t0 + t1 + t2, arc)
+        }
+        _ => {
+            let [t0, t1] = edge.term_pair([x_in, a0], [a0, a1]);
+            let [t2, t3] = edge.term_pair([a1, a2], [a2, x_out]);
+            (t0 + t1 + t2 + t3, edge.term(x_out, x_in))
+        }
+    };
+    // The arc runs counter-clockwise from the exit to the entry point, in [0, 2 pi): the edge
+    // term gives its signed short angle, so a negative one wraps by a turn, and for points on one
+    // line through the origin (where the term is zero) it is none or half a turn.
+    let (xo, xi) = (x_out.v, x_in.v);
+    let cz = xo.x * xi.y - xo.y * xi.x;
+    let horizon = if cz == 0.0 {
+        if xo.dot(xi) < 0.0 { PI } else { 0.0 }
+    } else if cz < 0.0 {
+        arc + 2.0 * PI
+    } else {
+        arc
+    };
+    Some(integral_of_sum(t + horizon))
+}
+
 /// [`ring_sum`] for a single ring, with the edges between vertices clearly above the horizon (all
 /// of them for most lights) taken two at a time ([`EdgeTerm::term_pair`]) and without the horizon
 /// tests of [`ClipFree::add_edge`]; from the first pair with a vertex that is not, that takes
@@ -746,6 +851,31 @@ mod tests {
         assert!((edge_term(Ray::new(a), Ray::new(b)) - 1e-9).abs() < 1e-24);
         let c = DVec3::new(-1.0, 1e-9, 0.0).normalize();
         assert!((edge_term(Ray::new(a), Ray::new(c)) - (PI - 1e-9)).abs() < 1e-15);
+    }
+
+    /// Short images: at `2^-61`, the shortest the tables' form admits (`CLIP_FREE_RANGE`), the quad
+    /// kernel's own arc term holds; at `2^-100` that term (on the scale of a product of two
+    /// crossing points) would underflow, and the kernel hands over to the general loop, which
+    /// rescales its running product.
+    #[test]
+    fn quad_kernel_hands_over_where_its_arc_term_would_underflow() {
+        let quad = [
+            DVec3::new(1.0, -0.4, -0.3),
+            DVec3::new(1.0, 0.4, -0.3),
+            DVec3::new(0.6, 0.4, 0.7),
+            DVec3::new(0.6, -0.4, 0.7),
+        ]
+        .map(DVec3::normalize);
+        for (k, scale) in (0..4).flat_map(|k| [(k, 2f64.powi(-61)), (k, 2f64.powi(-100))]) {
+            let mut q = quad;
+            q.rotate_left(k);
+            let unit = quad_sum(&q, |v| v, Rational).unwrap();
+            let short = quad_sum(&q, |v| v * scale, Rational).unwrap();
+            assert!((unit - short).abs() <= 1e-15, "{scale}: {unit} vs {short}");
+            let unit = quad_sum(&q, |v| v, Exact).unwrap();
+            let short = quad_sum(&q, |v| v * scale, Exact).unwrap();
+            assert!((unit - short).abs() <= 1e-15, "{scale}: {unit} vs {short}");
+        }
     }
 
     #[test]
