@@ -547,14 +547,11 @@ impl ClipFree {
     /// part above and the crossing's factor of the product (thesis 003 eq. 4.6 and 4.7).
     #[inline(always)]
     fn cross(&mut self, ra: Ray, rb: Ray, up_a: bool, edge: impl EdgeTerm) {
-        let (a, b) = (ra.v, rb.v);
-        // The crossing point, as a positive combination of a and b on the horizon.
         let x = if up_a {
-            b * a.z - a * b.z
+            crossing_point(ra, rb)
         } else {
-            a * b.z - b * a.z
+            crossing_point(rb, ra)
         };
-        let x = Ray::new(DVec3::new(x.x, x.y, 0.0));
         let (pr, pi) = (x.v.x, if up_a { -x.v.y } else { x.v.y });
         // The first factor starts the product (a multiplication by 1 would only lengthen the
         // chain of dependent operations up to the horizon's term). Only the argument matters,
