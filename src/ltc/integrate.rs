@@ -852,10 +852,11 @@ mod tests {
         assert!((edge_term(Ray::new(a), Ray::new(c)) - (PI - 1e-9)).abs() < 1e-15);
     }
 
-    /// Short images: at `2^-61`, the shortest the tables' form admits (`CLIP_FREE_RANGE`), the quad
-    /// kernel's own arc term holds; at `2^-100` that term (on the scale of a product of two
-    /// crossing points) would underflow, and the kernel hands over to the general loop, which
-    /// rescales its running product.
+    /// Short images: at `2^-61`, the shortest image of a unit vector under the maps of the tables'
+    /// form that the clip-free path takes (entries at most `CLIP_FREE_RANGE`, determinant at
+    /// least its inverse), the quad kernel's own arc term holds; at `2^-100` that term (on the
+    /// scale of a product of two crossing points) would underflow, and the kernel hands over to
+    /// the general loop, which rescales its running product.
     #[test]
     fn quad_kernel_hands_over_where_its_arc_term_would_underflow() {
         let quad = [
