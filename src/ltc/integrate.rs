@@ -663,11 +663,29 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
         // Wholly below: the exact path decides whether the region surrounds the upper hemisphere.
         return None;
     }
-    // The first vertex of the run above the horizon (its predecessor is below), by mask; 4 where
-    // there is no single run.
-    const FIRST: [usize; 16] = [4, 0, 1, 0, 2, 4, 1, 0, 3, 3, 4, 3, 2, 2, 1, 4];
-    let first = FIRST[up];
-    if first == 4 {
+    // By mask, the first vertex of the run above the horizon (its predecessor is below) and the
+    // run's length; length 0 where there is no single run. (A table rather than `count_ones`,
+    // which baseline x86-64 has no instruction for.)
+    const RUNS: [(usize, u8); 16] = [
+        (0, 0),
+        (0, 1),
+        (1, 1),
+        (0, 2),
+        (2, 1),
+        (0, 0),
+        (1, 2),
+        (0, 3),
+        (3, 1),
+        (3, 2),
+        (0, 0),
+        (3, 3),
+        (2, 2),
+        (2, 3),
+        (1, 3),
+        (0, 0),
+    ];
+    let (first, run) = RUNS[up];
+    if run == 0 {
         return single_ring_sum(quad, map, edge);
     }
     // The images in the run's order, by a match rather than by a computed index: indexing the
@@ -679,7 +697,6 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
         2 => [v[2], v[3], v[0], v[1]],
         _ => [v[3], v[0], v[1], v[2]],
     };
-    let run = up.count_ones();
     let x_in = crossing_point(a0, a3);
     let x_out = match run {
         1 => crossing_point(a0, a1),
