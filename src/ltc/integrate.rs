@@ -588,10 +588,19 @@ impl ClipFree {
         if self.im == 0.0 {
             if self.re < 0.0 { PI } else { 0.0 }
         } else {
+            // The rational argument is a ratio of polynomials of degree 3 in the product's size,
+            // which the scaling before each factor bounds only loosely (images of `2^-92` gave
+            // NaN here): brought within 1e±90 first, behind a predictable branch, so that the
+            // polynomials neither underflow nor overflow.
+            let (mut re, mut im) = (self.re, self.im);
+            let size = re.abs() + im.abs();
+            if !(1e-90..=1e90).contains(&size) {
+                (re, im) = rescale_product(re, im, size);
+            }
             // One turn added to a negative argument (no `rem_euclid`, which would be a call to
             // `fmod`).
-            let t = edge.arg(self.re, self.im);
-            if self.im < 0.0 { t + 2.0 * PI } else { t }
+            let t = edge.arg(re, im);
+            if im < 0.0 { t + 2.0 * PI } else { t }
         }
     }
 
@@ -615,6 +624,22 @@ impl ClipFree {
         };
         Some(integral_of_sum(self.sum + horizon))
     }
+}
+
+/// `(re, im)`, of magnitude sum `size` outside `1e±90`, scaled into it by a power of ten. Out of
+/// line, so that the common case costs a predicted branch and no select on the way to the
+/// horizon's term.
+#[cold]
+#[inline(never)]
+fn rescale_product(mut re: f64, mut im: f64, mut size: f64) -> (f64, f64) {
+    // Bounded by the finite range of f64 (an infinite or NaN size is left alone).
+    while size > 1e90 && size < f64::INFINITY {
+        (re, im, size) = (re * 1e-60, im * 1e-60, size * 1e-60);
+    }
+    while size < 1e-90 && size > 0.0 {
+        (re, im, size) = (re * 1e60, im * 1e60, size * 1e60);
+    }
+    (re, im)
 }
 
 /// The crossing point of the edge between `above` (above the horizon) and `below` (below it), in
@@ -871,9 +896,10 @@ mod tests {
 
     /// Short images: at `2^-61`, the shortest image of a unit vector under the maps of the tables'
     /// form that the clip-free path takes (entries at most `CLIP_FREE_RANGE`, determinant at
-    /// least its inverse), the quad kernel's own arc term holds; at `2^-100` that term (on the
-    /// scale of a product of two crossing points) would underflow, and the kernel hands over to
-    /// the general loop, which rescales its running product.
+    /// least its inverse), the quad kernel's own arc term holds; at `2^-92` (the bound quoted at
+    /// `CLIP_FREE_RANGE` for maps of any form) and `2^-100` that term (on the scale of a product
+    /// of two crossing points) would underflow, and the kernel hands over to the general loop,
+    /// which rescales its running product (at `2^-92` it returned NaN before its final rescale).
     #[test]
     fn quad_kernel_hands_over_where_its_arc_term_would_underflow() {
         let quad = [
@@ -883,7 +909,8 @@ mod tests {
             DVec3::new(0.6, -0.4, 0.7),
         ]
         .map(DVec3::normalize);
-        for (k, scale) in (0..4).flat_map(|k| [(k, 2f64.powi(-61)), (k, 2f64.powi(-100))]) {
+        let scales = [2f64.powi(-61), 2f64.powi(-92), 2f64.powi(-100)];
+        for (k, scale) in (0..4).flat_map(|k| scales.map(|s| (k, s))) {
             let mut q = quad;
             q.rotate_left(k);
             let unit = quad_sum(&q, |v| v, Rational).unwrap();
