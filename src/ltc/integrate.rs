@@ -560,7 +560,8 @@ impl ClipFree {
         // crossing point is still being computed. The factors lie within about 2^-240 to 2^64
         // (images within 2^±92, see `CLIP_FREE_RANGE`, vertices off the horizon by
         // `HORIZON_TOLERANCE`, edges shorter than half a circle), so neither the products nor
-        // the final squared length leave the normal range of f64.
+        // the final squared length leave the normal range of f64; the argument's polynomials,
+        // cubic in the product's size, get a last rescale in `horizon_arcs`.
         (self.re, self.im) = if self.crossings == 0 {
             (pr, pi)
         } else {
