@@ -497,11 +497,18 @@ impl ClipFree {
         }
     }
 
+    /// Whether `a` is off the horizon by more than [`HORIZON_TOLERANCE`] (false for NaN and
+    /// infinite components too).
+    #[inline(always)]
+    fn off_horizon(a: Ray) -> bool {
+        a.v.z * a.v.z > Self::ON_HORIZON2 * a.len2
+    }
+
     /// Whether `a` is strictly above the horizon by more than [`HORIZON_TOLERANCE`] (false for
     /// NaN and infinite components too).
     #[inline(always)]
     fn clearly_above(a: Ray) -> bool {
-        a.v.z > 0.0 && a.v.z * a.v.z > Self::ON_HORIZON2 * a.len2
+        a.v.z > 0.0 && Self::off_horizon(a)
     }
 
     /// Adds the edge `a -> b` (vectors of any positive length); `None` when `a` lies on the
@@ -509,8 +516,7 @@ impl ClipFree {
     #[inline(always)]
     fn add_edge(&mut self, ra: Ray, rb: Ray, edge: impl EdgeTerm) -> Option<()> {
         let (a, b) = (ra.v, rb.v);
-        // Written so that NaN and infinite components also bail out.
-        if !(a.z * a.z > Self::ON_HORIZON2 * ra.len2) {
+        if !Self::off_horizon(ra) {
             return None;
         }
         self.edges += 1;
@@ -555,25 +561,14 @@ impl ClipFree {
         let (pr, pi) = (x.v.x, if up_a { -x.v.y } else { x.v.y });
         // The first factor starts the product (a multiplication by 1 would only lengthen the
         // chain of dependent operations up to the horizon's term). Only the argument matters,
-        // so the product so far is brought within 1e±60 by a factor before each further one
-        // (a multiplication; a division would sit on every crossing's path), while the next
-        // crossing point is still being computed. The factors lie within about 2^-240 to 2^64
-        // (images within 2^±92, see `CLIP_FREE_RANGE`, vertices off the horizon by
-        // `HORIZON_TOLERANCE`, edges shorter than half a circle), so neither the products nor
-        // the final squared length leave the normal range of f64; the argument's polynomials,
-        // cubic in the product's size, get a last rescale in `horizon_arcs`.
+        // so the product so far is brought within 1e±90 ([`in_range`]) before each further one.
+        // The factors lie within about 2^-240 to 2^64 (images within 2^±92, see
+        // `CLIP_FREE_RANGE`, vertices off the horizon by `HORIZON_TOLERANCE`, edges shorter than
+        // half a circle), so no product leaves the range of f64.
         (self.re, self.im) = if self.crossings == 0 {
             (pr, pi)
         } else {
-            let size = self.re.abs() + self.im.abs();
-            let k = if size > 1e60 {
-                1e-60
-            } else if size < 1e-60 {
-                1e60
-            } else {
-                1.0
-            };
-            let (re, im) = (self.re * k, self.im * k);
+            let (re, im) = in_range(self.re, self.im);
             (re * pr - im * pi, re * pi + im * pr)
         };
         self.crossings += 1;
@@ -586,23 +581,11 @@ impl ClipFree {
     /// least one crossing.
     #[inline(always)]
     fn horizon_arcs(&self, edge: impl EdgeTerm) -> f64 {
-        if self.im == 0.0 {
-            if self.re < 0.0 { PI } else { 0.0 }
-        } else {
-            // The rational argument is a ratio of polynomials of degree 3 in the product's size,
-            // which the scaling before each factor bounds only loosely (images of `2^-92` gave
-            // NaN here): brought within 1e±90 first, behind a predictable branch, so that the
-            // polynomials neither underflow nor overflow.
-            let (mut re, mut im) = (self.re, self.im);
-            let size = re.abs() + im.abs();
-            if !(1e-90..=1e90).contains(&size) {
-                (re, im) = rescale_product(re, im, size);
-            }
-            // One turn added to a negative argument (no `rem_euclid`, which would be a call to
-            // `fmod`).
-            let t = edge.arg(re, im);
-            if im < 0.0 { t + 2.0 * PI } else { t }
-        }
+        // The rational argument is a ratio of polynomials of degree 3 in the product's size:
+        // brought within 1e±90 first, as before each factor, so that they neither underflow nor
+        // overflow.
+        let (re, im) = in_range(self.re, self.im);
+        counter_clockwise_arc(re, im, || edge.arg(re, im))
     }
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
@@ -627,9 +610,36 @@ impl ClipFree {
     }
 }
 
-/// `(re, im)`, of magnitude sum `size` outside `1e±90`, scaled into it by a power of ten. Out of
-/// line, so that the common case costs a predicted branch and no select on the way to the
-/// horizon's term.
+/// `(re, im)` scaled by powers of ten until the sum of their magnitudes lies within `1e±90`,
+/// where the products and the rational argument of [`ClipFree`]'s crossings stay far from
+/// underflow and overflow. Only their argument matters. The common case, already in range, is a
+/// predicted branch with no select on the way to the horizon's term.
+#[inline(always)]
+fn in_range(re: f64, im: f64) -> (f64, f64) {
+    let size = re.abs() + im.abs();
+    if (1e-90..=1e90).contains(&size) {
+        (re, im)
+    } else {
+        rescale_product(re, im, size)
+    }
+}
+
+/// The arc from the x-axis counter-clockwise to `re + i im` (not both zero), in `[0, 2 pi)`:
+/// `short()`, its signed angle in `[-pi, pi]`, wrapped by a turn when negative (no `rem_euclid`,
+/// which would be a call to `fmod`); on the real axis, where an edge term cannot tell a half
+/// turn from none, decided by the sign of `re` without calling `short`.
+#[inline(always)]
+fn counter_clockwise_arc(re: f64, im: f64, short: impl FnOnce() -> f64) -> f64 {
+    if im == 0.0 {
+        if re < 0.0 { PI } else { 0.0 }
+    } else if im < 0.0 {
+        short() + 2.0 * PI
+    } else {
+        short()
+    }
+}
+
+/// [`in_range`] out of range: out of line, so that the common case stays small.
 #[cold]
 #[inline(never)]
 fn rescale_product(mut re: f64, mut im: f64, mut size: f64) -> (f64, f64) {
@@ -668,8 +678,7 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
         Ray::new(map(p2)),
         Ray::new(map(p3)),
     ];
-    // Every vertex off the horizon (written so that NaN and infinite images bail out).
-    let off = |r: Ray| r.v.z * r.v.z > ClipFree::ON_HORIZON2 * r.len2;
+    let off = ClipFree::off_horizon;
     if !(off(v[0]) & off(v[1]) & off(v[2]) & off(v[3])) {
         return None;
     }
@@ -677,13 +686,12 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
     let bit = |k: usize| usize::from(v[k].v.z > 0.0) << k;
     let up = bit(0) | bit(1) | bit(2) | bit(3);
     if up == 0b1111 {
-        // Every edge above the horizon (the same terms and sums as the paired loop).
-        let [t0, t1] = edge.term_pair([v[0], v[1]], [v[1], v[2]]);
-        let [t2, t3] = edge.term_pair([v[2], v[3]], [v[3], v[0]]);
-        let sum = (t0 + t1) + (t2 + t3);
-        let magnitude = (t0.abs() + t1.abs()) + (t2.abs() + t3.abs());
-        let horizon = ClipFree::horizon_if_all_above(sum, magnitude, 4)?;
-        return Some(integral_of_sum(sum + horizon));
+        // Every edge above the horizon: the paired loop's two steps.
+        let mut acc = ClipFree::new();
+        acc.edges = 4;
+        acc.add_above_pair([v[0], v[1]], [v[1], v[2]], edge);
+        acc.add_above_pair([v[2], v[3]], [v[3], v[0]], edge);
+        return acc.finish(edge);
     }
     if up == 0 {
         // Wholly below: the exact path decides whether the region surrounds the upper hemisphere.
@@ -751,19 +759,11 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
             (t0 + t1 + t2 + t3, edge.term(x_out, x_in))
         }
     };
-    // The arc runs counter-clockwise from the exit to the entry point, in [0, 2 pi): the edge
-    // term gives its signed short angle, so a negative one wraps by a turn, and for points on one
-    // line through the origin (where the term is zero) it is none or half a turn.
+    // The arc runs counter-clockwise from the exit to the entry point; `conj(x_out) x_in` is
+    // the crossings' product of the general loop.
     let (xo, xi) = (x_out.v, x_in.v);
-    let cz = xo.x * xi.y - xo.y * xi.x;
-    let horizon = if cz == 0.0 {
-        if xo.dot(xi) < 0.0 { PI } else { 0.0 }
-    } else if cz < 0.0 {
-        arc + 2.0 * PI
-    } else {
-        arc
-    };
-    Some(integral_of_sum(t + horizon))
+    let (re, im) = (xo.x * xi.x + xo.y * xi.y, xo.x * xi.y - xo.y * xi.x);
+    Some(integral_of_sum(t + counter_clockwise_arc(re, im, || arc)))
 }
 
 /// [`ring_sum`] for a single ring, with the edges between vertices clearly above the horizon (all
