@@ -252,30 +252,31 @@ pub struct LtcTable {
 #[repr(C, align(64))]
 pub(crate) struct Node([f64; 8]);
 
-/// Interleaves the generated per-channel arrays at compile time.
-const fn interleave<const N: usize>(channels: [&[f64; N]; CHANNELS]) -> [Node; N] {
+/// Interleaves the generated per-channel arrays at compile time, each into its channel's slot
+/// of the nodes (so the storage order follows [`Channel`]'s values, whatever the list's order).
+const fn interleave<const N: usize>(channels: [(Channel, &[f64; N]); CHANNELS]) -> [Node; N] {
     let mut out = [Node([0.0; 8]); N];
     let mut i = 0;
     while i < N {
-        let mut ch = 0;
-        while ch < CHANNELS {
-            out[i].0[ch] = channels[ch][i];
-            ch += 1;
+        let mut k = 0;
+        while k < CHANNELS {
+            let (ch, values) = channels[k];
+            out[i].0[ch as usize] = values[i];
+            k += 1;
         }
         i += 1;
     }
     out
 }
 
-/// The generated arrays in storage order ([`Channel`]'s values; checked by a test).
 static GGX_NODES: [Node; data::SIZE * data::SIZE] = interleave([
-    &data::M_INV_00,
-    &data::M_INV_20,
-    &data::M_INV_02,
-    &data::M_INV_22,
-    &data::NORM,
-    &data::ALBEDO,
-    &data::FRESNEL,
+    (Channel::M00, &data::M_INV_00),
+    (Channel::M02, &data::M_INV_02),
+    (Channel::M20, &data::M_INV_20),
+    (Channel::M22, &data::M_INV_22),
+    (Channel::Norm, &data::NORM),
+    (Channel::Albedo, &data::ALBEDO),
+    (Channel::Fresnel, &data::FRESNEL),
 ]);
 
 static GGX_TABLE: LtcTable = LtcTable {
