@@ -92,8 +92,13 @@ pub enum GeomError {
     /// all to the plane.
     NotInOpenHemisphere,
     /// The input is geometrically degenerate in a way the operation cannot resolve; the string
-    /// says how.
+    /// says how. This is a fault of the input: fix or drop it.
     Degenerate(&'static str),
+    /// The input is valid, but the computation met a configuration it cannot decide exactly
+    /// (near-degenerate within rounding) and declined to guess rather than return a possibly
+    /// wrong value; the string says where. Not a fault of the input: a renderer may fall back
+    /// (for example to the Monte Carlo reference, or a slightly moved shading point).
+    Undecidable(&'static str),
     /// (shade) A mesh triangle refers to a vertex index past the end of the vertex list.
     InvalidIndex {
         /// Index of the triangle.
@@ -184,6 +189,11 @@ impl fmt::Display for GeomError {
                  holds them all; split the input first",
             ),
             GeomError::Degenerate(why) => write!(f, "degenerate input: {why}"),
+            GeomError::Undecidable(where_) => write!(
+                f,
+                "valid input, but not decidable within rounding here ({where_}); \
+                 fall back to an approximate method for this query"
+            ),
             GeomError::InvalidIndex { triangle, index } => write!(
                 f,
                 "triangle {triangle} refers to vertex {index}, past the end of the vertex list"
@@ -204,6 +214,16 @@ impl fmt::Display for GeomError {
                  TriangleMesh (per-triangle method)"
             ),
         }
+    }
+}
+
+impl GeomError {
+    /// Whether the error is a numerical give-up on valid input ([`GeomError::Undecidable`])
+    /// rather than a fault of the input. A renderer skips or fixes bad input, and falls back to
+    /// an approximate method where this is `true`.
+    #[must_use]
+    pub fn is_undecidable(&self) -> bool {
+        matches!(self, GeomError::Undecidable(_))
     }
 }
 
