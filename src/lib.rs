@@ -7,6 +7,8 @@
 //! - [`sphere`]: spherical polygons: solid angle, gnomonic projection, ordering of silhouette edges,
 //!   hemisphere clipping.
 //! - [`ltc`]: linearly transformed cosines and polygon integrals.
+//! - [`sdf`]: signed-distance scenes and approximate area-light soft shadows in them (beside
+//!   the exact shading, for comparison).
 //! - [`shade`]: scenes of lights and occluders, and the radiance at a shading point.
 //!
 //! Scalars are `f64` and vectors are glam's `DVec2`/`DVec3`; glam is re-exported so that callers
@@ -34,6 +36,7 @@ mod error;
 pub mod ltc;
 pub(crate) mod math;
 pub mod planar;
+pub mod sdf;
 pub mod shade;
 pub mod sphere;
 
