@@ -11,7 +11,7 @@ mod gnomonic;
 mod order;
 mod polygon;
 pub(crate) mod predicates;
-mod sample; // [shade] solid-angle sampling of spherical triangles
+mod sample;
 mod wolfe;
 
 pub use boolean::MIN_CAP_COS;
@@ -19,5 +19,5 @@ pub use clip::HORIZON_TOLERANCE;
 pub use gnomonic::{Gnomonic, enclosing_cap};
 pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};
-pub use sample::SphericalTriangle; // [shade]
+pub use sample::{SAMPLE_TOLERANCE, SphericalTriangle};
 pub(crate) use wolfe::min_norm_point;
