@@ -12,6 +12,7 @@ mod order;
 mod polygon;
 pub(crate) mod predicates;
 mod sample;
+mod triangulate;
 mod wolfe;
 
 pub use boolean::MIN_CAP_COS;

@@ -111,16 +111,11 @@ impl SphericalTriangle {
                 ));
             }
         };
-        let ab = b - a;
-        let ac = c - a;
+        let (ab, ac) = (b - a, c - a);
         let (apb, apc) = (a + b, a + c);
-        // det(a, b, c) = det(a, b - a, c - a) = det(a, b + a, c + a): the shorter of each pair
-        // keeps relative precision for nearby and for nearly antipodal vertices alike. Positive
-        // (the sign is exact above), but it may round to zero for a sliver below rounding, which
-        // cannot be sampled meaningfully.
-        let det = a.dot(shorter(ab, apb).cross(shorter(ac, apc)));
-        let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-        let area = 2.0 * atan2(det, den);
+        // Positive (the sign is exact above), but it may round to zero for a sliver below
+        // rounding, which cannot be sampled meaningfully.
+        let area = signed_solid_angle(a, b, c);
         let Some(t) = tangent(a, ac, apc) else {
             return Err(GeomError::Degenerate(
                 "spherical triangle with a repeated vertex",
@@ -301,6 +296,30 @@ impl SphericalTriangle {
             0.0
         }
     }
+}
+
+/// Signed solid angle of the triangle `(a, b, c)` of unit vectors (Van Oosterom–Strackee,
+/// `tan(area / 2) = det(a, b, c) / (1 + a.b + b.c + c.a)`), with both terms kept to relative
+/// precision for nearby and for nearly antipodal vertices: `det(a, b, c) = det(a, b -+ a,
+/// c -+ a)` on the shorter of each pair, and each `x.y` as `1 - |x - y|^2 / 2` or
+/// `|x + y|^2 / 2 - 1`, whichever chord is shorter, with the constants added first. (The plain
+/// denominator cancels to rounding noise for a thin triangle from a point to a far, tiny edge,
+/// as in a fan from the antipode of a tiny polygon.)
+pub(crate) fn signed_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let det = a.dot(shorter(b - a, b + a).cross(shorter(c - a, c + a)));
+    let mut constant = 1.0;
+    let mut small = 0.0;
+    for (x, y) in [(a, b), (b, c), (c, a)] {
+        let (d, s) = ((x - y).length_squared(), (x + y).length_squared());
+        if d <= s {
+            constant += 1.0;
+            small -= 0.5 * d;
+        } else {
+            constant -= 1.0;
+            small += 0.5 * s;
+        }
+    }
+    2.0 * atan2(det, constant + small)
 }
 
 /// The shorter of two vectors (the first on a tie).
