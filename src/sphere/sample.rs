@@ -4,6 +4,9 @@
 
 use glam::{DVec2, DVec3};
 
+use alloc::vec::Vec;
+
+use super::polygon::SphericalPolygon;
 use super::predicates::{normalize_any, orient};
 use crate::GeomError;
 use crate::math::{atan2, sin_cos, sqrt};
@@ -229,17 +232,10 @@ impl SphericalTriangle {
     #[must_use]
     pub fn inverse(&self, dir: DVec3) -> Option<DVec2> {
         let p = normalize_any(dir)?;
-        let tol = SAMPLE_TOLERANCE * self.size + 4.0 * f64::EPSILON;
-        let (a, b, c) = (self.a, self.b, self.c);
-        for (x, y) in [(a, b), (b, c), (c, a)] {
-            // Signed distance (sine) of p to the plane of x -> y: det(x, y, p) = det(x, w, p - x)
-            // with w the shorter of y -+ x, all small for a small or nearly antipodal edge.
-            let w = shorter(y - x, y + x);
-            let d = x.dot(w.cross(p - x)) / x.cross(w).length();
-            if !(d >= -tol) {
-                return None;
-            }
+        if !self.covers(p) {
+            return None;
         }
+        let (a, b) = (self.a, self.b);
         let bp = p - b;
         let nb = b.cross(shorter(bp, p + b));
         // n . A and n . T for the plane through B and p.
@@ -286,14 +282,115 @@ impl SphericalTriangle {
         Some(DVec2::new(u1, u2))
     }
 
+    /// Whether the unit vector `p` lies in the triangle or outside it by at most
+    /// [`SAMPLE_TOLERANCE`] of its size plus `4 eps`.
+    pub(crate) fn covers(&self, p: DVec3) -> bool {
+        let tol = SAMPLE_TOLERANCE * self.size + 4.0 * f64::EPSILON;
+        let (a, b, c) = (self.a, self.b, self.c);
+        [(a, b), (b, c), (c, a)].into_iter().all(|(x, y)| {
+            // Signed distance (sine) of p to the plane of x -> y: det(x, y, p) = det(x, w, p - x)
+            // with w the shorter of y -+ x, all small for a small or nearly antipodal edge.
+            let w = shorter(y - x, y + x);
+            let d = x.dot(w.cross(p - x)) / x.cross(w).length();
+            d >= -tol
+        })
+    }
+
     /// The density of [`SphericalTriangle::sample`] at `dir`: `1 / solid_angle` when
     /// [`SphericalTriangle::inverse`] accepts `dir`, else `0`.
     #[must_use]
     pub fn pdf(&self, dir: DVec3) -> f64 {
-        if self.inverse(dir).is_some() {
+        if normalize_any(dir).is_some_and(|p| self.covers(p)) {
             1.0 / self.area
         } else {
             0.0
+        }
+    }
+}
+
+/// Uniform sampling of a spherical polygon by solid angle: its triangulation
+/// ([`SphericalPolygon::triangulate`]) with a triangle chosen in proportion to its solid angle
+/// (binary search of the cumulative areas), then sampled by [`SphericalTriangle::sample`].
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::{DVec2, DVec3};
+/// use arealight::sphere::{PolygonSampler, SphericalPolygon};
+/// let l = SphericalPolygon::new(vec![vec![
+///     DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.2, 0.0, 1.0), DVec3::new(0.2, 0.1, 1.0),
+///     DVec3::new(0.1, 0.1, 1.0), DVec3::new(0.1, 0.2, 1.0), DVec3::new(0.0, 0.2, 1.0),
+/// ]])?;
+/// let s = PolygonSampler::new(&l)?;
+/// let w = s.sample(DVec2::new(0.4, 0.9));
+/// assert!(l.contains(w));
+/// assert_eq!(s.pdf(w), 1.0 / s.solid_angle());
+/// assert_eq!(s.pdf(-w), 0.0);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct PolygonSampler {
+    tris: Vec<SphericalTriangle>,
+    /// Cumulative solid angles: `cdf[k]` is the sum over triangles `0..=k`.
+    cdf: Vec<f64>,
+}
+
+impl PolygonSampler {
+    /// Triangulates `poly` for sampling.
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::Degenerate`] for the empty region (nothing to sample); the errors of
+    /// [`SphericalPolygon::triangulate`].
+    pub fn new(poly: &SphericalPolygon) -> Result<Self, GeomError> {
+        let tris = poly.triangulate()?;
+        let mut cdf = Vec::with_capacity(tris.len());
+        let mut total = 0.0;
+        for t in &tris {
+            total += t.solid_angle();
+            cdf.push(total);
+        }
+        if tris.is_empty() {
+            return Err(GeomError::Degenerate("the empty region cannot be sampled"));
+        }
+        Ok(PolygonSampler { tris, cdf })
+    }
+
+    /// The triangles sampled from (see [`SphericalPolygon::triangulate`]).
+    #[must_use]
+    pub fn triangles(&self) -> &[SphericalTriangle] {
+        &self.tris
+    }
+
+    /// The polygon's solid angle: the sum of its triangles'.
+    #[must_use]
+    pub fn solid_angle(&self) -> f64 {
+        self.cdf[self.cdf.len() - 1]
+    }
+
+    /// A direction in the polygon from two numbers in `[0, 1]` (clamped, NaN as `0`), uniform in
+    /// solid angle over uniform `u`: `u.x` picks the triangle by cumulative solid angle and,
+    /// rescaled to that triangle's share, is its first coordinate.
+    #[must_use]
+    pub fn sample(&self, u: DVec2) -> DVec3 {
+        let total = self.solid_angle();
+        let x = clamp01(u.x) * total;
+        let k = self
+            .cdf
+            .partition_point(|&c| c <= x)
+            .min(self.cdf.len() - 1);
+        let lo = if k == 0 { 0.0 } else { self.cdf[k - 1] };
+        let w = self.tris[k].solid_angle();
+        self.tris[k].sample(DVec2::new((x - lo) / w, u.y))
+    }
+
+    /// `1 / solid_angle` for a direction in the polygon (one of its triangles covers it, to
+    /// [`SAMPLE_TOLERANCE`] of the triangle's size), else `0` (also for non-directions).
+    #[must_use]
+    pub fn pdf(&self, dir: DVec3) -> f64 {
+        match normalize_any(dir) {
+            Some(p) if self.tris.iter().any(|t| t.covers(p)) => 1.0 / self.solid_angle(),
+            _ => 0.0,
         }
     }
 }
