@@ -385,3 +385,42 @@ fn random_polygons_with_holes() {
     }
     assert!(done >= 20, "{done}");
 }
+
+/// Fuzz crash (sphere_triangulate): the complement of a triangle whose enclosing cap is fixed by
+/// two of its vertices, so the cap's center lies on the hull's edge and the fan from its
+/// antipode made a triangle within rounding of a hemisphere, where sampling is undefined; its
+/// samples landed 1e-2 outside. Now the fan's apex is the antipode of the hull's mean direction
+/// and triangles within 1e-6 of a hemisphere fail the certificate.
+#[test]
+fn fuzz_complement_with_cap_center_on_the_hull() {
+    let p = poly(vec![vec![
+        DVec3::new(0.3432942662006448, 0.9390107869605873, 0.020193780364743813),
+        DVec3::new(
+            0.058696727088374916,
+            0.9978443605023736,
+            -0.029348363544187458,
+        ),
+        DVec3::new(1.0, 0.0, 0.0),
+    ]]);
+    run("fuzz: cap center on the hull", &p);
+    for t in p.triangulate().unwrap() {
+        assert!(t.solid_angle() < 2.0 * PI - 1e-6);
+    }
+    let s = arealight::sphere::PolygonSampler::new(&p).unwrap();
+    let edges: Vec<(DVec3, DVec3)> = p
+        .rings()
+        .flat_map(|r| (0..r.len()).map(move |i| (r[i], r[(i + 1) % r.len()])))
+        .collect();
+    for k in 0..400 {
+        let u = arealight::glam::DVec2::new(
+            (k % 20) as f64 / 20.0 + 0.01,
+            (k / 20) as f64 / 20.0 + 0.01,
+        );
+        let d = s.sample(u);
+        assert_ne!(
+            check::exact_contains(&p, d, &edges),
+            Some(false),
+            "{u}: {d}"
+        );
+    }
+}

@@ -20,6 +20,11 @@ use crate::planar::constrained_delaunay;
 /// in two by a coordinate plane, recursively.
 const CHART_COS: f64 = 1e-3;
 
+/// Smallest gap between a triangle's solid angle and a hemisphere's that a triangulation
+/// accepts: [`SphericalTriangle::sample`] is uniform and inside to that gap (its tests go to
+/// 4e-8); a triangle closer to a hemisphere than rounding cannot even be measured.
+const HEMISPHERE_MARGIN: f64 = 1e-6;
+
 impl SphericalPolygon {
     /// Splits the region into spherical triangles with minor-arc edges, positive orientation,
     /// non-zero area and disjoint interiors, whose union is the region.
@@ -35,7 +40,7 @@ impl SphericalPolygon {
     ///    projected vertices with the edges as constraints, restricted to the region (labels
     ///    spread from the edges' sides), is a spherical triangulation; no extra vertex, or, when
     ///    the region contains the far side of the chart (a complement), one: the antipode of the
-    ///    center, fanned over the projected convex hull;
+    ///    hull vertices' mean direction, fanned over the projected convex hull;
     /// 3. a single ring star-shaped about a point (its area vector, or an axis): the fan from
     ///    that point (one extra vertex);
     /// 4. otherwise the region is cut in two by the coordinate plane `x = 0` (exact hemisphere
@@ -46,12 +51,13 @@ impl SphericalPolygon {
     ///    that reach this step.
     ///
     /// Every candidate is certified with exact predicates before it is used: each triangle is
-    /// positively oriented (`orient3d`), every directed edge of the triangles is either an edge
-    /// of the polygon or cancelled by its reverse, and the areas add up to the region's within
-    /// `2 pi`. The first two make the number of triangles over any direction off the edges equal
-    /// to the region's indicator plus a constant `k`, and the third makes `k = 0`: the triangles
-    /// tile the region exactly (for step 4, each half exactly; the halves tile the region up to
-    /// the rounding of the crossing points the clipping computes). Deterministic; no sampling.
+    /// positively oriented (`orient3d`) and at least 1e-6 sr short of a hemisphere, every
+    /// directed edge of the triangles is either an edge of the polygon or cancelled by its
+    /// reverse, and the areas add up to the region's within `2 pi`. The first two make the
+    /// number of triangles over any direction off the edges equal to the region's indicator
+    /// plus a constant `k`, and the third makes `k = 0`: the triangles tile the region exactly
+    /// (for step 4, each half exactly; the halves tile the region up to the rounding of the
+    /// crossing points the clipping computes). Deterministic; no sampling.
     ///
     /// Triangles certified positive whose area rounds to zero (slivers below rounding between
     /// nearly collinear vertices) are left out: they cover nothing beyond rounding of an edge.
@@ -321,17 +327,28 @@ fn chart(ix: &mut Indexed, c: DVec3, complement: bool) -> Result<Vec<[u32; 3]>, 
         .map(|(t, _)| *t)
         .collect();
     if complement {
-        let apex = ix.verts.len() as u32;
-        ix.verts.push(-c);
         let mut directed: Vec<[u32; 2]> = tris
             .iter()
             .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
             .collect();
         directed.sort_unstable();
-        for &[i, j] in &directed {
-            if directed.binary_search(&[j, i]).is_err() {
-                out.push([apex, j, i]);
-            }
+        let hull: Vec<[u32; 2]> = directed
+            .iter()
+            .filter(|&&[i, j]| directed.binary_search(&[j, i]).is_err())
+            .copied()
+            .collect();
+        // The apex: the antipode of the hull vertices' mean direction, whose image lies strictly
+        // inside the projected hull (a positive combination of its vertices), so every fan
+        // triangle is proper. The cap's center itself can lie on the hull's boundary (a cap
+        // fixed by two vertices), which makes hemisphere-sized slivers.
+        let mean: DVec3 = hull.iter().map(|e| ix.verts[e[0] as usize]).sum();
+        let apex_dir = normalize_any(-mean).ok_or(GeomError::Undecidable(
+            "degenerate convex hull in the chart",
+        ))?;
+        let apex = ix.verts.len() as u32;
+        ix.verts.push(apex_dir);
+        for &[i, j] in &hull {
+            out.push([apex, j, i]);
         }
     }
     Ok(out)
@@ -401,7 +418,8 @@ fn label(tris: &[[u32; 3]], edges: &[[u32; 2]]) -> Result<Vec<bool>, GeomError> 
 }
 
 /// Whether `tris` tiles exactly the region of solid angle `area` bounded by the directed
-/// `edges` (see [`SphericalPolygon::triangulate`]): every triangle positively oriented (exact),
+/// `edges` (see [`SphericalPolygon::triangulate`]): every triangle positively oriented (exact)
+/// and at least [`HEMISPHERE_MARGIN`] short of a hemisphere,
 /// every directed triangle edge a polygon edge or cancelled by its reverse, every polygon edge
 /// used, and the areas adding up to `area` within `2 pi`.
 fn certify(verts: &[DVec3], tris: &[[u32; 3]], edges: &[[u32; 2]], area: f64) -> bool {
@@ -411,7 +429,13 @@ fn certify(verts: &[DVec3], tris: &[[u32; 3]], edges: &[[u32; 2]], area: f64) ->
         if orient(a, b, c) != 1 {
             return false;
         }
-        sum += triangle_solid_angle(a, b, c);
+        let w = triangle_solid_angle(a, b, c);
+        // Triangles within HEMISPHERE_MARGIN of a hemisphere (three vertices nearly on a great
+        // circle) are valid but beyond what sampling resolves; another method splits them.
+        if !(w <= 2.0 * PI - HEMISPHERE_MARGIN) {
+            return false;
+        }
+        sum += w;
     }
     if !((sum - area).abs() < 2.0 * PI) {
         return false;
