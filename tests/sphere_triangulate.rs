@@ -424,3 +424,28 @@ fn fuzz_complement_with_cap_center_on_the_hull() {
         );
     }
 }
+
+/// Fuzz failure (sphere_triangulate): a sliver triangle of 3.4e-4 sr between vertices 80 to 170
+/// degrees apart, whose area two correct formulas give 1.6e-12 apart (relative): the checker
+/// now allows `8 eps` times the squared edge chords on top of 1e-12 relative.
+#[test]
+fn fuzz_sliver_area_resolution() {
+    let p = poly(vec![vec![
+        DVec3::new(
+            -0.7470180736252172,
+            -0.1365516908777279,
+            -0.6506286447703504,
+        ),
+        DVec3::new(
+            0.8204752017956706,
+            -0.006725206572095661,
+            0.5716425586281312,
+        ),
+        DVec3::new(
+            -0.08804509063256238,
+            -0.7043607250604991,
+            -0.7043607250604991,
+        ),
+    ]]);
+    run("fuzz: sliver", &p);
+}
