@@ -80,6 +80,7 @@ mod boolean;
 mod contour;
 mod predicates;
 mod shape;
+mod triangulate;
 
 pub use boolean::intersect::{MAX_PASSES, SNAP_REL};
 pub use boolean::label::VertexClass;
@@ -91,3 +92,4 @@ pub use boolean::{
 pub use contour::Contour;
 pub use predicates::MAX_COORD;
 pub use shape::Shape;
+pub(crate) use triangulate::constrained_delaunay;
