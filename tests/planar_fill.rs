@@ -629,7 +629,7 @@ fn few_ulp_slivers_are_dropped() {
         DVec2::new(1.0, 1.0),
         DVec2::new(0.0, 1.0),
     ];
-    let s = Shape::with_fill_rule(vec![spiked], FillRule::NonZero).unwrap();
+    let s = Shape::with_fill_rule(vec![spiked.clone()], FillRule::NonZero).unwrap();
     s.validate().unwrap();
     assert_eq!(s.area(), 1.0, "{s:?}");
     // The strict constructor keeps the sliver ring; the first operation drops it, the union
@@ -653,6 +653,27 @@ fn few_ulp_slivers_are_dropped() {
         r.validate().unwrap();
         assert_eq!(r.contours().count(), 1, "{op:?}: {r:?}");
         assert_eq!(r.area(), 1.0);
+    }
+    // A spike two vertices of which are closer than the snapping distance (no sliver loop:
+    // only welding removes it).
+    let strict_spiked = Shape::new(vec![spiked]).unwrap();
+    assert_eq!(strict_spiked.vertex_count(), 8);
+    for op in [BoolOp::Union, BoolOp::Difference, BoolOp::Xor] {
+        let r = boolean(&strict_spiked, &Shape::empty(), op).unwrap();
+        r.validate().unwrap();
+        assert_eq!(r.area(), 1.0, "{op:?}: {r:?}");
+    }
+    // A thin triangle whose vertices are far apart (only the sliver test catches it).
+    let thin = vec![
+        DVec2::new(2.0, 0.0),
+        DVec2::new(3.0, 0.0),
+        DVec2::new(2.5, e),
+    ];
+    let strict_thin = Shape::new(vec![rings("0:0, 1:0, 1:1, 0:1")[0].clone(), thin]).unwrap();
+    for op in [BoolOp::Union, BoolOp::Difference, BoolOp::Xor] {
+        let r = boolean(&strict_thin, &Shape::empty(), op).unwrap();
+        r.validate().unwrap();
+        assert_eq!(r.contours().count(), 1, "{op:?}: {r:?}");
     }
     // Disjoint bounding boxes take a shortcut too.
     let far = shape("10:10, 11:10, 11:11");
