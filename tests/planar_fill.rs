@@ -452,6 +452,20 @@ proptest! {
     }
 }
 
+proptest! {
+    // A quarter of the cases: each resolves a few hundred edges under four rules.
+    #![proptest_config(ProptestConfig { cases: config().cases.div_ceil(4), ..config() })]
+
+    #[test]
+    fn many_edges(rings in prop::collection::vec(prop_oneof![float_ring(12), star_ring(12, 1.0)], 4..=8), grid in grid_soup()) {
+        // Enough edges (over 32) for the splitting phase's grid of cells, with long edges
+        // (random float rings) and short ones (stars) together.
+        let mut rings = rings;
+        rings.extend(grid.into_iter().map(|r| r.into_iter().map(|p| p * 0.25).collect()));
+        check_soup(&rings, true)?;
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input and hand-checked cases
 
@@ -789,4 +803,49 @@ fn repeated_closing_point_is_dropped_once() {
             .area(),
         1.0
     );
+}
+
+#[test]
+fn benchmark_stars_resolve_like_the_references() {
+    // The self-intersecting stars of `benches/planar.rs`, at the bench's sizes.
+    for n in [16, 64, 256, 1024] {
+        let ring = self_intersecting_star(n);
+        assert!(
+            Shape::new(vec![ring.clone()]).is_err(),
+            "n = {n}: the star is simple"
+        );
+        let s = Shape::with_fill_rule(vec![ring.clone()], FillRule::NonZero).unwrap();
+        let eo = Shape::with_fill_rule(vec![ring.clone()], FillRule::EvenOdd).unwrap();
+        println!(
+            "n = {n}: non-zero {} contours, {} vertices; even-odd {} contours, {} vertices",
+            s.contours().count(),
+            s.vertex_count(),
+            eo.contours().count(),
+            eo.vertex_count()
+        );
+        s.validate().unwrap();
+        let sd = sym_diff_io(&s, std::slice::from_ref(&ring), FillRule::NonZero);
+        assert!(sd <= 1e-9, "n = {n}: symmetric difference {sd}");
+        let ca = clipper_resolve_area(std::slice::from_ref(&ring), FillRule::NonZero);
+        assert!(
+            (ca - s.area()).abs() <= 1e-7,
+            "n = {n}: {} vs clipper2 {ca}",
+            s.area()
+        );
+        check_samples(&[ring], FillRule::NonZero, &s).unwrap();
+        // The simple stars of the boolean benches need no resolving; above 128 vertices they
+        // are resolved all the same, to the region `Shape::new` reads.
+        let simple = bench_polygon(n, DVec2::ZERO, 0.0, true);
+        let strict = Shape::new(vec![simple.clone()]).unwrap();
+        let filled = Shape::with_fill_rule(vec![simple], FillRule::NonZero).unwrap();
+        filled.validate().unwrap();
+        assert_eq!(filled.vertex_count(), n);
+        let d = ioverlay_area(&to_paths(&strict).overlay_as::<i64>(
+            &to_paths(&filled),
+            OverlayRule::Xor,
+            i_overlay::core::fill_rule::FillRule::EvenOdd,
+        ));
+        assert!(d <= 1e-12, "n = {n}: {d}");
+        check_all(&strict, &filled, 1e-9).unwrap();
+    }
 }
