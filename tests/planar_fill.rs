@@ -457,6 +457,27 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: config().cases.div_ceil(4), ..config() })]
 
     #[test]
+    fn many_separate_parts(parts in prop::collection::vec((star_ring(6, 4.0), 0.05f64..0.6, any::<bool>(), any::<bool>()), 9..=24)) {
+        // More than eight connected parts, nested, overlapping or apart, some self-intersecting:
+        // their starting windings are counted through the band index.
+        let rings: Vec<Vec<DVec2>> = parts
+            .into_iter()
+            .map(|(r, k, rev, bow)| {
+                let c = r.iter().copied().sum::<DVec2>() / r.len() as f64;
+                let mut r: Vec<DVec2> = r.into_iter().map(|p| c + (p - c) * k).collect();
+                if bow && r.len() >= 4 {
+                    r.swap(1, 2);
+                }
+                if rev {
+                    r.reverse();
+                }
+                r
+            })
+            .collect();
+        check_soup(&rings, true)?;
+    }
+
+    #[test]
     fn many_edges(rings in prop::collection::vec(prop_oneof![float_ring(12), star_ring(12, 1.0)], 4..=8), grid in grid_soup()) {
         // Enough edges (over 32) for the splitting phase's grid of cells, with long edges
         // (random float rings) and short ones (stars) together.

@@ -504,6 +504,10 @@ fn resolve(rings: Vec<Vec<DVec2>>, rule: FillRule, scale: f64) -> Result<Shape, 
         "winding numbers of the split rings contradict each other; the rings are too close to \
          degenerate for f64",
     );
+    // Each part's start costs a pass over the segments; many parts (a multipolygon of
+    // thousands of separate rings) use an index of the segments by rows of y instead.
+    let mut parts = 0usize;
+    let mut rows: Option<Rows> = None;
     for &v0 in &order {
         let h0 = out[first[v0 as usize] as usize] as usize;
         if right[h0] != UNKNOWN {
@@ -512,7 +516,15 @@ fn resolve(rings: Vec<Vec<DVec2>>, rule: FillRule, scale: f64) -> Result<Shape, 
         // All of this part lies at x >= x0 (and above the node where x = x0), so the wedge
         // containing the direction (-1, 0) at `v0` is the one right of its first half-edge, and
         // a ray from `v0` to the left meets only other parts.
-        right[h0] = winding_left_of(pts, &segs, pts[v0 as usize]);
+        parts += 1;
+        if parts == ROWS_AFTER {
+            rows = Some(Rows::new(pts, &segs));
+        }
+        let p0 = pts[v0 as usize];
+        right[h0] = match &rows {
+            Some(rows) => winding_left_of(pts, rows.near(&segs, p0), p0),
+            None => winding_left_of(pts, segs.iter().copied(), p0),
+        };
         queue.clear();
         queue.push(h0 as u32);
         while let Some(h) = queue.pop() {
@@ -599,14 +611,105 @@ fn angle_cmp(p: DVec2, a: DVec2, b: DVec2) -> core::cmp::Ordering {
     }
 }
 
+/// From this many connected parts on, their starting windings are counted through [`Rows`].
+const ROWS_AFTER: usize = 8;
+
+/// Segments by horizontal bands: band `k` lists every segment whose y-range meets it, so the
+/// segments that can cross the horizontal line through a point are among those of the point's
+/// band. Bands come from a monotone map of y, so a segment whose y-range contains `p.y` is
+/// always listed in `p`'s band; segments spanning many bands are kept in one list for all.
+struct Rows {
+    lo: f64,
+    k: f64,
+    count: usize,
+    first: Vec<u32>,
+    members: Vec<u32>,
+    tall: Vec<u32>,
+}
+
+impl Rows {
+    fn new(pts: &[DVec2], segs: &[(u32, u32, i64)]) -> Rows {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for &(u, v, _) in segs {
+            for y in [pts[u as usize].y, pts[v as usize].y] {
+                lo = lo.min(y);
+                hi = hi.max(y);
+            }
+        }
+        let count = (crate::math::sqrt(segs.len() as f64) as usize).max(1);
+        let k = if hi > lo {
+            count as f64 / (hi - lo)
+        } else {
+            0.0
+        };
+        let band = |y: f64| (((y - lo) * k) as usize).min(count - 1);
+        let span = |s: &(u32, u32, i64)| {
+            let (a, b) = (pts[s.0 as usize].y, pts[s.1 as usize].y);
+            (band(a.min(b)), band(a.max(b)))
+        };
+        // Segments spanning a quarter of the bands or more are checked for every point.
+        let tall_bands = (count / 4).max(2);
+        let mut first: Vec<u32> = alloc::vec![0; count + 1];
+        let mut tall = Vec::new();
+        for (i, s) in segs.iter().enumerate() {
+            let (b0, b1) = span(s);
+            if b1 - b0 >= tall_bands {
+                tall.push(i as u32);
+                continue;
+            }
+            for b in b0..=b1 {
+                first[b + 1] += 1;
+            }
+        }
+        for b in 1..first.len() {
+            first[b] += first[b - 1];
+        }
+        let mut fill = first.clone();
+        let mut members: Vec<u32> = alloc::vec![0; first[count] as usize];
+        for (i, s) in segs.iter().enumerate() {
+            let (b0, b1) = span(s);
+            if b1 - b0 >= tall_bands {
+                continue;
+            }
+            for b in b0..=b1 {
+                members[fill[b] as usize] = i as u32;
+                fill[b] += 1;
+            }
+        }
+        Rows {
+            lo,
+            k,
+            count,
+            first,
+            members,
+            tall,
+        }
+    }
+
+    /// The segments that may cross the horizontal line through `p` (a superset).
+    fn near<'a>(
+        &'a self,
+        segs: &'a [(u32, u32, i64)],
+        p: DVec2,
+    ) -> impl Iterator<Item = (u32, u32, i64)> + 'a {
+        let b = (((p.y - self.lo) * self.k) as usize).min(self.count - 1);
+        let listed = &self.members[self.first[b] as usize..self.first[b + 1] as usize];
+        listed
+            .iter()
+            .chain(self.tall.iter())
+            .map(move |&i| segs[i as usize])
+    }
+}
+
 /// The winding number of the points just left of `p` with respect to the segments
 /// `(from, to, multiplicity)`: the signed count of segments crossing the ray from `p` to the
 /// left, with the half-open rule (a segment counts when its lower end is at or below `p` and its
 /// upper end above) and exact sides. Segments through `p` itself never count: their crossing with
-/// the ray is `p`, where the side test is zero.
-fn winding_left_of(pts: &[DVec2], segs: &[(u32, u32, i64)], p: DVec2) -> i64 {
+/// the ray is `p`, where the side test is zero. `segs` may hold any superset of the segments
+/// that cross the horizontal line through `p`.
+fn winding_left_of(pts: &[DVec2], segs: impl Iterator<Item = (u32, u32, i64)>, p: DVec2) -> i64 {
     let mut w = 0;
-    for &(u, v, m) in segs {
+    for (u, v, m) in segs {
         let (a, b) = (pts[u as usize], pts[v as usize]);
         if a.x >= p.x && b.x >= p.x {
             continue;
@@ -660,14 +763,14 @@ mod tests {
         // A counter-clockwise square as segments from lower to higher node index.
         let pts = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
         let segs = [(0, 1, 1), (1, 2, 1), (2, 3, 1), (0, 3, -1)];
-        assert_eq!(winding_left_of(&pts, &segs, v(1.0, 1.0)), 1);
-        assert_eq!(winding_left_of(&pts, &segs, v(3.0, 1.0)), 0);
-        assert_eq!(winding_left_of(&pts, &segs, v(-1.0, 1.0)), 0);
+        assert_eq!(winding_left_of(&pts, segs.iter().copied(), v(1.0, 1.0)), 1);
+        assert_eq!(winding_left_of(&pts, segs.iter().copied(), v(3.0, 1.0)), 0);
+        assert_eq!(winding_left_of(&pts, segs.iter().copied(), v(-1.0, 1.0)), 0);
         // At the height of a vertex: the half-open rule counts the left edge once.
-        assert_eq!(winding_left_of(&pts, &segs, v(1.0, 0.0)), 1);
-        assert_eq!(winding_left_of(&pts, &segs, v(1.0, 2.0)), 0);
+        assert_eq!(winding_left_of(&pts, segs.iter().copied(), v(1.0, 0.0)), 1);
+        assert_eq!(winding_left_of(&pts, segs.iter().copied(), v(1.0, 2.0)), 0);
         let rev: Vec<(u32, u32, i64)> = segs.iter().map(|&(a, b, m)| (a, b, -m)).collect();
-        assert_eq!(winding_left_of(&pts, &rev, v(1.0, 1.0)), -1);
+        assert_eq!(winding_left_of(&pts, rev.iter().copied(), v(1.0, 1.0)), -1);
     }
 
     #[test]
