@@ -78,6 +78,18 @@ pub enum GeomError {
         /// The largest supported magnitude.
         limit: f64,
     },
+    /// A coordinate of a vertex lies outside the supported range; the message names the vertex
+    /// and the range.
+    CoordinateOutOfRange {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Index of the vertex within the ring.
+        vertex: usize,
+        /// The offending magnitude.
+        value: f64,
+        /// The largest supported magnitude.
+        limit: f64,
+    },
     /// Silhouette edges do not close into loops: an endpoint is used by only one edge.
     OpenChain {
         /// Index (in the input slice) of an edge whose end has no successor.
@@ -175,6 +187,16 @@ impl fmt::Display for GeomError {
             GeomError::OutOfRange { what, value, limit } => write!(
                 f,
                 "{what} is {value:e}, outside the supported range (magnitude at most {limit:e})"
+            ),
+            GeomError::CoordinateOutOfRange {
+                ring,
+                vertex,
+                value,
+                limit,
+            } => write!(
+                f,
+                "a coordinate of vertex {vertex} in ring {ring} has magnitude {value:e}, outside \
+                 the supported range (at most {limit:e}); scale the input down"
             ),
             GeomError::OpenChain { edge } => write!(
                 f,

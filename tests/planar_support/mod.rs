@@ -228,3 +228,17 @@ pub fn bench_polygon(n: usize, center: DVec2, phase: f64, star: bool) -> Vec<DVe
         })
         .collect()
 }
+
+/// A star ring of `n` vertices (`n` even, not a multiple of 3) that crosses itself: the star
+/// polygon {n/3} (vertex `j` at angle `3 * 2 pi j / n`, going three times around the centre)
+/// with radii alternating 1 and 0.6, so that each edge crosses the edges of the neighbouring
+/// turns (a few crossings per vertex) and the faces wind up to three times.
+pub fn self_intersecting_star(n: usize) -> Vec<DVec2> {
+    (0..n)
+        .map(|j| {
+            let t = std::f64::consts::TAU * (3 * j) as f64 / n as f64;
+            let r = if j % 2 == 0 { 1.0 } else { 0.6 };
+            DVec2::new(t.cos(), t.sin()) * r
+        })
+        .collect()
+}
