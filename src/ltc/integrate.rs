@@ -176,14 +176,71 @@ pub fn ggx_polygon_integral(
     }
     let l = super::lookup(cos_theta_v, alpha)?;
     // The tables' LTCs are fitted as clipped to the shading horizon and renormalized (`norm`),
-    // so the light is clipped there first; the clip is skipped when nothing reaches below.
-    let above = poly.rings().flatten().all(|v| v.z > HORIZON_TOLERANCE) && !poly.is_full();
-    let integral = if above {
+    // so the light is clipped there first; the clip is skipped only for regions shown to lie in
+    // the upper hemisphere. Vertices above the horizon are not enough: a region may still
+    // contain the whole lower hemisphere (the complement of a light above the point).
+    let integral = if inside_upper_hemisphere(poly) {
         ltc_integral(poly, l.m_inv)?
     } else {
         ltc_integral(&poly.clip_to_hemisphere(DVec3::Z), l.m_inv)?
     };
     Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
+}
+
+/// Whether the region certainly lies in the open upper hemisphere: `false` when it does not or
+/// when that is not certain (and for the empty region, which needs no decision).
+///
+/// Every vertex must lie above the horizon by more than [`HORIZON_TOLERANCE`]: then no edge (a
+/// minor arc, a positive combination of its endpoints) meets the closed lower hemisphere, which
+/// is therefore wholly inside or wholly outside the region. The gnomonic map about `+z`,
+/// `p -> (x / z, y / z)`, takes the rings to plane polygons with the region on their left; the
+/// sum of their signed areas is the area of the region's image when that image is bounded (the
+/// region avoids the lower hemisphere), and minus the area of the bounded part it leaves out
+/// otherwise. So the sign decides, when it exceeds the rounding bound accumulated alongside.
+/// Each ring's area is taken about its own first vertex, so that a small ring far from the
+/// zenith keeps its relative precision: its terms are of the ring's size squared, not of its
+/// distance from the zenith times its size.
+///
+/// Linear in the vertices with one division per coordinate; an undecided sign (a region about
+/// `1e-15` of its distance from the zenith across, or less) answers `false`, and the caller
+/// clips, which is right either way.
+fn inside_upper_hemisphere(poly: &SphericalPolygon) -> bool {
+    if poly.is_full() {
+        return false;
+    }
+    let project = |v: DVec3| (v.z > HORIZON_TOLERANCE).then(|| (v.x / v.z, v.y / v.z));
+    // The signed area (twice), a bound on the error of its terms, and the sum of their sizes.
+    let (mut area, mut bound, mut size) = (0.0, 0.0, 0.0);
+    for ring in poly.rings() {
+        let Some((&first, rest)) = ring.split_first() else {
+            continue;
+        };
+        let Some(o) = project(first) else {
+            return false;
+        };
+        let size_o = o.0.abs() + o.1.abs();
+        // Offsets from the first vertex (the first offset is zero, and so is its term), each
+        // with a bound on its error per coordinate: a rounded quotient and a rounded difference,
+        // below `eps (|p| + |o|)`; doubled.
+        let (mut d, mut err_d, mut size_d) = ((0.0, 0.0), 0.0, 0.0);
+        for &v in rest {
+            let Some(p) = project(v) else {
+                return false;
+            };
+            let e = (p.0 - o.0, p.1 - o.1);
+            let err_e = 2.0 * f64::EPSILON * (p.0.abs() + p.1.abs() + size_o);
+            let size_e = e.0.abs() + e.1.abs();
+            area += d.0 * e.1 - d.1 * e.0;
+            // The inputs' errors times the other factor, and the products' and the difference's
+            // own rounding (doubled).
+            bound += size_d * err_e + size_e * err_d + 4.0 * f64::EPSILON * size_d * size_e;
+            size += size_d * size_e;
+            (d, err_d, size_d) = (e, err_e, size_e);
+        }
+    }
+    // The summation's rounding: below `n eps` times the sum of the terms' magnitudes.
+    let n = poly.vertex_count() as f64;
+    area > 2.0 * (bound + n * f64::EPSILON * size)
 }
 
 /// [`edge_factor_rational`] of `y / l` divided by `l`, as a fraction `num / den` of
