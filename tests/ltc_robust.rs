@@ -68,8 +68,9 @@ fn reproducer_2_complement_of_a_quad_above_the_point() {
     let ltc = l.ltc().unwrap();
     let in_quad = fan_quadrature(DVec3::Z, &quad, |d| ltc.density(d));
     let expected = l.norm * (ltc.upper_hemisphere_mass() - in_quad);
+    // The density's kink where its preimage crosses the cosine's horizon limits the quadrature.
     assert!(
-        (got - expected).abs() <= 1e-9,
+        (got - expected).abs() <= 1e-5 * l.norm,
         "{got} vs upper hemisphere minus quad {expected}"
     );
 }
@@ -191,4 +192,253 @@ fn regions_containing_the_lower_hemisphere_with_every_vertex_above() {
         );
         checked += 1;
     }
+}
+
+/// The upper hemisphere as a region: a ring on the horizon, counter-clockwise seen from above.
+fn upper_hemisphere() -> SphericalPolygon {
+    SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y]]).unwrap()
+}
+
+/// Stratified visible-normal estimate of the GGX directional albedo (`f cos` over the upper
+/// hemisphere, no Fresnel) with its standard error: `n x n` strata, one jittered sample each.
+fn brute_force_albedo(cos_v: f64, alpha: f64, n: usize, rng: &mut Rng) -> (f64, f64) {
+    use arealight::glam::DVec2;
+    use arealight::ltc::ggx_vndf_weight;
+    let v = DVec3::new((1.0 - cos_v * cos_v).sqrt(), 0.0, cos_v);
+    let (mut sum, mut sum2) = (0.0, 0.0);
+    for i in 0..n {
+        for j in 0..n {
+            let u = DVec2::new(
+                (i as f64 + rng.f64()) / n as f64,
+                (j as f64 + rng.f64()) / n as f64,
+            );
+            let w = ggx_vndf_weight(v, alpha, u).map_or(0.0, |(_, w)| w);
+            sum += w;
+            sum2 += w * w;
+        }
+    }
+    let m = (n * n) as f64;
+    let mean = sum / m;
+    // The stratified estimator's error is below that of plain sampling: a conservative sigma.
+    (mean, ((sum2 / m - mean * mean).max(0.0) / m).sqrt())
+}
+
+/// Issue 24, reproducer 3: at grazing views and near-mirror roughness the whole upper hemisphere
+/// integrated to 4.1e-6 (`cos_v = 0.025`) and to 1.064 (`cos_v = 0.03`, more than all the light)
+/// against a table albedo of about 0.999: `norm` was interpolated on its own, not as the albedo
+/// over the interpolated LTC's mass above the horizon. Checked against the brute-force albedo of
+/// the GGX BRDF itself (VNDF sampling, 4.5 sigma plus the table's 1% albedo tolerance).
+#[test]
+fn reproducer_3_whole_upper_hemisphere_at_grazing_mirror_views() {
+    let up = upper_hemisphere();
+    let mut rng = Rng::new(3);
+    for cos_v in [0.025, 0.03] {
+        let alpha = 1e-4;
+        let got = ggx_polygon_integral(&up, cos_v, alpha, 1.0).unwrap();
+        let (albedo, sigma) = brute_force_albedo(cos_v, alpha, 256, &mut rng);
+        assert!(
+            (got - albedo).abs() <= 0.01 + 4.5 * sigma,
+            "cos_v {cos_v}: {got} vs brute force {albedo} +- {sigma}"
+        );
+    }
+}
+
+/// For every view (`cos_v` from 1e-4 to 1, and beyond both ends) and roughness (0 to 1), the
+/// LTC integral of the whole upper hemisphere times `norm` is the table's albedo: the identity
+/// the tables' normalization stands for, between the nodes too. The rational path stays within
+/// its documented bound of it (the image of the hemisphere, clipped, has a perimeter of at most
+/// `2 pi`).
+#[test]
+fn whole_upper_hemisphere_gives_the_albedo_everywhere() {
+    use arealight::ltc::EDGE_FACTOR_RATIONAL_MAX_ERROR;
+    let up = upper_hemisphere();
+    let mut worst: f64 = 0.0;
+    for i in 0..=160 {
+        let cos_v = 10f64.powf(-4.2 + 4.2 * i as f64 / 160.0);
+        for k in 0..=60 {
+            let r = k as f64 / 60.0;
+            let alpha = r * r * 1.05;
+            let l = lookup(cos_v, alpha).unwrap();
+            let exact = ltc_integral(&up, l.m_inv).unwrap();
+            let err = (l.norm * exact / l.albedo - 1.0).abs();
+            assert!(
+                err <= 1e-9,
+                "({cos_v}, {alpha}): norm {} * {exact} vs albedo {}",
+                l.norm,
+                l.albedo
+            );
+            worst = worst.max(err);
+            let rational = ltc_integral_rational(&up, l.m_inv).unwrap();
+            assert!(
+                (rational - exact).abs() <= EDGE_FACTOR_RATIONAL_MAX_ERROR + 1e-12,
+                "({cos_v}, {alpha}): rational {rational} vs {exact}"
+            );
+        }
+    }
+    println!("whole upper hemisphere: largest relative deviation from the albedo {worst:.1e}");
+}
+
+/// Every cell of the committed table keeps the interpolated LTC's axis above the horizon with
+/// at least half its mass there, for every pair of interpolation weights: `M^-1[0][0] > 0` at its
+/// four nodes, and the determinant of the xz block, a product of interpolated entries, bounded
+/// below by interval arithmetic over the cell's corner values (`min m00 * min m22` minus the
+/// largest product of an `m02` and an `m20` in their ranges). Then `norm <= 2 albedo` at every
+/// lookup, and a lookup never interpolates through a matrix that puts the lobe under the
+/// horizon (which is what made the whole hemisphere integrate to 4.1e-6).
+#[test]
+fn every_cell_keeps_the_lobe_axis_above_the_horizon() {
+    let t = arealight::ltc::LtcTable::ggx();
+    let (nv, nr) = (t.view_nodes(), t.roughness_nodes());
+    let mut tightest = f64::INFINITY;
+    for k in 0..nr - 1 {
+        for j in 0..nv - 1 {
+            let corners = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)]
+                .map(|(a, b)| t.node_lookup(a, b).unwrap().m_inv);
+            let range = |f: &dyn Fn(&DMat3) -> f64| {
+                let v = corners.map(|m| f(&m));
+                (
+                    v.iter().copied().fold(f64::INFINITY, f64::min),
+                    v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                )
+            };
+            let (lo00, _) = range(&|m| m.x_axis.x);
+            let (lo22, _) = range(&|m| m.z_axis.z);
+            let (lo02, hi02) = range(&|m| m.z_axis.x);
+            let (lo20, hi20) = range(&|m| m.x_axis.z);
+            let (lo11, _) = range(&|m| m.y_axis.y);
+            assert!(lo00 > 0.0 && lo22 > 0.0 && lo11 > 0.0, "cell ({j}, {k})");
+            let cross = [lo02 * lo20, lo02 * hi20, hi02 * lo20, hi02 * hi20]
+                .into_iter()
+                .fold(f64::NEG_INFINITY, f64::max);
+            let det_lower = lo00 * lo22 - cross;
+            assert!(
+                det_lower > 0.0,
+                "cell ({j}, {k}): determinant down to {det_lower}"
+            );
+            tightest = tightest.min(det_lower / (lo00 * lo22));
+        }
+    }
+    println!("smallest determinant bound relative to m00 m22 over the cells: {tightest:.3}");
+}
+
+/// `0 <= ggx_polygon_integral <= albedo` (with `f0 = 1`) for random polygons, complements and
+/// rings with holes, at random views from grazing (`cos_v` down to 1e-4 and below) to normal
+/// and roughness from 0 to 1: no light gives more than the whole upper hemisphere.
+#[test]
+fn ggx_integral_is_never_above_the_albedo() {
+    let mut rng = Rng::new(0x24_03);
+    let mut checked = 0;
+    while checked < 3000 {
+        let c = rng.dir();
+        let n = 3 + (rng.next_u64() % 8) as usize;
+        let rho = 10f64.powf(rng.range(-3.0, 0.2));
+        let Ok(p) = SphericalPolygon::new(vec![star_ring(&mut rng, c, n, rho, 0.5)]) else {
+            continue;
+        };
+        let p = if rng.f64() < 0.3 { p.complement() } else { p };
+        let cos_v = 10f64.powf(rng.range(-4.5, 0.0));
+        let alpha = if rng.f64() < 0.2 {
+            0.0
+        } else {
+            10f64.powf(rng.range(-5.0, 0.0))
+        };
+        let l = lookup(cos_v, alpha).unwrap();
+        let got = ggx_polygon_integral(&p, cos_v, alpha, 1.0).unwrap();
+        assert!(
+            got >= 0.0 && got <= l.albedo * (1.0 + 1e-9),
+            "({cos_v}, {alpha}): {got} vs albedo {}",
+            l.albedo
+        );
+        checked += 1;
+    }
+}
+
+/// Stratified visible-normal estimate of the GGX reflectance (`f cos`, no Fresnel) from the
+/// directions in `region`, with its standard error (`n x n` strata, one jittered sample each).
+fn brute_force_region(
+    region: &SphericalPolygon,
+    cos_v: f64,
+    alpha: f64,
+    n: usize,
+    rng: &mut Rng,
+) -> (f64, f64) {
+    use arealight::glam::DVec2;
+    use arealight::ltc::ggx_vndf_weight;
+    let v = DVec3::new((1.0 - cos_v * cos_v).sqrt(), 0.0, cos_v);
+    let (mut sum, mut sum2) = (0.0, 0.0);
+    for i in 0..n {
+        for j in 0..n {
+            let u = DVec2::new(
+                (i as f64 + rng.f64()) / n as f64,
+                (j as f64 + rng.f64()) / n as f64,
+            );
+            let w = match ggx_vndf_weight(v, alpha, u) {
+                Some((l, w)) if region.contains(l) => w,
+                _ => 0.0,
+            };
+            sum += w;
+            sum2 += w * w;
+        }
+    }
+    let m = (n * n) as f64;
+    let mean = sum / m;
+    (mean, ((sum2 / m - mean * mean).max(0.0) / m).sqrt())
+}
+
+/// The light above the great circle through the mirror direction `m` of the view at `cos_v`
+/// and the y axis: a quad with one edge through `m`, holding the half of a narrow lobe on the
+/// zenith's side. Its response is a sensitive probe of where the lobe sits: moved by its own
+/// width, the response goes from about half the albedo to about none or all of it.
+fn half_lobe_light(cos_v: f64) -> SphericalPolygon {
+    let s = (1.0 - cos_v * cos_v).sqrt();
+    let m = DVec3::new(-s, 0.0, cos_v);
+    let up = DVec3::new(cos_v, 0.0, s);
+    let ring: Vec<DVec3> = [(-0.4, 0.0), (0.4, 0.0), (0.4, 0.3), (-0.4, 0.3)]
+        .iter()
+        .map(|&(y, w)| (m + DVec3::Y * y + up * w).normalize())
+        .collect();
+    let p = SphericalPolygon::new(vec![ring]).unwrap();
+    if p.solid_angle() > 2.0 * PI {
+        p.complement()
+    } else {
+        p
+    }
+}
+
+/// Near-mirror lobes between the table's nodes sit where the GGX lobe is: the response to a
+/// light whose edge runs through the mirror direction matches brute-force GGX (VNDF sampling,
+/// 4.5 sigma) within 3% of the albedo, at views between nodes from near-normal to grazing
+/// (`cos_v` down to 0.008) and `alpha` from 1e-4 to 3e-3. The lobes are narrower than the node
+/// spacing (0.01 degrees against 1.3 to 1.8): interpolating the nodes' matrices as stored (rows
+/// of different lengths, offsets linear in `sqrt(1 - cos)` or in `ln cos`) turned the lobe's
+/// axis past its own width, and the response came out near 0 or near the whole albedo.
+#[test]
+fn near_mirror_lobes_sit_at_the_mirror_direction_between_nodes() {
+    let mut rng = Rng::new(0x24_04);
+    let mut worst: f64 = 0.0;
+    for &cos_v in &[0.95, 0.7, 0.4, 0.15, 0.05, 0.02, 0.008] {
+        // At the most grazing view the fit itself is off by more (`fit::shading_error`, about
+        // 0.2 there at alpha 3e-3): only the nearest-mirror lobes.
+        let alphas: &[f64] = if cos_v < 0.01 {
+            &[1e-4, 3e-4, 1e-3]
+        } else {
+            &[1e-4, 3e-4, 1e-3, 3e-3]
+        };
+        for &alpha in alphas {
+            // Off the nodes: a random shift of up to a few percent of the view cosine.
+            let cos_v: f64 = cos_v * rng.range(0.97, 1.0);
+            let light = half_lobe_light(cos_v);
+            let l = lookup(cos_v, alpha).unwrap();
+            let got = ggx_polygon_integral(&light, cos_v, alpha, 1.0).unwrap();
+            let (bf, sigma) = brute_force_region(&light, cos_v, alpha, 160, &mut rng);
+            let err = (got - bf).abs() / l.albedo;
+            assert!(
+                (got - bf).abs() <= 0.03 * l.albedo + 4.5 * sigma,
+                "({cos_v}, {alpha}): LTC {got} vs brute force {bf} +- {sigma} (albedo {})",
+                l.albedo
+            );
+            worst = worst.max(err);
+        }
+    }
+    println!("half-lobe lights: largest |LTC - brute force| / albedo {worst:.4}");
 }

@@ -898,17 +898,19 @@ fn transformed_clip_free(
     edge: impl EdgeTerm,
 ) -> Option<f64> {
     let (x, y, z) = (&m.x_axis, &m.y_axis, &m.z_axis);
-    if y.x == 0.0 && y.y == 1.0 && y.z == 0.0 && x.y == 0.0 && z.y == 0.0 {
-        // The form of the fitted tables' matrices (HDHN16 §4.1): `y` passes unchanged, so four
+    if y.x == 0.0 && y.z == 0.0 && x.y == 0.0 && z.y == 0.0 {
+        // The form of the fitted tables' matrices (HDHN16 §4.1): `y` only scaled, so five
         // products per vertex instead of nine; the images are the same.
-        let (m00, m02, m20, m22) = (x.x, z.x, x.z, z.z);
+        let (m00, m02, m20, m22, m11) = (x.x, z.x, x.z, z.z, y.y);
         let small = |e: f64| e.abs() <= CLIP_FREE_RANGE;
-        let in_range = small(m00) & small(m02) & small(m20) & small(m22);
-        if !(m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && in_range) {
+        let in_range = small(m00) & small(m02) & small(m20) & small(m22) & small(m11);
+        let regular =
+            m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && m11 >= 1.0 / CLIP_FREE_RANGE;
+        if !(regular && in_range) {
             // Far from the tables' matrices (or NaN): let the general path rescale it.
             return general_clip_free(poly, m, edge);
         }
-        let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, v.y, m20 * v.x + m22 * v.z);
+        let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, m11 * v.y, m20 * v.x + m22 * v.z);
         clip_free_sum(poly, map, edge)
     } else {
         general_clip_free(poly, m, edge)
@@ -916,7 +918,9 @@ fn transformed_clip_free(
 }
 
 /// Bound on the entries (at most this) and the determinant (at least its inverse) of the maps the
-/// clip-free path takes: the images of unit vectors then have lengths within about `2^±92`, so
+/// clip-free path takes (for the tables' form, on the xz block's determinant and on the `y`
+/// scale separately, which keeps its images' lengths within `2^±61`): the images of unit vectors
+/// then have lengths within about `2^±92`, so
 /// the crossing points (products of two images) and the edge terms' products of squared lengths
 /// stay far from overflow and underflow. The fitted tables' matrices lie well inside (entries up
 /// to about `1 / alpha_min = 1e4`).
