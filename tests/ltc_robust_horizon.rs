@@ -386,8 +386,176 @@ fn reproducer_1_through_the_exact_clip() {
     for (what, got) in [
         ("exact", clamped_cosine_integral(&p)),
         ("rational", clamped_cosine_integral_rational(&p)),
-        ("ggx", ggx_polygon_integral(&p, 0.5, 0.3, 1.0).unwrap()),
     ] {
         assert!(got <= want + 1e-12, "{what}: {got} vs {want}");
     }
+    // Today the inconsistent clip is reported; after the fix, a value.
+    match ggx_polygon_integral(&p, 0.5, 0.3, 1.0) {
+        Ok(v) => assert!(v <= want + 1e-12, "ggx: {v} vs {want}"),
+        Err(e) => assert!(e.is_undecidable(), "{e}"),
+    }
+}
+
+/// Found by fuzzing (`ltc_grazing`): a large triangle one vertex of which lies `1e-9` above the
+/// horizon, another on it, seen at the most grazing view with `alpha = 0`. Its part above the
+/// horizon is a sliver of `1e-9` sr, whose image in the cosine space (solid angle `1.7e-13`)
+/// has one vertex `1.1e-13` above that horizon: the sphere layer's clip (reproducer 1) made it
+/// the whole hemisphere, and `ggx_polygon_integral` returned `norm` (0.939) against an albedo of
+/// 0.909. The value is at most `norm` times the image's solid angle over pi (`5e-14`); until the
+/// sphere layer's fix lands the exact path reports the inconsistent clip as undecidable.
+#[test]
+fn fuzz_sliver_above_the_horizon_at_the_most_grazing_view() {
+    let p = SphericalPolygon::new(vec![vec![
+        DVec3::new(0.0, -1.0, 1e-9),
+        DVec3::new(
+            -0.026297584151910847,
+            0.9993081977726123,
+            -0.026297584151910847,
+        ),
+        DVec3::new(1.0, 0.0, 0.0),
+    ]])
+    .unwrap();
+    let l = lookup(1e-300, 0.0).unwrap();
+    match ggx_polygon_integral(&p, 1e-300, 0.0, 1.0) {
+        Ok(v) => assert!((0.0..=1e-12).contains(&v), "{v}, albedo {}", l.albedo),
+        Err(e) => assert!(e.is_undecidable(), "{e}"),
+    }
+}
+
+/// Found by fuzzing (`ltc_grazing`), a fault of the target's first continuity bound, kept as a
+/// check of continuity where it is weakest: a triangle with a nearly antipodal edge (length
+/// `pi - 0.1`), its vertex 0 moved from `1e-9` above the horizon onto it and below. Moving an
+/// endpoint of an edge of length `L` by `d` sweeps up to `d tan(L / 2)` (here 20 `d`), not the
+/// `d L / 2` of a short edge; the integral moved by `1.8e-9` for `d = 1e-9`.
+#[test]
+fn fuzz_nearly_antipodal_edge_moves_continuously() {
+    let ring = [
+        DVec3::new(4.0, -12.0, -1.0),
+        DVec3::new(-9.0, 38.0, 4.0),
+        DVec3::new(-1.0, 0.0, 0.0),
+    ]
+    .map(DVec3::normalize);
+    let arc = |a: DVec3, b: DVec3| a.cross(b).length().atan2(a.dot(b));
+    let at = |h: f64| {
+        let v = ring[0];
+        let f = (1.0 - h * h).sqrt() / (v.x * v.x + v.y * v.y).sqrt();
+        let mut r = ring;
+        r[0] = DVec3::new(v.x * f, v.y * f, h);
+        let p = SphericalPolygon::new(vec![r.to_vec()]).unwrap();
+        let value = clamped_cosine_integral_clip_free(&p);
+        assert_eq!(value, ltc_integral(&p, DMat3::IDENTITY).unwrap());
+        (value, r)
+    };
+    let heights = [1e-9, 1e-12, 1e-15, 0.0, -1e-15, -1e-12, -1e-9];
+    for w in heights.windows(2) {
+        let ((a, ra), (b, rb)) = (at(w[0]), at(w[1]));
+        let d = arc(ra[0], rb[0]);
+        let half_tan = |p: DVec3, q: DVec3| (0.5 * arc(p, q)).tan();
+        let bound = d
+            * (half_tan(ra[2], ra[0]).max(half_tan(rb[2], rb[0]))
+                + half_tan(ra[0], ra[1]).max(half_tan(rb[0], rb[1])))
+            / PI;
+        assert!(
+            (a - b).abs() <= bound + 1e-13,
+            "{a} at {}, {b} at {}: bound {bound}",
+            w[0],
+            w[1]
+        );
+    }
+}
+
+/// Found by fuzzing (`ltc_grazing`): the complement of a sliver (a triangle with two vertices
+/// 0.005 rad apart at 35 degrees of elevation and its third near the horizon), the third vertex
+/// moved to `1e-14` below the horizon. Its two crossing points lie `5e-17` apart, below what
+/// rounding resolves, and the clip-free path took the horizon arc between them as empty instead
+/// of almost the whole circle: 0 instead of 0.99972 (which the exact clip gives, and every other
+/// height too). Now such products go to the exact path.
+#[test]
+fn fuzz_complement_of_a_sliver_with_a_vertex_just_below_the_horizon() {
+    let a = DVec3::new(-0.9683086332611238, 0.24964206951263349, 0.0);
+    let b = DVec3::new(0.5818519398793889, 0.5750862196482331, 0.5750862196482331);
+    let c = DVec3::new(0.5773502691896258, 0.5773502691896258, 0.5773502691896258);
+    let mut values = Vec::new();
+    for h in [
+        1e-9, 1e-12, 1e-14, 0.0, -1e-14, -5e-14, -1e-13, -1e-12, -1e-9,
+    ] {
+        let f = (1.0f64 - h * h).sqrt() / (a.x * a.x + a.y * a.y).sqrt();
+        let p = SphericalPolygon::new(vec![vec![DVec3::new(a.x * f, a.y * f, h), b, c]]).unwrap();
+        let want = clamped_cosine_integral(&p);
+        for (what, got) in [
+            ("clip-free", clamped_cosine_integral_clip_free(&p)),
+            ("ltc identity", ltc_integral(&p, DMat3::IDENTITY).unwrap()),
+        ] {
+            assert!(
+                (got - want).abs() <= 1e-12,
+                "{what} at {h:e}: {got} vs exact {want}"
+            );
+        }
+        values.push(want);
+    }
+    // The complement of a sliver 0.0009 of the hemisphere's integral wide.
+    for &v in &values {
+        assert!((v - values[0]).abs() <= 1e-9 && v > 0.999 && v < 1.0, "{v}");
+    }
+}
+
+/// Found by fuzzing (`ltc_grazing`): a triangle whose part above the horizon is almost the
+/// whole upper hemisphere, at the most grazing view with `alpha = 0`, where the table's map has
+/// a condition of about `3e7`: its LTC integral came out `2.3e-9` (relative) above the whole
+/// hemisphere's, so the response exceeded the albedo. No part of the hemisphere holds more than
+/// all of it; the response is capped there exactly.
+#[test]
+fn fuzz_almost_the_whole_hemisphere_at_the_most_grazing_view() {
+    let p = SphericalPolygon::new(vec![vec![
+        DVec3::new(0.0, 1.0, 1e-9),
+        DVec3::new(
+            -0.9997633976070043,
+            -0.015380975347800066,
+            -0.015380975347800066,
+        ),
+        DVec3::new(
+            -0.010877922219413961,
+            -0.7070649442619075,
+            -0.7070649442619075,
+        ),
+    ]])
+    .unwrap();
+    let l = lookup(1e-300, 0.0).unwrap();
+    let got = ggx_polygon_integral(&p, 1e-300, 0.0, 1.0).unwrap();
+    assert!(
+        got <= l.albedo * (1.0 + 1e-12),
+        "{got} vs albedo {}",
+        l.albedo
+    );
+}
+
+/// Found by fuzzing (`ltc_grazing`): reproducer 1's configuration (a vertex `1e-14` and an ulp
+/// above the horizon, the others well below), whose part above is a sliver. The clip-free path
+/// cannot order its two crossings and hands it over; `ltc_integral`, whose exact path checks the
+/// clip, gives 0 or reports it undecidable, but `clamped_cosine_integral_clip_free`, which has
+/// no error to report, takes the sphere clip's value, 1. Ignored until the sphere layer's fix
+/// lands.
+#[test]
+#[ignore = "needs the sphere layer's clip fix (issue 24, reproducer 1)"]
+fn fuzz_sliver_through_the_unchecked_fallback() {
+    let p = SphericalPolygon::new(vec![vec![
+        DVec3::new(
+            0.7784130394753295,
+            0.6277524511897818,
+            1.0000000000000002e-14,
+        ),
+        DVec3::new(
+            -0.014489710525281226,
+            -0.014489710525281226,
+            -0.9997900262444046,
+        ),
+        DVec3::new(-0.16539535392599136, 0.882108554271954, -0.441054277135977),
+    ]])
+    .unwrap();
+    match ltc_integral(&p, DMat3::IDENTITY) {
+        Ok(v) => assert!(v <= 1e-12, "{v}"),
+        Err(e) => assert!(e.is_undecidable(), "{e}"),
+    }
+    let clip_free = clamped_cosine_integral_clip_free(&p);
+    assert!(clip_free <= 1e-12, "{clip_free}");
 }

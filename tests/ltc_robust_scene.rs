@@ -74,7 +74,8 @@ fn points() -> usize {
 fn occluders_never_add_light_at_grazing_mirror_views() {
     let mut rng = Rng(0x5CE4E);
     let n = points();
-    let (mut shaded, mut errors, mut worst_gain, mut worst_bound) = (0, 0, 0f64, 0f64);
+    let (mut shaded, mut undecidable, mut worst_gain, mut worst_bound) = (0, 0, 0f64, 0f64);
+    let mut errors: Vec<String> = Vec::new();
     let mut sc = case(&mut rng);
     for i in 0..n {
         if i % 20 == 0 {
@@ -99,9 +100,16 @@ fn occluders_never_add_light_at_grazing_mirror_views() {
             sc.with.shade(p, DVec3::Z, view, &material),
             sc.without.shade(p, DVec3::Z, view, &material),
         );
-        let (Ok(with), Ok(without)) = (with, without) else {
-            errors += 1;
-            continue;
+        let (with, without) = match (with, without) {
+            (Ok(a), Ok(b)) => (a, b),
+            (Err(e), _) | (_, Err(e)) => {
+                if e.is_undecidable() {
+                    undecidable += 1;
+                } else {
+                    errors.push(format!("{e}"));
+                }
+                continue;
+            }
         };
         shaded += 1;
         let l = lookup(cos_v, material.alpha()).unwrap();
@@ -129,8 +137,16 @@ fn occluders_never_add_light_at_grazing_mirror_views() {
         worst_bound = worst_bound.max(without.x / bound);
     }
     println!(
-        "{shaded} points shaded, {errors} errors; largest occluded/unoccluded {worst_gain:.3e}, \
-         largest value / hemisphere bound {worst_bound:.3e}"
+        "{shaded} points shaded, {undecidable} undecidable, {} other errors {:?}; largest \
+         occluded/unoccluded {worst_gain:.3e}, largest value / hemisphere bound {worst_bound:.3e}",
+        errors.len(),
+        errors.iter().take(3).collect::<Vec<_>>()
     );
-    assert!(shaded > n / 2, "{errors} of {n} points failed");
+    // Errors other than `Undecidable` come from the other layers (issue 24's sphere and shade
+    // parts); the LTC layer's own give-ups must stay below 0.1%.
+    assert!(
+        undecidable * 1000 <= n,
+        "{undecidable} of {n} points undecidable"
+    );
+    assert!(shaded > n / 2, "{} of {n} points failed", errors.len());
 }

@@ -96,7 +96,11 @@ pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
 ///
 /// # Errors
 ///
-/// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
+/// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`;
+/// [`crate::GeomError::Undecidable`] when the exact path's clip of the transformed polygon at the
+/// horizon is not consistent (its parts above and below do not partition the region's solid
+/// angle, or the integral exceeds the part above's solid angle over pi): a vertex's image a few
+/// ulps from the horizon, where the clip is delicate, rather than a possibly wrong value.
 pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
     transformed_integral(poly, m_inv, Exact)
 }
@@ -136,7 +140,9 @@ fn transformed_integral(
 }
 
 /// The exact path of [`transformed_integral`], kept out of line so that the clip-free path's
-/// code stays small and needs no large stack frame.
+/// code stays small and needs no large stack frame. The clip of the transformed polygon is
+/// checked ([`checked_upper_part`]): the clip-free path hands over exactly the configurations
+/// where clipping is delicate (a vertex's image within `HORIZON_TOLERANCE` of the horizon).
 #[cold]
 #[inline(never)]
 fn exact_transformed(
@@ -144,7 +150,39 @@ fn exact_transformed(
     m: glam::DMat3,
     edge: impl EdgeTerm,
 ) -> Result<f64, crate::GeomError> {
-    Ok(clipped_sum(&poly.transformed(m)?, edge))
+    let t = poly.transformed(m)?;
+    let up = checked_upper_part(&t, "the LTC integral's clip at the cosine's horizon")?;
+    let v = upper_sum(&up.0, edge);
+    // The clamped cosine is at most `1 / pi`: no more than the part's solid angle over pi (the
+    // rational factor's error and rounding aside).
+    if v > up.1 / PI + 1e-12 {
+        return Err(crate::GeomError::Undecidable(
+            "the LTC integral exceeds its clipped part's solid angle over pi",
+        ));
+    }
+    Ok(v)
+}
+
+/// The part of `poly` in the closed upper hemisphere with its solid angle, or
+/// [`crate::GeomError::Undecidable`] when the clip is not consistent with the region: the part
+/// cannot be larger than the region, nor leave out more than the lower hemisphere (both to
+/// `1e-9` of the sphere's solid angle, the sphere layer's own fuzzing tolerance). The sphere
+/// layer's clip can fail that near the horizon (issue 24, reproducer 1: a sliver clipped to the
+/// whole hemisphere, or the complement of one to nothing), and the integral of a wrong clip is a
+/// wrong value. Not a proof of the clip: a wrong part within those bounds passes (the clip of
+/// the other hemisphere, which would complete the partition check, fails the same way today and
+/// would flag correct parts). The check costs two solid angles, on the exact paths only.
+fn checked_upper_part(
+    poly: &SphericalPolygon,
+    what: &'static str,
+) -> Result<(SphericalPolygon, f64), crate::GeomError> {
+    const TOL: f64 = 4e-9 * PI;
+    let up = poly.clip_to_hemisphere(DVec3::Z);
+    let (wu, w) = (up.solid_angle(), poly.solid_angle());
+    if !(wu <= w + TOL && w - wu <= 2.0 * PI + TOL) {
+        return Err(crate::GeomError::Undecidable(what));
+    }
+    Ok((up, wu))
 }
 
 /// The GGX specular response to a uniform unit-radiance polygon light: approximately
@@ -156,11 +194,22 @@ fn exact_transformed(
 /// the view at `cos_theta_v` from the normal; `alpha` is GGX's roughness parameter (`alpha =
 /// roughness^2` in the usual artist mapping). Evaluated here: the table lookup, the clip to the
 /// shading horizon (the tables are fitted for LTCs clipped there), the transform by `M^-1`, the
-/// horizon handling in cosine space and Baum's edge sum.
+/// horizon handling in cosine space and Baum's edge sum. The clip is skipped for regions shown
+/// to lie in the upper hemisphere (every vertex above the horizon is not enough: the complement
+/// of a light above the point holds the whole lower hemisphere), and checked against the
+/// region's solid angle otherwise; where it fails the check, the part above the horizon is taken
+/// as the upper hemisphere less the complement's part (whose LTC integral is `albedo / norm` in
+/// closed form minus that of the complement's clip, if that one passes).
+///
+/// With `f0 = 1` the result lies in `[0, albedo]` for every region: `norm` is the albedo over
+/// the LTC's mass above the horizon.
 ///
 /// # Errors
 ///
-/// [`crate::GeomError::OutOfRange`] for NaN parameters (see [`super::lookup`]).
+/// [`crate::GeomError::OutOfRange`] for NaN parameters (see [`super::lookup`]);
+/// [`crate::GeomError::Undecidable`] where a clip at a horizon is not consistent within rounding:
+/// the shading one, of the region and of its complement, or the cosine space's on the exact path
+/// of [`ltc_integral`].
 pub fn ggx_polygon_integral(
     poly: &SphericalPolygon,
     cos_theta_v: f64,
@@ -182,8 +231,20 @@ pub fn ggx_polygon_integral(
     let integral = if inside_upper_hemisphere(poly) {
         ltc_integral(poly, l.m_inv)?
     } else {
-        ltc_integral(&poly.clip_to_hemisphere(DVec3::Z), l.m_inv)?
+        match checked_upper_part(poly, "the clip at the shading horizon") {
+            Ok((up, _)) => ltc_integral(&up, l.m_inv)?,
+            // The complement's clip, where the region's is inconsistent: `P n H` is `H` less
+            // `P' n H`, and the LTC integral of `H` is in closed form (`albedo / norm`).
+            Err(e) => {
+                let (rest, _) = checked_upper_part(&poly.complement(), "").map_err(|_| e)?;
+                (l.albedo / l.norm - ltc_integral(&rest, l.m_inv)?).max(0.0)
+            }
+        }
     };
+    // No part of the upper hemisphere holds more of the LTC than all of it, `albedo / norm`
+    // (exactly, where rounding in the images under a map of condition up to about 1e7 at
+    // grazing views could put a region just short of the hemisphere a few 1e-9 above it).
+    let integral = integral.min(l.albedo / l.norm);
     Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
 }
 
@@ -635,14 +696,18 @@ impl ClipFree {
     }
 
     /// The total angle of the horizon arcs, the argument of the crossings' product, given at
-    /// least one crossing.
+    /// least one crossing; `None` where rounding decides between almost none and almost all of
+    /// the circle ([`arcs_undecided`]).
     #[inline(always)]
-    fn horizon_arcs(&self, edge: impl EdgeTerm) -> f64 {
+    fn horizon_arcs(&self, edge: impl EdgeTerm) -> Option<f64> {
         // The rational argument is a ratio of polynomials of degree 3 in the product's size:
         // brought within 1e±90 first, as before each factor, so that they neither underflow nor
         // overflow.
         let (re, im) = in_range(self.re, self.im);
-        counter_clockwise_arc(re, im, || edge.arg(re, im))
+        if arcs_undecided(re, im, self.crossings) {
+            return None;
+        }
+        Some(counter_clockwise_arc(re, im, || edge.arg(re, im)))
     }
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
@@ -655,7 +720,7 @@ impl ClipFree {
             // the rational factor for the rational one, with the same relative error bound as
             // its edges). Exactly on the negative axis the arc is a half circle, which an edge
             // term cannot tell from a zero-length one.
-            self.horizon_arcs(edge)
+            self.horizon_arcs(edge)?
         } else if self.edges == 0 {
             0.0
         } else if !self.any_below {
@@ -679,6 +744,19 @@ fn in_range(re: f64, im: f64) -> (f64, f64) {
     } else {
         rescale_product(re, im, size)
     }
+}
+
+/// Whether the crossings' product `re + i im` (of `crossings` factors) lies within its rounding
+/// of the positive real axis, where the horizon arcs total either almost nothing or almost a
+/// full turn and the sign of `im` is noise: crossing points closer than rounding can resolve,
+/// as the two crossings next to a vertex a little below the horizon between two edges of a
+/// sliver (a vertex `1e-14` below the horizon in a wedge of 0.005 rad puts them `5e-17` apart).
+/// Each crossing point's direction is good to a few ulps; the margin allows 64 per factor.
+/// The exact path decides these.
+#[inline(always)]
+fn arcs_undecided(re: f64, im: f64, crossings: usize) -> bool {
+    const ARC_MARGIN: f64 = 64.0 * f64::EPSILON;
+    re > 0.0 && im.abs() <= ARC_MARGIN * crossings as f64 * re
 }
 
 /// The arc from the x-axis counter-clockwise to `re + i im` (not both zero), in `[0, 2 pi)`:
@@ -820,6 +898,9 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
     // the crossings' product of the general loop.
     let (xo, xi) = (x_out.v, x_in.v);
     let (re, im) = (xo.x * xi.x + xo.y * xi.y, xo.x * xi.y - xo.y * xi.x);
+    if arcs_undecided(re, im, 2) {
+        return None;
+    }
     Some(integral_of_sum(t + counter_clockwise_arc(re, im, || arc)))
 }
 
