@@ -5,8 +5,9 @@
 mod common;
 
 use arealight::glam::DVec3;
+use arealight::internals::convex_silhouette;
 use arealight::planar::BoolOp;
-use arealight::shade::{ConvexPolyhedron, ShadingFrame, convex_silhouette};
+use arealight::solid::{ConvexPolyhedron, ShadingFrame};
 use arealight::sphere::{SphericalPolygon, order_edges};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::f64::consts::PI;

@@ -5,7 +5,8 @@ mod planar_support;
 
 use arealight::GeomError;
 use arealight::glam::DVec2;
-use arealight::planar::{BoolOp, Shape, VertexClass, boolean, contact_classes};
+use arealight::internals::{VertexClass, contact_classes};
+use arealight::planar::{BoolOp, Shape, boolean};
 use planar_support::*;
 
 /// Checks validity, identities, and the exact expected areas [A&B, A|B, A-B, A^B].

@@ -7,7 +7,8 @@
 mod planar_support;
 
 use arealight::glam::DVec2;
-use arealight::planar::{BoolOp, Shape, boolean, boolean_fast, boolean_robust};
+use arealight::internals::{boolean_fast, boolean_robust};
+use arealight::planar::{BoolOp, Shape, boolean};
 use planar_support::*;
 use proptest::prelude::*;
 

@@ -27,14 +27,14 @@
 //! points where it differs from the new visible region's by more than 2%.
 
 use arealight::glam::DVec3;
+use arealight::internals::{Pcg32, TriangleRole, convex_silhouette, may_occlude, triangle_polygon};
 use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
-use arealight::shade::reference::Pcg32;
 use arealight::shade::{
-    BoundingSphere, ConvexPolyhedron, Estimate, Light, Material, Method, MonteCarlo, ReferenceBrdf,
-    Scene, ShadingFrame, Shape, TriangleMesh, TriangleRole, convex_silhouette, may_occlude,
-    triangle_polygon,
+    Body, ConvexPolyhedron, Estimate, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
+    ShadingFrame, TriangleMesh,
 };
+use arealight::solid::BoundingSphere;
 use arealight::sphere::SphericalPolygon;
 
 /// The outcome of one scene: points checked, worst |z|, and the MC failures (empty on success).
@@ -128,24 +128,17 @@ fn old_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
     let up = DVec3::Z;
     let mut total = 0.0;
     for (i, l) in scene.lights().iter().enumerate() {
-        let (c, r) = l.shape().mesh().bounding_sphere();
-        let lb = BoundingSphere {
-            center: c,
-            radius: r,
-        };
+        let lb: BoundingSphere = l.shape().mesh().bounding_sphere();
         let mut blockers: Vec<SphericalPolygon> = Vec::new();
         for o in scene.occluders() {
-            let (c, r) = o.mesh().bounding_sphere();
-            let ob = BoundingSphere {
-                center: c,
-                radius: r,
-            };
+            let ob: BoundingSphere = o.mesh().bounding_sphere();
             if !may_occlude(frame.origin(), frame.normal(), lb, ob) {
                 continue;
             }
             match o {
-                Shape::Convex(p) => blockers.push(convex_silhouette(p, frame).unwrap()),
-                Shape::Mesh(m) => {
+                Body::Convex(p) => blockers.push(convex_silhouette(p, frame).unwrap()),
+                other => {
+                    let m = other.mesh();
                     for t in 0..m.triangle_count() {
                         if let Some(p) =
                             triangle_polygon(m, t, frame, TriangleRole::Blocker).unwrap()
@@ -238,11 +231,11 @@ fn shading_point(scene: &Scene, rng: &mut Pcg32, i: usize, h: f64) -> (DVec3, DV
 /// Whether `x` lies strictly inside a convex light (behind every face plane).
 fn inside_a_convex_light(scene: &Scene, x: DVec3) -> bool {
     scene.lights().iter().any(|l| match l.shape() {
-        Shape::Convex(p) => {
+        Body::Convex(p) => {
             let m = p.mesh();
             (0..m.triangle_count()).all(|t| m.triangle_normal(t).dot(x - m.triangle(t)[0]) < -1e-9)
         }
-        Shape::Mesh(_) => false,
+        _ => false,
     })
 }
 
@@ -283,7 +276,7 @@ fn cuboid(c: DVec3, h: DVec3) -> ConvexPolyhedron {
     ConvexPolyhedron::cuboid(c, h).unwrap()
 }
 
-fn light(shape: impl Into<Shape>, rgb: DVec3) -> Light {
+fn light(shape: impl Into<Body>, rgb: DVec3) -> Light {
     Light::new(shape, rgb).unwrap()
 }
 
@@ -565,7 +558,7 @@ fn random_scenes_with_interpenetrating_objects() {
     for case in 0..24u64 {
         let c = DVec3::new(r(-0.5, 0.5), r(-0.5, 0.5), r(2.0, 3.0));
         let size = r(0.3, 0.7);
-        let shape: Shape = match case % 5 {
+        let shape: Body = match case % 5 {
             0 => quad(c, size, true).into(),
             1 => cuboid(c, DVec3::new(size, r(0.2, 0.6), r(0.1, 0.4))).into(),
             2 => ConvexPolyhedron::icosphere(c, size, 1).unwrap().into(),
@@ -594,7 +587,7 @@ fn random_scenes_with_interpenetrating_objects() {
             ),
             DVec3::new(0.5, 1.0, 1.5),
         );
-        let mut occluders: Vec<Shape> = Vec::new();
+        let mut occluders: Vec<Body> = Vec::new();
         for k in 0..2 {
             let o = c + DVec3::new(r(-0.7, 0.7), r(-0.7, 0.7), r(-0.7, 0.5));
             occluders.push(match (case + k) % 3 {

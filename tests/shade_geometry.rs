@@ -4,12 +4,12 @@
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
-use arealight::shade::reference::Pcg32;
+use arealight::internals::{Pcg32, TriangleRole, convex_silhouette, may_occlude, triangle_polygon};
 use arealight::shade::{
-    BoundingSphere, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
-    ShadingFrame, Shape, TriangleMesh, TriangleRole, convex_silhouette, may_occlude,
-    triangle_polygon,
+    Body, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
+    ShadingFrame, TriangleMesh,
 };
+use arealight::solid::BoundingSphere;
 
 fn rand_dir(rng: &mut Pcg32) -> DVec3 {
     let z = 2.0 * rng.next_f64() - 1.0;
@@ -210,7 +210,7 @@ fn non_convex_occluder_subtracts_all_its_triangles() {
         .unwrap();
     let scene = Scene::new(
         vec![Light::new(quad, DVec3::ONE).unwrap()],
-        vec![Shape::Mesh(l_shape)],
+        vec![Body::Mesh(l_shape)],
     )
     .unwrap();
     let (ok, errors) = check_scene(&scene, 13, 60);
@@ -268,14 +268,14 @@ fn invalid_geometry_is_an_error() {
     assert!(ConvexPolyhedron::icosphere(DVec3::ZERO, 1.0, 9).is_err());
     assert!(
         Light::new(
-            Shape::Mesh(box_mesh(DVec3::ZERO, DVec3::ONE)),
+            Body::Mesh(box_mesh(DVec3::ZERO, DVec3::ONE)),
             DVec3::new(-1.0, 0.0, 0.0)
         )
         .is_err()
     );
     assert!(
         Light::new(
-            Shape::Mesh(box_mesh(DVec3::ZERO, DVec3::ONE)),
+            Body::Mesh(box_mesh(DVec3::ZERO, DVec3::ONE)),
             DVec3::splat(f64::NAN)
         )
         .is_err()

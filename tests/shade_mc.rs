@@ -9,10 +9,8 @@
 //! the estimated sigma is zero.
 
 use arealight::glam::DVec3;
-use arealight::shade::reference::Pcg32;
-use arealight::shade::{
-    DemoConfig, Material, Method, MonteCarlo, ReferenceBrdf, Scene, demo_scene,
-};
+use arealight::internals::{DemoConfig, Pcg32, demo_scene};
+use arealight::shade::{Material, Method, MonteCarlo, ReferenceBrdf, Scene};
 use std::f64::consts::PI;
 
 /// A shading point: position, normal, view, material.

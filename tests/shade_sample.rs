@@ -2,8 +2,8 @@
 //! uniform in solid angle. Fixed seeds; the confidence bounds are 4 sigma of the estimators.
 
 use arealight::glam::{DVec2, DVec3};
+use arealight::internals::Pcg32;
 use arealight::ltc::clamped_cosine_integral;
-use arealight::shade::reference::Pcg32;
 use arealight::sphere::{SphericalPolygon, SphericalTriangle};
 use std::f64::consts::PI;
 

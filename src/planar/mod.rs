@@ -76,18 +76,14 @@
 //! # Ok::<(), arealight::GeomError>(())
 //! ```
 
-mod boolean;
+pub(crate) mod boolean;
 mod contour;
 mod predicates;
 mod shape;
 
-pub use boolean::intersect::{MAX_PASSES, SNAP_REL};
-pub use boolean::label::VertexClass;
+pub use boolean::intersect::SNAP_REL;
 pub use boolean::trace::SLIVER_REL;
-pub use boolean::{
-    BoolOp, ContactClasses, Workspace, boolean, boolean_fast, boolean_robust, boolean_with,
-    contact_classes,
-};
+pub use boolean::{BoolOp, Workspace, boolean, boolean_with};
 pub use contour::Contour;
 pub use predicates::MAX_COORD;
 pub use shape::Shape;

@@ -19,12 +19,12 @@ use alloc::vec::Vec;
 
 use glam::{DVec2, DVec3};
 
-use super::brdf::Material;
-use super::scene::{Scene, Shape};
-use super::silhouette::ShadingFrame;
+use super::material::Material;
+use super::scene::Scene;
 use crate::GeomError;
 use crate::ltc::{Ltc, lookup};
 use crate::math::sqrt;
+use crate::solid::{Body, BoundingSphere, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalTriangle;
 
 /// PCG32 (O'Neill 2014, `XSH RR` output): a small, fast, deterministic generator, so that the
@@ -204,7 +204,7 @@ impl MonteCarlo {
         // skipped as a blocker of itself; its own mesh is checked separately when it is not
         // convex).
         let no = scene.occluders().len();
-        let blockers: Vec<(&super::mesh::TriangleMesh, (DVec3, f64))> = scene
+        let blockers: Vec<(&TriangleMesh, BoundingSphere)> = scene
             .occluders()
             .iter()
             .chain(scene.lights().iter().map(|l| l.shape()))
@@ -234,7 +234,7 @@ impl MonteCarlo {
             if tris.is_empty() {
                 continue;
             }
-            let self_occluding = matches!(light.shape(), Shape::Mesh(_));
+            let self_occluding = matches!(light.shape(), Body::Mesh(_));
             let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
             for _ in 0..n {
                 let pick = rng.next_f64() * total;
@@ -259,7 +259,7 @@ impl MonteCarlo {
                 };
                 let t_max = t_light * (1.0 - RAY_EPS);
                 let t_min = t_light * RAY_EPS;
-                let blocked_by = |m: &super::mesh::TriangleMesh, skip: Option<usize>| {
+                let blocked_by = |m: &TriangleMesh, skip: Option<usize>| {
                     (0..m.triangle_count()).any(|j| {
                         Some(j) != skip
                             && ray_triangle(x, w, m.triangle(j))
@@ -268,9 +268,9 @@ impl MonteCarlo {
                 };
                 let mut blocked = self_occluding && blocked_by(mesh, Some(ti));
                 if !blocked {
-                    for (j, &(m, (c, r))) in blockers.iter().enumerate() {
+                    for (j, &(m, bound)) in blockers.iter().enumerate() {
                         if j != no + li
-                            && ray_meets_sphere(x, w, c, r, t_max)
+                            && ray_meets_sphere(x, w, bound.center, bound.radius, t_max)
                             && blocked_by(m, None)
                         {
                             blocked = true;
