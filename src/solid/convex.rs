@@ -7,7 +7,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use robust::orient3d;
 
-use super::facing::FACE_TOLERANCE;
+use super::facing::{Side, face_distances, face_side};
 use super::mesh::{BoundingSphere, DEGENERATE_TRIANGLE, MeshEdge, TriangleMesh, check_vertices};
 use crate::GeomError;
 use crate::sphere::predicates::c3;
@@ -70,20 +70,19 @@ impl ConvexPolyhedron {
         ConvexPolyhedron::from_mesh(&TriangleMesh::new(vertices, triangles)?)
     }
 
-    /// Validates a triangle mesh as a convex polyhedron: every vertex at most
-    /// `FACE_TOLERANCE * radius` in front of every face plane, and closed (every edge shared by
-    /// exactly two triangles running opposite ways).
+    /// Validates a triangle mesh as a convex polyhedron: no vertex in front of any face by the
+    /// facing predicate ([`face_side`], within [`FACE_TOLERANCE`](crate::solid::FACE_TOLERANCE)
+    /// of the plane counts as on it), and closed (every edge shared by exactly two triangles
+    /// running opposite ways).
     ///
     /// # Errors
     ///
     /// [`GeomError::NotConvex`] for a vertex in front of a face plane (a non-convex or inside-out
     /// mesh), [`GeomError::OpenMesh`] for an edge without exactly one opposite edge.
     pub fn from_mesh(mesh: &TriangleMesh) -> Result<Self, GeomError> {
-        let BoundingSphere { center, radius } = mesh.bounding_sphere();
-        let tol = FACE_TOLERANCE * radius;
-        for (f, (&n, &d)) in mesh.normals().iter().zip(mesh.offsets()).enumerate() {
+        for f in 0..mesh.triangle_count() {
             for (v, &p) in mesh.vertices().iter().enumerate() {
-                if n.dot(p - center) - d > tol {
+                if face_side(mesh, f, p) == Side::Front {
                     return Err(GeomError::NotConvex { face: f, vertex: v });
                 }
             }
@@ -122,19 +121,10 @@ impl ConvexPolyhedron {
     }
 
     /// Signed distances of `x` in front of each face plane, and the tolerance below which a face
-    /// counts as edge-on ([`FACE_TOLERANCE`]).
+    /// counts as edge-on: the facing predicate for all faces at once (`Side::of(out[f], tol)` is
+    /// `face_side(mesh, f, x)`).
     pub(crate) fn facing(&self, x: DVec3, out: &mut Vec<f64>) -> f64 {
-        let BoundingSphere { center, radius } = self.bounding_sphere();
-        let rel = x - center;
-        out.clear();
-        out.extend(
-            self.mesh
-                .normals()
-                .iter()
-                .zip(self.mesh.offsets())
-                .map(|(n, d)| n.dot(rel) - d),
-        );
-        FACE_TOLERANCE * (radius + rel.length())
+        face_distances(&self.mesh, x, out)
     }
 }
 

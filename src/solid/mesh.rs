@@ -99,7 +99,7 @@ pub struct MeshEdge {
 /// per-triangle method (seed paper 000, section 4.4). Values are valid: coordinates are finite
 /// and at most [`MAX_MESH_COORD`] in magnitude, indices are in range and no triangle is
 /// degenerate ([`DEGENERATE_TRIANGLE`]). Construction also records each triangle's unit normal,
-/// its plane's offset for the facing test ([`FACE_TOLERANCE`](crate::solid::FACE_TOLERANCE)) and the edge
+/// its plane's offset for the facing predicate ([`crate::solid::face_side`]) and the edge
 /// adjacency ([`TriangleMesh::edges`]).
 ///
 /// # Examples

@@ -9,7 +9,8 @@
 //!   primitives (`cuboid`, `icosphere`, `ellipsoid`, `frustum`; [`TriangleMesh::quad`]).
 //! - [`Body`]: the geometry of one object of a scene, either of the two.
 //! - [`ShadingFrame`]: the local frame of a shading point.
-//! - [`FACE_TOLERANCE`]: the tolerance of the facing predicate.
+//! - [`face_side`]: the one facing predicate (does a mesh triangle face a point), with its
+//!   tolerance [`FACE_TOLERANCE`].
 //!
 //! This layer knows spherical polygons (it projects objects onto the sphere of directions) but no
 //! light, radiance or BRDF, and not the `ltc` layer.
@@ -31,6 +32,6 @@ pub(crate) mod silhouette;
 
 pub use body::Body;
 pub use convex::ConvexPolyhedron;
-pub use facing::FACE_TOLERANCE;
+pub use facing::{FACE_TOLERANCE, Side, face_side};
 pub use frame::ShadingFrame;
 pub use mesh::{BoundingSphere, DEGENERATE_TRIANGLE, MAX_MESH_COORD, MeshEdge, TriangleMesh};

@@ -10,10 +10,10 @@ use super::cull::{above_horizon, may_occlude};
 use super::{Blocker, Visibility};
 use crate::GeomError;
 use crate::planar::BoolOp;
-use crate::solid::facing::FACE_TOLERANCE;
+use crate::solid::facing::{Side, face_side, snapped_distance};
 use crate::solid::separation::{Separation, separating_plane};
 use crate::solid::silhouette::{
-    TriangleRole, clipped_triangle_polygon, convex_silhouette, triangle_polygon, triangle_side,
+    TriangleRole, clipped_triangle_polygon, convex_silhouette, triangle_polygon,
 };
 use crate::solid::{Body, BoundingSphere, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
@@ -230,7 +230,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ///    paper's plain subtraction. With `x` on the light's side it hides nothing (culled in
     ///    step 1).
     /// 3. A blocker that interpenetrates the light is tested against each front face's plane
-    ///    (its vertices, with [`FACE_TOLERANCE`] relative to the pair's size): entirely in every
+    ///    (its vertices, by the facing predicate [`face_side`]): entirely in every
     ///    `H_f`, it is subtracted whole as in 2; in none, it is dropped.
     /// 4. Otherwise, and for open non-planar mesh lights, the light is handled face by face: each
     ///    front triangle's projection (seed 000 section 4.4) minus the blockers that are whole on
@@ -291,7 +291,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             SmallVec::new()
         } else {
             (0..mesh.triangle_count())
-                .filter(|&t| triangle_side(mesh, t, x) > 0)
+                .filter(|&t| face_side(mesh, t, x) == Side::Front)
                 .collect()
         };
         // Straddling blockers keep how they act on each front face (in the order of `faces`),
@@ -353,14 +353,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                     }
                     Reach::Straddles => {
                         let (body, _) = self.blocker(b);
-                        let tol = self.pair_tolerance(light, b);
-                        piece = subtract_cut(piece, body, true, mesh, f, tol, frame)?;
+                        piece = subtract_cut(piece, body, true, mesh, f, frame)?;
                     }
                 }
             }
             if own_blockers && !piece.is_empty() {
-                let tol = self.pair_tolerance(light, Blocker::Light(light));
-                piece = subtract_cut(piece, body, false, mesh, f, tol, frame)?;
+                piece = subtract_cut(piece, body, false, mesh, f, frame)?;
             }
             if !piece.is_empty() {
                 out.push(piece);
@@ -370,33 +368,23 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// How blocker `b` acts on front triangle `f` of light `light` (step 3 of
-    /// [`ClipVisibility::visible_region`]): the signs of its vertices' distances from `f`'s
-    /// plane, with distances within [`ClipVisibility::pair_tolerance`] taken as zero.
+    /// [`ClipVisibility::visible_region`]): the sides of `f`'s plane its vertices lie on, by the
+    /// facing predicate ([`face_side`]; vertices within its tolerance are on the plane).
     fn reach(&self, light: usize, b: Blocker, f: usize) -> Reach {
         let mesh = self.lights[light].as_ref().mesh();
-        let (n, a) = (mesh.triangle_normal(f), mesh.triangle(f)[0]);
-        let tol = self.pair_tolerance(light, b);
         let (mut front, mut behind) = (false, false);
         for &v in self.blocker(b).0.mesh().vertices() {
-            let s = n.dot(v - a);
-            front |= s > tol;
-            behind |= s < -tol;
+            match face_side(mesh, f, v) {
+                Side::Front => front = true,
+                Side::Behind => behind = true,
+                Side::On => {}
+            }
         }
         match (front, behind) {
             (true, false) => Reach::Whole,
             (false, _) => Reach::Nothing,
             (true, true) => Reach::Straddles,
         }
-    }
-
-    /// Distance from a light's face plane below which a blocker vertex counts as on the plane:
-    /// [`FACE_TOLERANCE`] times the pair's size. The distance `n . (v - a)` is taken from a
-    /// vertex `a` of the face, so its rounding is a few ulps of `|v - a|`, which the pair's size
-    /// bounds.
-    fn pair_tolerance(&self, light: usize, b: Blocker) -> f64 {
-        let lb = self.light_bounds[light];
-        let bb = self.blocker(b).1;
-        FACE_TOLERANCE * (lb.radius + bb.radius + (lb.center - bb.center).length())
     }
 
     /// The region covered by light `light` seen from the frame's point, clipped to the upper
@@ -516,37 +504,32 @@ impl<L: AsRef<Body>> Visibility for ClipVisibility<L> {
 /// cut to their parts strictly on the shading point's side of `f`'s plane (step 4 of
 /// [`ClipVisibility::visible_region`]). `external` is false when the blocker is the light's own
 /// mesh (then `f` itself is skipped).
-#[allow(clippy::too_many_arguments)]
 fn subtract_cut(
     mut piece: SphericalPolygon,
     blocker: &Body,
     external: bool,
     light_mesh: &TriangleMesh,
     f: usize,
-    tol: f64,
     frame: &ShadingFrame,
 ) -> Result<SphericalPolygon, GeomError> {
     let up = DVec3::Z;
     let (x, up_world) = (frame.origin(), frame.normal());
-    let (n, a) = (light_mesh.triangle_normal(f), light_mesh.triangle(f)[0]);
     let face_bound = triangle_bound(light_mesh.triangle(f));
     let bm = blocker.mesh();
     // Seen from outside a convex blocker, a ray enters through a front triangle before it can
     // meet a back one, so the back ones add nothing.
     let front_only = matches!(blocker, Body::Convex(_))
-        && (0..bm.triangle_count()).any(|t| triangle_side(bm, t, x) > 0);
+        && (0..bm.triangle_count()).any(|t| face_side(bm, t, x) == Side::Front);
     for t in 0..bm.triangle_count() {
-        if (!external && t == f) || (front_only && triangle_side(bm, t, x) < 0) {
+        if (!external && t == f) || (front_only && face_side(bm, t, x) == Side::Behind) {
             continue;
         }
         // Only a triangle whose cone from x meets the face's can hide part of it.
         if !may_occlude(x, up_world, face_bound, triangle_bound(bm.triangle(t))) {
             continue;
         }
-        let dist = bm.triangle(t).map(|v| {
-            let s = n.dot(v - a);
-            if s.abs() <= tol { 0.0 } else { s }
-        });
+        // Cut by the same predicate that decided the blocker straddles the face.
+        let dist = bm.triangle(t).map(|v| snapped_distance(light_mesh, f, v));
         if let Some(p) = clipped_triangle_polygon(bm, t, dist, frame)? {
             let p = p.clip_to_hemisphere(up);
             if !p.is_empty() {

@@ -7,6 +7,7 @@ use glam::DVec3;
 use smallvec::SmallVec;
 
 use crate::GeomError;
+use crate::solid::facing::Side;
 use crate::solid::{ConvexPolyhedron, ShadingFrame};
 use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, order_directed_edges};
 
@@ -22,7 +23,8 @@ use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, orde
 /// seed 000 Alg. 2; configurations that are not one simple loop (near-degenerate views) go through
 /// [`order_directed_edges`] instead, which merges endpoints by tolerance and validates.
 ///
-/// A face whose plane passes within [`FACE_TOLERANCE`](crate::solid::FACE_TOLERANCE) of the point is seen edge-on and counts as
+/// Front faces are decided by the facing predicate ([`face_side`](crate::solid::face_side)): a
+/// face whose plane passes within its tolerance of the point is seen edge-on and counts as
 /// back-facing. A point inside the polyhedron (behind every face) sees the full sphere; a point on
 /// its surface (no face strictly in front, some within the tolerance) is covered by the
 /// intersection of the half-spaces behind the faces it lies on: a hemisphere for a point on a
@@ -38,14 +40,15 @@ pub fn convex_silhouette(
 ) -> Result<SphericalPolygon, GeomError> {
     let mut s = Vec::new();
     let tol = poly.facing(frame.origin(), &mut s);
-    if !s.iter().any(|&d| d > tol) {
+    let front = |d: f64| Side::of(d, tol) == Side::Front;
+    if !s.iter().any(|&d| front(d)) {
         // No front face: the point is inside or on the surface. The polyhedron then covers, seen
         // from the point, the intersection of the closed half-spaces behind the faces the point
         // lies on: the full sphere inside, a hemisphere on a face (a cube standing on the
         // ground covers the ground point's whole upper hemisphere), a lune on an edge.
         let mut region = SphericalPolygon::full();
         for (f, &d) in s.iter().enumerate() {
-            if d >= -tol {
+            if Side::of(d, tol) == Side::On {
                 let n = frame.dir_to_local(poly.mesh().triangle_normal(f));
                 region = region.clip_to_hemisphere(-n);
             }
@@ -57,7 +60,7 @@ pub fn convex_silhouette(
     for e in poly.edges() {
         // Every edge of a convex polyhedron has both faces (checked by `from_mesh`).
         let Some(f1) = e.f1 else { continue };
-        match (s[e.f0 as usize] > tol, s[f1 as usize] > tol) {
+        match (front(s[e.f0 as usize]), front(s[f1 as usize])) {
             (true, false) => contour.push((e.b, e.a)),
             (false, true) => contour.push((e.a, e.b)),
             _ => {}

@@ -7,8 +7,8 @@ mod convex;
 mod triangle;
 
 pub use convex::convex_silhouette;
+pub(crate) use triangle::clipped_triangle_polygon;
 pub use triangle::{TriangleRole, triangle_polygon};
-pub(crate) use triangle::{clipped_triangle_polygon, triangle_side};
 
 #[cfg(test)]
 mod tests {

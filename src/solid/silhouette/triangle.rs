@@ -8,7 +8,7 @@ use glam::DVec3;
 use smallvec::SmallVec;
 
 use crate::GeomError;
-use crate::solid::facing::FACE_TOLERANCE;
+use crate::solid::facing::{Side, face_side};
 use crate::solid::{ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
 
@@ -27,8 +27,8 @@ pub enum TriangleRole {
 }
 
 /// The spherical triangle that mesh triangle `i` covers, seen from the frame's origin, in the
-/// local frame; `None` when it covers nothing (seen edge-on within [`FACE_TOLERANCE`] or so
-/// nearly edge-on that its projection has no area within rounding, or from behind for an
+/// local frame; `None` when it covers nothing (seen edge-on by the facing predicate,
+/// [`face_side`], or so nearly edge-on that its projection has no area within rounding, or from behind for an
 /// [`TriangleRole::Emitter`]).
 ///
 /// # Errors
@@ -40,42 +40,21 @@ pub fn triangle_polygon(
     frame: &ShadingFrame,
     role: TriangleRole,
 ) -> Result<Option<SphericalPolygon>, GeomError> {
-    let side = triangle_side(mesh, i, frame.origin());
-    if side == 0 || (side < 0 && role == TriangleRole::Emitter) {
+    let side = face_side(mesh, i, frame.origin());
+    if side == Side::On || (side == Side::Behind && role == TriangleRole::Emitter) {
         return Ok(None);
     }
     let [a, b, c] = mesh.triangle(i).map(|v| frame.to_local(v));
     covered_region(&[a, b, c], side)
 }
 
-/// Which side of mesh triangle `i`'s plane the point `x` lies on: `1` in front (the side the
-/// normal points to), `-1` behind, `0` within [`FACE_TOLERANCE`] (edge-on). The one facing test
-/// of the per-triangle method, shared by [`triangle_polygon`] and the per-face visibility of
-/// [`crate::visibility::ClipVisibility`], so that both agree on every face.
-pub(crate) fn triangle_side(mesh: &TriangleMesh, i: usize, x: DVec3) -> i8 {
-    let [a, b, c] = mesh.triangle(i);
-    let n = mesh.triangle_normal(i);
-    // Relative to the triangle's centroid, so the rounding of s scales with the distance to it.
-    let m = (a + b + c) / 3.0;
-    let s = n.dot(x - m);
-    let size = (a - m).length().max((b - m).length()).max((c - m).length());
-    let tol = FACE_TOLERANCE * ((x - m).length() + size);
-    if s > tol {
-        1
-    } else if s < -tol {
-        -1
-    } else {
-        0
-    }
-}
-
 /// The region covered by a planar convex polygon (vertices in the local frame, counter-clockwise
-/// seen from the side `side` says the point is on: `1` front, `-1` back), or `None` when its
+/// seen from the side `side` says the point is on, front or back), or `None` when its
 /// projection has no area within rounding.
-fn covered_region(local: &[DVec3], side: i8) -> Result<Option<SphericalPolygon>, GeomError> {
+fn covered_region(local: &[DVec3], side: Side) -> Result<Option<SphericalPolygon>, GeomError> {
     // Counter-clockwise seen from the point is clockwise on the sphere seen from outside, so a
     // front-facing polygon covers the reversed ring (see `convex_silhouette`).
-    let ordered: SmallVec<[DVec3; 4]> = if side > 0 {
+    let ordered: SmallVec<[DVec3; 4]> = if side == Side::Front {
         local.iter().rev().copied().collect()
     } else {
         local.iter().copied().collect()
@@ -146,8 +125,8 @@ pub(crate) fn clipped_triangle_polygon(
     if dist.iter().all(|&d| d <= 0.0) {
         return Ok(None);
     }
-    let side = triangle_side(mesh, i, frame.origin());
-    if side == 0 {
+    let side = face_side(mesh, i, frame.origin());
+    if side == Side::On {
         return Ok(None);
     }
     let v = mesh.triangle(i).map(|p| frame.to_local(p));
