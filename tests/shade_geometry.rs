@@ -286,6 +286,76 @@ fn invalid_geometry_is_an_error() {
 }
 
 #[test]
+fn invalid_shading_arguments_are_named_input_faults() {
+    // A renderer must tell a bad query (skip or fix it) from a give-up (fall back): every bad
+    // point, normal or view is an input fault naming the argument, never "vertex 0/1/2" and never
+    // `Undecidable`; scaled normals and views, down to the smallest normal magnitudes and up to
+    // the largest finite ones, shade like unit ones.
+    let quad = TriangleMesh::quad(DVec3::Z * 2.0, DVec3::Y, DVec3::X).unwrap();
+    let scene = Scene::new(vec![Light::new(quad, DVec3::ONE).unwrap()], vec![]).unwrap();
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    let (x, n, v) = (
+        DVec3::new(0.1, 0.2, 0.0),
+        DVec3::Z,
+        DVec3::new(0.3, 0.0, 1.0),
+    );
+    let bad = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY];
+    for b in bad {
+        for k in 0..3 {
+            let mut e = DVec3::ZERO;
+            e[k] = b;
+            let cases = [
+                (x + e, n, v, "shading point"),
+                (x, n + e, v, "surface normal"),
+                (x, n, v + e, "view direction"),
+            ];
+            for (xx, nn, vv, what) in cases {
+                let r = scene.shade(xx, nn, vv, &m);
+                assert_eq!(r, Err(GeomError::NonFiniteArgument { what }), "{what} {b}");
+                assert!(!r.unwrap_err().is_undecidable());
+                assert_eq!(
+                    ShadingFrame::new(xx, nn, vv).map(|_| ()),
+                    Err(GeomError::NonFiniteArgument { what })
+                );
+            }
+        }
+    }
+    for zero in [
+        DVec3::ZERO,
+        DVec3::Z * 1e-320,
+        DVec3::new(0.0, -0.0, 4e-324),
+    ] {
+        assert_eq!(
+            scene.shade(x, zero, v, &m),
+            Err(GeomError::ZeroLengthArgument {
+                what: "surface normal"
+            })
+        );
+        assert_eq!(
+            scene.shade(x, n, zero, &m),
+            Err(GeomError::ZeroLengthArgument {
+                what: "view direction"
+            })
+        );
+    }
+    assert!(matches!(
+        scene.shade(DVec3::new(0.0, 2e100, 0.0), n, v, &m),
+        Err(GeomError::OutOfRange {
+            what: "shading point coordinate",
+            ..
+        })
+    ));
+    let unit = scene.shade(x, n, v, &m).unwrap();
+    for s in [1e-300, 1e-30, 7.0, 1e30, 1e300] {
+        let scaled = scene.shade(x, n * s, v * s, &m).unwrap();
+        assert!(
+            (scaled - unit).abs().max_element() <= 1e-15 * unit.max_element(),
+            "scale {s}: {scaled} vs {unit}"
+        );
+    }
+}
+
+#[test]
 fn scene_is_send_and_sync() {
     fn send_sync<T: Send + Sync>() {}
     send_sync::<Scene>();

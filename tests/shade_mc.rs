@@ -8,6 +8,7 @@
 //! 1e-1): a visible sliver of a light below about 1e-6 sr is hit by none of 1024 samples, and then
 //! the estimated sigma is zero.
 
+use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::internals::{DemoConfig, Pcg32, demo_scene};
 use arealight::shade::{Material, Method, MonteCarlo, ReferenceBrdf, Scene};
@@ -141,17 +142,23 @@ fn unoccluded_analytic_matches_monte_carlo_with_ltc_brdf() {
 fn shading_is_finite_and_errors_are_reported() {
     let demo = demo_scene(DemoConfig::default()).unwrap();
     let s = &demo.scene;
-    assert!(
-        s.shade(DVec3::NAN, DVec3::Z, DVec3::Z, &demo.ground)
-            .is_err()
+    assert_eq!(
+        s.shade(DVec3::NAN, DVec3::Z, DVec3::Z, &demo.ground),
+        Err(GeomError::NonFiniteArgument {
+            what: "shading point"
+        })
     );
-    assert!(
-        s.shade(DVec3::ZERO, DVec3::ZERO, DVec3::Z, &demo.ground)
-            .is_err()
+    assert_eq!(
+        s.shade(DVec3::ZERO, DVec3::ZERO, DVec3::Z, &demo.ground),
+        Err(GeomError::ZeroLengthArgument {
+            what: "surface normal"
+        })
     );
-    assert!(
-        s.shade(DVec3::ZERO, DVec3::Z, DVec3::ZERO, &demo.ground)
-            .is_err()
+    assert_eq!(
+        s.shade(DVec3::ZERO, DVec3::Z, DVec3::ZERO, &demo.ground),
+        Err(GeomError::ZeroLengthArgument {
+            what: "view direction"
+        })
     );
     // A view below the surface is allowed (treated as grazing by the LTC lookup).
     assert!(

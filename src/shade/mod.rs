@@ -24,7 +24,7 @@
 //!   face-by-face path and the Monte Carlo reference nothing (no front face is seen).
 //! - The per-triangle path (meshes, and [`Method::PerTriangle`]) chains many spherical booleans
 //!   of edge-sharing triangles; on a few near-degenerate configurations the `sphere` layer may
-//!   report [`crate::GeomError::Degenerate`] (none in the current tests). The silhouette path
+//!   give up with [`crate::GeomError::Undecidable`] (none in the current tests). The silhouette path
 //!   of convex shapes has not been seen to fail.
 //!
 //! # Examples

@@ -75,6 +75,7 @@ impl Pcg32 {
 
 /// Which BRDF the Monte Carlo estimator integrates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ReferenceBrdf {
     /// The BRDF as the analytic path models it: Lambert plus the LTC distribution scaled by the
     /// table's Fresnel-weighted norm. The estimate then differs from [`Scene::shade`] only by

@@ -218,9 +218,18 @@ impl Scene {
     ///
     /// # Errors
     ///
-    /// Invalid point, normal or view ([`ShadingFrame::new`]); a degenerate silhouette (the point
-    /// within rounding distance of a light's or occluder's edge line); an error of the spherical
-    /// set operations ([`SphericalPolygon::boolean`]) on a near-degenerate configuration.
+    /// Two kinds, told apart by [`GeomError::is_undecidable`]:
+    ///
+    /// - input faults, naming the argument ([`ShadingFrame::new`]): a NaN or infinite point,
+    ///   normal or view ([`GeomError::NonFiniteArgument`]), a normal or view of zero length
+    ///   ([`GeomError::ZeroLengthArgument`]), a point beyond the coordinate range
+    ///   ([`GeomError::OutOfRange`]); skip or fix the query;
+    /// - [`GeomError::Undecidable`]: the query is valid but a silhouette or spherical set
+    ///   operation cannot be decided within rounding (the point within rounding distance of an
+    ///   edge's line, near-coincident blocker edges); fall back for this query (the Monte Carlo
+    ///   reference, or a point moved by a tiny amount).
+    ///
+    /// No other error is returned: the scene and the material were validated when built.
     pub fn shade(
         &self,
         point: DVec3,
@@ -269,7 +278,7 @@ impl Scene {
             // The visible pieces are already clipped to the upper hemisphere.
             diffuse += clamped_cosine_integral_upper(&vis);
             if let Some((m_inv, _)) = spec {
-                specular += ltc_integral(&vis, m_inv)?;
+                specular += ltc_integral(&vis, m_inv).map_err(|e| e.give_up(LTC_FAILED))?;
             }
         }
         let mut out = material.albedo() * diffuse;
@@ -279,6 +288,10 @@ impl Scene {
         Ok(out * light.radiance)
     }
 }
+
+/// What a failed LTC lookup or integral reports: the frame's view and the material were
+/// validated, and the visible region is a valid polygon, so any error is a give-up.
+const LTC_FAILED: &str = "the LTC integral of a visible region failed within rounding";
 
 /// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,
 /// [`crate::ltc::LtcLookup::specular_scale`]) for the frame's view angle and the material's
@@ -290,7 +303,7 @@ fn specular_setup(
     if !material.has_specular() {
         return Ok(None);
     }
-    let look = lookup(frame.view().z, material.alpha())?;
+    let look = lookup(frame.view().z, material.alpha()).map_err(|e| e.give_up(LTC_FAILED))?;
     let f0 = material.f0();
     let scale = DVec3::new(
         look.specular_scale(f0.x),

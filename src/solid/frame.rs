@@ -3,7 +3,22 @@
 
 use glam::{DMat3, DVec3};
 
+use super::mesh::MAX_MESH_COORD;
 use crate::GeomError;
+
+/// The unit vector along an argument `v` named `what`: an error for a non-finite vector or one of
+/// zero or subnormal length. Scaled by its largest component first, so that no length in between
+/// overflows or underflows.
+fn direction(v: DVec3, what: &'static str) -> Result<DVec3, GeomError> {
+    if !v.is_finite() {
+        return Err(GeomError::NonFiniteArgument { what });
+    }
+    let m = v.abs().max_element();
+    if !(m >= f64::MIN_POSITIVE) {
+        return Err(GeomError::ZeroLengthArgument { what });
+    }
+    Ok((v / m).normalize())
+}
 
 /// The local shading frame of a point (DESIGN.md): the normal on `+z`, the view direction in the
 /// xz-plane with `x >= 0`, right-handed; directions are taken from the shading point.
@@ -29,25 +44,32 @@ pub struct ShadingFrame {
 
 impl ShadingFrame {
     /// The frame at `point` with surface normal `normal` and direction to the viewer `view`
-    /// (neither needs to be normalized). A view along the normal picks an arbitrary tangent; a
-    /// view below the surface is allowed (the LTC lookup treats it as grazing).
+    /// (neither needs to be normalized; any magnitude from `f64::MIN_POSITIVE` up is fine). A
+    /// view along the normal picks an arbitrary tangent; a view below the surface is allowed (the
+    /// LTC lookup treats it as grazing).
     ///
     /// # Errors
     ///
-    /// [`GeomError::NonFinite`] (`vertex` 0, 1, 2 for point, normal, view) or
-    /// [`GeomError::ZeroVector`] (`vertex` 1 or 2) for an unusable input.
+    /// Input faults, naming the argument: [`GeomError::NonFiniteArgument`] for a NaN or infinite
+    /// point, normal or view; [`GeomError::ZeroLengthArgument`] for a normal or view of zero or
+    /// subnormal length; [`GeomError::OutOfRange`] for a point coordinate beyond
+    /// [`MAX_MESH_COORD`] (the range of scene geometry).
     pub fn new(point: DVec3, normal: DVec3, view: DVec3) -> Result<Self, GeomError> {
-        for (i, v) in [point, normal, view].into_iter().enumerate() {
-            if !v.is_finite() {
-                return Err(GeomError::NonFinite { ring: 0, vertex: i });
-            }
+        if !point.is_finite() {
+            return Err(GeomError::NonFiniteArgument {
+                what: "shading point",
+            });
         }
-        let n = normal
-            .try_normalize()
-            .ok_or(GeomError::ZeroVector { ring: 0, vertex: 1 })?;
-        let v = view
-            .try_normalize()
-            .ok_or(GeomError::ZeroVector { ring: 0, vertex: 2 })?;
+        let m = point.abs().max_element();
+        if m > MAX_MESH_COORD {
+            return Err(GeomError::OutOfRange {
+                what: "shading point coordinate",
+                value: m,
+                limit: MAX_MESH_COORD,
+            });
+        }
+        let n = direction(normal, "surface normal")?;
+        let v = direction(view, "view direction")?;
         // Tangent: the view's component in the surface plane; any tangent for a view along n.
         let t = (v - n * v.dot(n))
             .try_normalize()

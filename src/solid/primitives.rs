@@ -12,14 +12,43 @@ use super::mesh::{MAX_MESH_COORD, TriangleMesh};
 use crate::GeomError;
 use crate::math::{sin_cos, sqrt};
 
+/// Checks that a vector argument named `what` is finite.
+fn finite(v: DVec3, what: &'static str) -> Result<(), GeomError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(GeomError::NonFiniteArgument { what })
+    }
+}
+
+/// Checks that every component of the radii argument named `what` is positive and finite.
+fn positive(radii: DVec3, what: &'static str) -> Result<(), GeomError> {
+    finite(radii, what)?;
+    let m = radii.min_element();
+    if m > 0.0 {
+        Ok(())
+    } else {
+        Err(GeomError::OutOfRange {
+            what,
+            value: m,
+            limit: MAX_MESH_COORD,
+        })
+    }
+}
+
 impl TriangleMesh {
     /// A planar quad light or occluder: the parallelogram `center +- u +- v`, two triangles,
     /// facing `u x v` (counter-clockwise seen from that side).
     ///
     /// # Errors
     ///
-    /// As [`TriangleMesh::new`]: non-finite input, or `u` and `v` (nearly) parallel.
+    /// [`GeomError::NonFiniteArgument`] for a NaN or infinite argument; as
+    /// [`TriangleMesh::new`] otherwise: a corner out of range, or `u` and `v` (nearly) parallel
+    /// ([`GeomError::DegenerateTriangle`]).
     pub fn quad(center: DVec3, u: DVec3, v: DVec3) -> Result<Self, GeomError> {
+        finite(center, "quad center")?;
+        finite(u, "quad half-edge u")?;
+        finite(v, "quad half-edge v")?;
         TriangleMesh::new(
             vec![
                 center - u - v,
@@ -37,8 +66,11 @@ impl ConvexPolyhedron {
     ///
     /// # Errors
     ///
-    /// Non-finite input, or a (nearly) zero extent ([`GeomError::Degenerate`]).
+    /// [`GeomError::NonFiniteArgument`] for a NaN or infinite argument, a corner out of range
+    /// ([`GeomError::OutOfRange`]), or a (nearly) zero extent ([`GeomError::Degenerate`]).
     pub fn cuboid(center: DVec3, half_extents: DVec3) -> Result<Self, GeomError> {
+        finite(center, "cuboid center")?;
+        finite(half_extents, "cuboid half extents")?;
         let h = half_extents;
         let pts: Vec<DVec3> = (0..8)
             .map(|i| {
@@ -58,8 +90,9 @@ impl ConvexPolyhedron {
     ///
     /// # Errors
     ///
-    /// Non-finite input or a non-positive radius; `subdivisions > 5` is
-    /// [`GeomError::OutOfRange`] (over 10 000 vertices: use a mesh instead).
+    /// [`GeomError::NonFiniteArgument`] for a NaN or infinite center or radius;
+    /// [`GeomError::OutOfRange`] for a radius that is not positive, for vertices out of range,
+    /// and for `subdivisions > 5` (over 10 000 vertices: use a mesh instead).
     pub fn icosphere(center: DVec3, radius: f64, subdivisions: u32) -> Result<Self, GeomError> {
         ConvexPolyhedron::ellipsoid_icosphere(center, DVec3::splat(radius), subdivisions)
     }
@@ -74,6 +107,8 @@ impl ConvexPolyhedron {
         radii: DVec3,
         subdivisions: u32,
     ) -> Result<Self, GeomError> {
+        finite(center, "icosphere center")?;
+        positive(radii, "icosphere radius (positive)")?;
         if subdivisions > 5 {
             return Err(GeomError::OutOfRange {
                 what: "icosphere subdivisions",
@@ -90,14 +125,17 @@ impl ConvexPolyhedron {
     ///
     /// # Errors
     ///
-    /// Non-finite input, a zero radius, `rings < 1` or `segments < 3`
-    /// ([`GeomError::OutOfRange`]).
+    /// [`GeomError::NonFiniteArgument`] for a NaN or infinite center or radius;
+    /// [`GeomError::OutOfRange`] for a radius that is not positive, `rings < 1` or
+    /// `segments < 3`.
     pub fn ellipsoid(
         center: DVec3,
         radii: DVec3,
         rings: u32,
         segments: u32,
     ) -> Result<Self, GeomError> {
+        finite(center, "ellipsoid center")?;
+        positive(radii, "ellipsoid radius (positive)")?;
         if rings < 1 || segments < 3 || rings > 1000 || segments > 1000 {
             return Err(GeomError::OutOfRange {
                 what: "ellipsoid rings (>= 1) or segments (>= 3), each at most",
@@ -125,8 +163,9 @@ impl ConvexPolyhedron {
     ///
     /// # Errors
     ///
-    /// Non-finite input, a zero axis, `segments < 3` or a negative radius
-    /// ([`GeomError::OutOfRange`]); both radii zero is [`GeomError::Degenerate`].
+    /// [`GeomError::NonFiniteArgument`] for a NaN or infinite base, axis or radius;
+    /// [`GeomError::ZeroLengthArgument`] for a zero axis; [`GeomError::OutOfRange`] for
+    /// `segments < 3` or a negative radius; both radii zero is [`GeomError::Degenerate`].
     pub fn frustum(
         base: DVec3,
         axis: DVec3,
@@ -141,18 +180,28 @@ impl ConvexPolyhedron {
                 limit: 10_000.0,
             });
         }
-        if r0.is_nan() || r1.is_nan() || r0 < 0.0 || r1 < 0.0 {
+        finite(base, "frustum base")?;
+        finite(axis, "frustum axis")?;
+        if !(r0.is_finite() && r1.is_finite()) {
+            return Err(GeomError::NonFiniteArgument {
+                what: "frustum radius",
+            });
+        }
+        if r0 < 0.0 || r1 < 0.0 {
             return Err(GeomError::OutOfRange {
                 what: "frustum radius (non-negative)",
                 value: if r0 >= 0.0 { r1 } else { r0 },
                 limit: MAX_MESH_COORD,
             });
         }
-        let len = axis.length();
-        if len.is_nan() || len <= 0.0 || !len.is_finite() {
-            return Err(GeomError::ZeroVector { ring: 0, vertex: 0 });
+        // Scaled by the largest component first, so that no length overflows or underflows.
+        let m = axis.abs().max_element();
+        if !(m >= f64::MIN_POSITIVE) {
+            return Err(GeomError::ZeroLengthArgument {
+                what: "frustum axis",
+            });
         }
-        let w = axis / len;
+        let w = (axis / m).normalize();
         let (u, v) = w.any_orthonormal_pair();
         let mut pts = Vec::with_capacity(2 * segments as usize);
         for (c, r) in [(base, r0), (base + axis, r1)] {

@@ -18,6 +18,14 @@ use crate::solid::silhouette::{
 use crate::solid::{Body, BoundingSphere, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
 
+/// What a failed union of a mesh light's front faces reports: the faces are valid polygons, so
+/// any error of [`SphericalPolygon::boolean`] is a rounding give-up.
+const UNION_FAILED: &str = "the union of a mesh light's front triangles failed within rounding";
+
+/// What a failed subtraction of a blocker's region reports (as [`UNION_FAILED`]).
+const DIFFERENCE_FAILED: &str =
+    "subtracting a blocker's region from a light's region failed within rounding";
+
 /// How convex polyhedra are turned into spherical polygons.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
@@ -245,8 +253,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ///
     /// # Errors
     ///
-    /// As [`ClipVisibility::light_region`], and those of [`SphericalPolygon::boolean`];
-    /// [`GeomError::OutOfRange`] for a light index past the end.
+    /// [`GeomError::OutOfRange`] for a light index past the end; otherwise only
+    /// [`GeomError::Undecidable`]: the geometry is valid (checked when built), so a silhouette or
+    /// a spherical set operation that fails within rounding is a give-up.
     pub fn visible_region(
         &self,
         light: usize,
@@ -400,8 +409,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ///
     /// # Errors
     ///
-    /// A degenerate silhouette (the point within rounding distance of an edge's line); those of
-    /// [`SphericalPolygon::boolean`]; [`GeomError::OutOfRange`] for a light index past the end.
+    /// As [`ClipVisibility::visible_region`]: [`GeomError::OutOfRange`] for a light index past
+    /// the end, [`GeomError::Undecidable`] for a silhouette or a union of front triangles that
+    /// cannot be decided within rounding.
     pub fn light_region(
         &self,
         light: usize,
@@ -433,7 +443,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         }
         let mut union = pieces.pop().unwrap_or_default();
         for p in &pieces {
-            union = union.boolean(p, BoolOp::Union)?;
+            union = union
+                .boolean(p, BoolOp::Union)
+                .map_err(|e| e.give_up(UNION_FAILED))?;
         }
         Ok(alloc::vec![union])
     }
@@ -533,7 +545,9 @@ fn subtract_cut(
         if let Some(p) = clipped_triangle_polygon(bm, t, dist, frame)? {
             let p = p.clip_to_hemisphere(up);
             if !p.is_empty() {
-                piece = piece.boolean(&p, BoolOp::Difference)?;
+                piece = piece
+                    .boolean(&p, BoolOp::Difference)
+                    .map_err(|e| e.give_up(DIFFERENCE_FAILED))?;
                 if piece.is_empty() {
                     break;
                 }
@@ -564,7 +578,9 @@ fn subtract_all(
         if piece.is_empty() {
             break;
         }
-        piece = piece.boolean(r, BoolOp::Difference)?;
+        piece = piece
+            .boolean(r, BoolOp::Difference)
+            .map_err(|e| e.give_up(DIFFERENCE_FAILED))?;
     }
     Ok(piece)
 }

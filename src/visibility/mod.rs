@@ -26,6 +26,7 @@ use crate::sphere::SphericalPolygon;
 /// An object that may hide part of a light: an occluder or another light, by its index in the
 /// scene's list of occluders or of lights.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[non_exhaustive]
 pub enum Blocker {
     /// Occluder `k` (an index into the scene's occluders).
     Occluder(usize),

@@ -32,8 +32,9 @@ use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, orde
 ///
 /// # Errors
 ///
-/// Those of [`order_directed_edges`] when the projected silhouette is degenerate (the point
-/// within rounding distance of an edge's line).
+/// [`GeomError::Undecidable`] when the projected silhouette is degenerate within rounding (the
+/// point within rounding distance of an edge's line, so that [`order_directed_edges`] cannot
+/// close its loops).
 pub fn convex_silhouette(
     poly: &ConvexPolyhedron,
     frame: &ShadingFrame,
@@ -110,7 +111,11 @@ fn order_edges_of(
             )
         })
         .collect();
-    order_directed_edges(&edges)
+    // The polyhedron and the point are valid, so edges that do not close into loops are a
+    // rounding give-up, not an input fault.
+    order_directed_edges(&edges).map_err(|e| {
+        e.give_up("silhouette edges do not close into loops within rounding (the point is within rounding distance of an edge's line)")
+    })
 }
 
 /// Walks directed edges (vertex index pairs) as one loop: `Some(vertex indices)` when every

@@ -33,7 +33,8 @@ pub enum TriangleRole {
 ///
 /// # Errors
 ///
-/// Those of [`SphericalPolygon::new`] for a projection that rounding made degenerate.
+/// [`GeomError::Undecidable`] for a projection that rounding made degenerate in a way
+/// [`SphericalPolygon::new`] rejects (other than having no area, which is `Ok(None)`).
 pub fn triangle_polygon(
     mesh: &TriangleMesh,
     i: usize,
@@ -95,7 +96,7 @@ fn covered_region(local: &[DVec3], side: Side) -> Result<Option<SphericalPolygon
             | GeomError::CoincidentVertices { .. }
             | GeomError::TooFewVertices { .. },
         ) => Ok(None),
-        Err(e) => Err(e),
+        Err(e) => Err(e.give_up("a projected triangle is degenerate within rounding")),
     }
 }
 
@@ -115,7 +116,8 @@ fn covered_region(local: &[DVec3], side: Side) -> Result<Option<SphericalPolygon
 ///
 /// # Errors
 ///
-/// Those of [`SphericalPolygon::new`] for a projection that rounding made degenerate.
+/// [`GeomError::Undecidable`] for a projection that rounding made degenerate in a way
+/// [`SphericalPolygon::new`] rejects (other than having no area, which is `Ok(None)`).
 pub(crate) fn clipped_triangle_polygon(
     mesh: &TriangleMesh,
     i: usize,
