@@ -4,6 +4,8 @@
 //! - [`Scene`]: lights ([`Light`]) and occluders, and [`Scene::shade`], the analytic radiance at
 //!   a shading point. Which part of each light the point sees comes from the visibility layer
 //!   ([`crate::visibility::ClipVisibility`], the exact rule of [`Scene::visible_region`]).
+//! - [`Scene::shade_per_light`]: every light's share, split into diffuse and specular lobes,
+//!   with its unshadowed value ([`LightShading`]), for denoising and ratio estimators.
 //! - [`Material`]: Lambert + GGX with Schlick's Fresnel.
 //! - [`MonteCarlo`]: an estimator of the same radiance (solid-angle sampling of the lights'
 //!   triangles, exact ray-triangle visibility), with its standard error, for tests and
@@ -57,11 +59,13 @@
 
 pub(crate) mod demo;
 mod material;
+mod query;
 pub(crate) mod reference;
 mod scene;
 
 pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 pub use crate::visibility::{Blocker, Method};
 pub use material::Material;
+pub use query::LightShading;
 pub use reference::{Estimate, MonteCarlo, ReferenceBrdf};
 pub use scene::{Light, Scene};

@@ -2,11 +2,9 @@
 
 use alloc::vec::Vec;
 
-use glam::{DMat3, DVec3};
+use glam::DVec3;
 
-use super::material::Material;
 use crate::GeomError;
-use crate::ltc::{clamped_cosine_integral_upper, lookup, ltc_integral};
 use crate::solid::{Body, ShadingFrame};
 use crate::sphere::SphericalPolygon;
 use crate::visibility::{Blocker, ClipVisibility, Method};
@@ -145,7 +143,7 @@ impl Scene {
     }
 
     /// Light `i`, or [`GeomError::OutOfRange`] past the end.
-    fn light(&self, i: usize) -> Result<&Light, GeomError> {
+    pub(super) fn light(&self, i: usize) -> Result<&Light, GeomError> {
         self.lights().get(i).ok_or(GeomError::OutOfRange {
             what: "light index",
             value: i as f64,
@@ -206,109 +204,4 @@ impl Scene {
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
         self.vis.light_region(light, frame)
     }
-
-    /// The outgoing radiance (RGB) at `point` towards `view`, for a surface with normal
-    /// `normal` and material `material`: seed 000 Alg. 1 summed over the lights.
-    ///
-    /// `view` points from the surface towards the viewer; `normal` and `view` need not be
-    /// normalized. For each light the visible region is computed in the shading frame
-    /// ([`Scene::visible_region`]), and integrated with Baum's formula for the diffuse lobe and,
-    /// after the LTC transform `M^-1` looked up for the view angle and roughness, for the GGX lobe
-    /// (HDHN16 eq. 2 / seed 000 eq. 2, Alg. 1 lines 13-16).
-    ///
-    /// # Errors
-    ///
-    /// Two kinds, told apart by [`GeomError::is_undecidable`]:
-    ///
-    /// - input faults, naming the argument ([`ShadingFrame::new`]): a NaN or infinite point,
-    ///   normal or view ([`GeomError::NonFiniteArgument`]), a normal or view of zero length
-    ///   ([`GeomError::ZeroLengthArgument`]), a point beyond the coordinate range
-    ///   ([`GeomError::OutOfRange`]); skip or fix the query;
-    /// - [`GeomError::Undecidable`]: the query is valid but a silhouette or spherical set
-    ///   operation cannot be decided within rounding (the point within rounding distance of an
-    ///   edge's line, near-coincident blocker edges); fall back for this query (the Monte Carlo
-    ///   reference, or a point moved by a tiny amount).
-    ///
-    /// No other error is returned: the scene and the material were validated when built.
-    pub fn shade(
-        &self,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
-        material: &Material,
-    ) -> Result<DVec3, GeomError> {
-        let frame = ShadingFrame::new(point, normal, view)?;
-        let mut total = DVec3::ZERO;
-        let spec = specular_setup(&frame, material)?;
-        for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, spec)?;
-        }
-        Ok(total)
-    }
-
-    /// The contribution of light `light` alone to [`Scene::shade`] (occluders included).
-    ///
-    /// # Errors
-    ///
-    /// As [`Scene::shade`]; [`GeomError::OutOfRange`] for a light index past the end.
-    pub fn shade_light(
-        &self,
-        light: usize,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
-        material: &Material,
-    ) -> Result<DVec3, GeomError> {
-        self.light(light)?;
-        let frame = ShadingFrame::new(point, normal, view)?;
-        let spec = specular_setup(&frame, material)?;
-        self.shade_light_in(light, &frame, material, spec)
-    }
-
-    fn shade_light_in(
-        &self,
-        i: usize,
-        frame: &ShadingFrame,
-        material: &Material,
-        spec: Option<(DMat3, DVec3)>,
-    ) -> Result<DVec3, GeomError> {
-        let light = &self.lights()[i];
-        let (mut diffuse, mut specular) = (0.0, 0.0);
-        for vis in self.vis.visible_region(i, frame)? {
-            // The visible pieces are already clipped to the upper hemisphere.
-            diffuse += clamped_cosine_integral_upper(&vis);
-            if let Some((m_inv, _)) = spec {
-                specular += ltc_integral(&vis, m_inv).map_err(|e| e.give_up(LTC_FAILED))?;
-            }
-        }
-        let mut out = material.albedo() * diffuse;
-        if let Some((_, scale)) = spec {
-            out += scale * specular;
-        }
-        Ok(out * light.radiance)
-    }
-}
-
-/// What a failed LTC lookup or integral reports: the frame's view and the material were
-/// validated, and the visible region is a valid polygon, so any error is a give-up.
-const LTC_FAILED: &str = "the LTC integral of a visible region failed within rounding";
-
-/// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,
-/// [`crate::ltc::LtcLookup::specular_scale`]) for the frame's view angle and the material's
-/// roughness; `None` for a material without a specular lobe. One table lookup per shading point.
-fn specular_setup(
-    frame: &ShadingFrame,
-    material: &Material,
-) -> Result<Option<(DMat3, DVec3)>, GeomError> {
-    if !material.has_specular() {
-        return Ok(None);
-    }
-    let look = lookup(frame.view().z, material.alpha()).map_err(|e| e.give_up(LTC_FAILED))?;
-    let f0 = material.f0();
-    let scale = DVec3::new(
-        look.specular_scale(f0.x),
-        look.specular_scale(f0.y),
-        look.specular_scale(f0.z),
-    );
-    Ok(Some((look.m_inv, scale)))
 }
