@@ -461,8 +461,8 @@ fn occluders_touching_lights() {
 fn shading_never_fails_on_degenerate_points() {
     // Shading points on light and occluder vertices, edge midpoints, in face planes and inside
     // objects, with random normals and views, in the scenes above: both methods must return a
-    // finite, non-negative radiance (or, for the per-triangle method only, an error of the
-    // sphere layer, counted and required to be rare), never panic.
+    // finite, non-negative radiance (or, for the per-triangle method only, a give-up of the
+    // sphere layer, `GeomError::Undecidable`, counted and required to be rare), never panic.
     let scenes = [
         Scene::new(
             vec![
@@ -526,7 +526,8 @@ fn shading_never_fails_on_degenerate_points() {
                 total += 1;
                 match scene.clone().with_method(method).shade(x, n, v, &m) {
                     Ok(c) if c.is_finite() && c.min_element() >= 0.0 => {}
-                    Err(e) if method == Method::PerTriangle => {
+                    // A give-up, never an input fault: every query here is valid.
+                    Err(e) if method == Method::PerTriangle && e.is_undecidable() => {
                         per_tri_errors += 1;
                         eprintln!("per-triangle x {x} n {n} v {v}: {e}");
                     }

@@ -1,6 +1,7 @@
 //! Solid-angle sampling of spherical triangles (Arvo 1995): samples land in the triangle and are
 //! uniform in solid angle. Fixed seeds; the confidence bounds are 4 sigma of the estimators.
 
+use arealight::GeomError;
 use arealight::glam::{DVec2, DVec3};
 use arealight::internals::Pcg32;
 use arealight::ltc::clamped_cosine_integral;
@@ -115,9 +116,18 @@ fn sub_triangle_counts_follow_their_areas() {
 
 #[test]
 fn degenerate_triangles_are_errors() {
-    assert!(SphericalTriangle::new(DVec3::X, DVec3::X, DVec3::Y).is_err());
-    assert!(SphericalTriangle::new(DVec3::X, DVec3::NAN, DVec3::Y).is_err());
-    assert!(SphericalTriangle::new(DVec3::X, DVec3::ZERO, DVec3::Y).is_err());
+    assert!(matches!(
+        SphericalTriangle::new(DVec3::X, DVec3::X, DVec3::Y),
+        Err(GeomError::Degenerate(_))
+    ));
+    assert_eq!(
+        SphericalTriangle::new(DVec3::X, DVec3::NAN, DVec3::Y),
+        Err(GeomError::NonFinite { ring: 0, vertex: 1 })
+    );
+    assert_eq!(
+        SphericalTriangle::new(DVec3::X, DVec3::ZERO, DVec3::Y),
+        Err(GeomError::ZeroVector { ring: 0, vertex: 1 })
+    );
     let t = SphericalTriangle::new(DVec3::X, DVec3::Y, DVec3::Z).unwrap();
     // Out-of-range uniforms are clamped, never NaN.
     assert!(t.sample(DVec2::new(2.0, -1.0)).is_finite());

@@ -383,7 +383,10 @@ impl LtcTable {
     /// let lean = ltc.density(DVec3::new(-0.6, 0.0, 0.8)) > ltc.density(DVec3::new(0.6, 0.0, 0.8));
     /// assert!(lean);
     /// assert!(l.albedo > 0.0 && l.albedo <= 1.0);
-    /// assert!(table.lookup(f64::NAN, 0.25).is_err());
+    /// assert!(matches!(
+    ///     table.lookup(f64::NAN, 0.25),
+    ///     Err(arealight::GeomError::OutOfRange { what: "cos_theta_v", .. })
+    /// ));
     /// ```
     #[inline]
     pub fn lookup(&self, cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {

@@ -270,6 +270,9 @@ mod tests {
         );
         let mut bad = good;
         bad[0] = [0, 1, 2];
-        assert!(ConvexPolyhedron::from_mesh(&TriangleMesh::new(v, bad).unwrap()).is_err());
+        assert!(matches!(
+            ConvexPolyhedron::from_mesh(&TriangleMesh::new(v, bad).unwrap()),
+            Err(GeomError::NotConvex { .. })
+        ));
     }
 }
