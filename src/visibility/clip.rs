@@ -265,8 +265,17 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// [`ClipVisibility::visible_region`] with all blockers (`blocked`) or none but the light's
-    /// own triangles.
+    /// own triangles, its pieces checked by [`upper_pieces`].
     fn region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        blocked: bool,
+    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        upper_pieces(self.region_unchecked(light, frame, blocked)?)
+    }
+
+    fn region_unchecked(
         &self,
         light: usize,
         frame: &ShadingFrame,
@@ -317,7 +326,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
         }
         if straddling.is_empty() && !self_blocking {
-            let mut out = self.light_region(light, frame)?;
+            let mut out = self.light_region_unchecked(light, frame)?;
             if !whole.is_empty() {
                 let mut regions = Vec::new();
                 for &b in &whole {
@@ -413,6 +422,14 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// the end, [`GeomError::Undecidable`] for a silhouette or a union of front triangles that
     /// cannot be decided within rounding.
     pub fn light_region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        upper_pieces(self.light_region_unchecked(light, frame)?)
+    }
+
+    fn light_region_unchecked(
         &self,
         light: usize,
         frame: &ShadingFrame,
@@ -555,6 +572,25 @@ fn subtract_cut(
         }
     }
     Ok(piece)
+}
+
+/// What a region that left the upper hemisphere reports (see [`upper_pieces`]).
+const REGION_LEFT_HEMISPHERE: &str =
+    "a spherical set operation returned a region outside the upper hemisphere within rounding";
+
+/// The pieces of a region, checked: every piece is clipped to the upper hemisphere before any
+/// set operation, and differences and unions of such pieces stay in it, so a piece that is the
+/// full sphere or contains the nadir `-z` is a set operation gone wrong within rounding (a
+/// region complemented). That is a give-up, [`GeomError::Undecidable`], not a radiance
+/// integrated over the wrong region.
+fn upper_pieces(pieces: Vec<SphericalPolygon>) -> Result<Vec<SphericalPolygon>, GeomError> {
+    if pieces
+        .iter()
+        .any(|p| p.is_full() || p.contains(DVec3::NEG_Z))
+    {
+        return Err(GeomError::Undecidable(REGION_LEFT_HEMISPHERE));
+    }
+    Ok(pieces)
 }
 
 /// A sphere holding a triangle (about its centroid, padded by a relative ulp margin), for the
