@@ -20,10 +20,10 @@
 //! region. Seeds are fixed, so the outcome is deterministic. A bias too small for any one point
 //! shows in the mean first-stage z-score, which must stay within `4 / sqrt(points)`.
 //!
-//! Every Monte Carlo test here fails with the old rule (subtract every culled occluder's whole
-//! projection, lights transparent to each other; checked once against the old `Scene::shade`).
+//! Every Monte Carlo test here fails with the naive rule (subtract every culled occluder's whole
+//! projection, lights transparent to each other), which is seed 000's Alg. 1 as written.
 //! The eight hand-built scenes also assert that they are scenes where the rule matters, by
-//! recomputing the old rule's diffuse integral from the public geometry API and counting the
+//! recomputing the naive rule's diffuse integral from the public geometry API and counting the
 //! points where it differs from the new visible region's by more than 2%.
 
 use arealight::glam::DVec3;
@@ -122,9 +122,9 @@ fn run(scene: &Scene, method: Method, count: usize, h: f64, seed: u64) -> Report
 }
 
 /// The diffuse integral (green radiance-weighted, summed over the lights) of the visible light
-/// under the old rule: each light's region minus the whole projection of every occluder that
+/// under the naive rule: each light's region minus the whole projection of every occluder that
 /// the bounding-sphere culling keeps; lights never block.
-fn old_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
+fn naive_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
     let up = DVec3::Z;
     let mut total = 0.0;
     for (i, l) in scene.lights().iter().enumerate() {
@@ -163,7 +163,7 @@ fn old_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
 }
 
 /// The same integral for the visible region the scene computes now.
-fn new_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
+fn exact_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
     let mut total = 0.0;
     for (i, l) in scene.lights().iter().enumerate() {
         for piece in scene.visible_region(i, frame).unwrap() {
@@ -173,9 +173,9 @@ fn new_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
     total
 }
 
-/// Asserts that on at least a tenth of `count` random ground points the old rule is off by more
+/// Asserts that on at least a tenth of `count` random ground points the naive rule is off by more
 /// than 2% (so that the Monte Carlo check below can tell the two apart).
-fn assert_old_rule_fails(name: &str, scene: &Scene, count: usize, h: f64, seed: u64) {
+fn assert_naive_rule_fails(name: &str, scene: &Scene, count: usize, h: f64, seed: u64) {
     let mut rng = Pcg32::new(seed, 12);
     let mut differ = 0;
     for _ in 0..count {
@@ -186,17 +186,17 @@ fn assert_old_rule_fails(name: &str, scene: &Scene, count: usize, h: f64, seed: 
         );
         let frame = ShadingFrame::new(x, DVec3::Z, DVec3::Z).unwrap();
         let (old, new) = (
-            old_rule_diffuse(scene, &frame),
-            new_rule_diffuse(scene, &frame),
+            naive_rule_diffuse(scene, &frame),
+            exact_rule_diffuse(scene, &frame),
         );
         if (old - new).abs() > 0.02 * new.abs() + 1e-9 {
             differ += 1;
         }
     }
-    eprintln!("{name}: the old rule is off by more than 2% at {differ} of {count} points");
+    eprintln!("{name}: the naive rule is off by more than 2% at {differ} of {count} points");
     assert!(
         differ * 10 >= count,
-        "{name}: the old rule differs at only {differ} of {count} points"
+        "{name}: the naive rule differs at only {differ} of {count} points"
     );
 }
 
@@ -241,7 +241,7 @@ fn inside_a_convex_light(scene: &Scene, x: DVec3) -> bool {
 
 /// Checks a scene with both methods on `count` points.
 fn check(name: &str, scene: &Scene, count: usize, h: f64, seed: u64) {
-    assert_old_rule_fails(name, scene, count, h, seed);
+    assert_naive_rule_fails(name, scene, count, h, seed);
     let mut all = Vec::new();
     for method in [Method::Silhouette, Method::PerTriangle] {
         let r = run(scene, method, count, h, seed);

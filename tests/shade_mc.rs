@@ -114,7 +114,7 @@ fn check_against_mc(cfg: DemoConfig, count: usize, samples: u32, seed: u64) -> f
         "mean z-score {zmean}: a bias"
     );
     // The per-triangle path runs hundreds of spherical differences of triangles sharing edges;
-    // every one must succeed (the configurations that once failed are in
+    // every one must succeed (the hardest configurations met are kept in
     // tests/shade_known_failures.rs).
     assert!(
         per_tri_errors.is_empty(),

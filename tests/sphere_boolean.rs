@@ -379,8 +379,8 @@ fn near_antipodal_operands() {
 #[test]
 fn fuzz_regression_union_touching_at_a_vertex_inside_an_edge() {
     // B touches the boundary circle of the hemisphere A at one of B's vertices, which lies
-    // inside an edge of A. The planar union returned the touching point as a T-junction, which
-    // is not a valid spherical ring set; it is now inserted into the touched edge.
+    // inside an edge of A. The planar union returns the touching point as a T-junction, which is
+    // not a valid spherical ring set, so it must be inserted into the touched edge.
     let a = SphericalPolygon::new(vec![vec![
         DVec3::new(48.0, 48.0, 37.0),
         DVec3::new(-1.0, -1.0, -1.0),
@@ -430,8 +430,8 @@ fn fuzz_regression_pinch_vertex_containment() {
 #[test]
 fn fuzz_regression_touching_a_boundary_that_lies_on_a_cut() {
     // B is the hemisphere bounded by the great circle y = 0, one of the octant cuts; A touches
-    // it at one of its vertices. After the cut edges cancelled, A's vertex lay inside one of B's
-    // surviving circle edges; the circle is now split there.
+    // it at one of its vertices. After the cut edges cancel, A's vertex lies inside one of B's
+    // surviving circle edges, which must be split there.
     let a = SphericalPolygon::new(vec![vec![
         DVec3::new(0.0, -1.0, 1.0),
         DVec3::new(0.0, -1.0, 64.0),
@@ -490,8 +490,8 @@ fn fuzz_regression_pinch_on_the_cut_circle() {
 fn regression_union_with_vertex_copies_ulps_apart() {
     // Union of the front faces of a two-box light (tests/shade_geometry.rs, point 20): the
     // accumulated region holds two copies of one mesh vertex 6e-17 apart (rings 1 and 3), from
-    // different earlier projections. The planar union welded the next triangle to one copy and
-    // kept an edge overlapping the other; operands are now welded within 1e-12 first.
+    // different earlier projections. Welding the next triangle to one copy only would keep an
+    // edge overlapping the other, so operands are welded within 1e-12 first.
     let v = DVec3::new;
     let a = SphericalPolygon::new(vec![
         vec![

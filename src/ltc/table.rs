@@ -38,8 +38,8 @@ pub(crate) const CHANNELS: usize = 7;
 /// The per-cell quantities, in storage order: `M^-1`'s first column `(M00, M20)`, its last column
 /// `(M02, M22)`, then the scalars. The columns are what a vertex's `x` and `z` are multiplied by,
 /// so each comes out of the bilinear lookup as one two-lane value that the transform uses as it
-/// is; with the rows stored together the compiler shuffled them apart on every lookup (28 more
-/// instructions per shaded quad, see BENCHMARKS.md, session 6).
+/// is; stored by rows, they would have to be shuffled apart on every lookup (see BENCHMARKS.md,
+/// "ltc shading").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Channel {
     /// `M^-1[0][0]` (row, column), with `M^-1` scaled so that `M^-1[1][1] = 1`.
@@ -454,8 +454,8 @@ fn interpolate(grid: &Grid, nodes: &[Node], cos_theta_v: f64, alpha: f64) -> Ltc
     let (w01, w11) = ((1.0 - tx) * ty, tx * ty);
     // Each channel summed in corner order: the compiler then pairs neighbouring channels of a
     // node (one 16-byte load per pair and corner). The balanced sum `(c00 + c10) + (c01 + c11)`
-    // made it pair corners of one channel instead, gathering each operand from two nodes: 137
-    // instead of 115 instructions and about 25% more time per lookup (BENCHMARKS.md, session 6).
+    // makes it pair corners of one channel instead, gathering each operand from two nodes, for
+    // about a fifth more instructions and a quarter more time per lookup (BENCHMARKS.md).
     let mut v = [0.0; 8];
     for (ch, out) in v.iter_mut().enumerate() {
         *out = w00 * c00[ch] + w10 * c10[ch] + w01 * c01[ch] + w11 * c11[ch];
