@@ -84,3 +84,66 @@ fn quad_light_seen_from_just_inside_an_icosphere_light() {
         );
     }
 }
+
+#[test]
+fn icosphere_light_face_with_one_vertex_just_above_the_horizon() {
+    // A small icosphere light cut through by an open two-sheet mesh light (the face-by-face
+    // path), seen from a point 7e-12 behind that sheet, normal down: one of the icosphere's front
+    // triangles has a single vertex 8e-12 above
+    // the horizon, and the horizon clip returned the whole upper hemisphere for it
+    // (tests/shade_known_failures.rs, issue 24), making the light 26 000 times brighter than
+    // unoccluded. Clips that add a long horizon arc are now checked against the clipped
+    // polygon's solid angle.
+    let h = 2.0;
+    let c = grid(-1, -1, 0);
+    let sheets = TriangleMesh::quad(c, DVec3::Y * h, DVec3::X * h)
+        .unwrap()
+        .merged(&TriangleMesh::quad(c + grid(-1, -1, -1), DVec3::X * h, DVec3::Y * h).unwrap())
+        .unwrap();
+    let ico = ConvexPolyhedron::icosphere(c, 1.0 / 16.0, 1).unwrap();
+    let rgb = DVec3::new(1.0, 2.0, 0.5);
+    let scene = Scene::new(
+        vec![
+            Light::new(ico, rgb).unwrap(),
+            Light::new(sheets, rgb).unwrap(),
+        ],
+        vec![],
+    )
+    .unwrap();
+    let x = DVec3::new(-0.875, 0.375, 7.275957614183426e-12);
+    let m = Material::new(DVec3::ONE, DVec3::splat(113.0 / 255.0), 0.0).unwrap();
+    assert_bounded_or_undecidable(&scene, x, -DVec3::Z, DVec3::Z, &m);
+}
+
+#[test]
+fn icosphere_light_seen_from_the_plane_of_an_occluder_quad() {
+    // The first instance of the same clip failure: an icosphere light (radius 2) behind a sheet
+    // light, seen from a point in the plane of an occluder quad, the face-by-face path; the
+    // light came out 187 times brighter than unoccluded.
+    let hs = 2.0;
+    let c = grid(0, -1, -1);
+    let sheets = TriangleMesh::quad(c, DVec3::Y * hs, DVec3::X * hs)
+        .unwrap()
+        .merged(&TriangleMesh::quad(c + grid(-1, -1, -1), DVec3::X * hs, DVec3::Y * hs).unwrap())
+        .unwrap();
+    let ico = ConvexPolyhedron::icosphere(grid(-1, -1, -1), 2.0, 1).unwrap();
+    let occ = TriangleMesh::quad(grid(0, 0, 0), grid(0, 0, -92), grid(-92, -92, -92)).unwrap();
+    let rgb = DVec3::new(1.0, 2.0, 0.5);
+    let scene = Scene::new(
+        vec![
+            Light::new(sheets, rgb).unwrap(),
+            Light::new(ico, rgb).unwrap(),
+        ],
+        vec![occ.into()],
+    )
+    .unwrap();
+    let x = DVec3::new(4.312500000000161, 4.312499999999839, 1.4375);
+    let n = DVec3::new(-0.7071067811865475, 0.7071067811865475, 0.0);
+    let m = Material::new(
+        DVec3::splat(164.0 / 255.0),
+        DVec3::splat(36.0 / 255.0),
+        156.0 / 255.0,
+    )
+    .unwrap();
+    assert_bounded_or_undecidable(&scene, x, n, n, &m);
+}

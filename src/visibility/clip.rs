@@ -340,7 +340,6 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             return Ok(out);
         }
         // Step 4: face by face.
-        let up = DVec3::Z;
         let mut whole_regions = Vec::new();
         for &b in &whole {
             self.blocker_regions(light, b, frame, &mut whole_regions)?;
@@ -353,7 +352,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             let Some(piece) = triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? else {
                 continue;
             };
-            let mut piece = subtract_all(piece.clip_to_hemisphere(up), &whole_regions)?;
+            let mut piece = subtract_all(upper_part(&piece)?, &whole_regions)?;
             for (k, (b, reach)) in straddling.iter().enumerate() {
                 let b = *b;
                 if piece.is_empty() {
@@ -434,10 +433,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        let up = DVec3::Z;
         let body = self.light_body(light)?;
         if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
-            let s = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+            let s = upper_part(&convex_silhouette(p, frame)?)?;
             return Ok(if s.is_empty() {
                 Vec::new()
             } else {
@@ -448,7 +446,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         let mut pieces = Vec::new();
         for t in 0..mesh.triangle_count() {
             if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Emitter)? {
-                let p = p.clip_to_hemisphere(up);
+                let p = upper_part(&p)?;
                 if !p.is_empty() {
                     pieces.push(p);
                 }
@@ -478,12 +476,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         frame: &ShadingFrame,
         out: &mut Vec<SphericalPolygon>,
     ) -> Result<(), GeomError> {
-        let up = DVec3::Z;
         let (x, n) = (frame.origin(), frame.normal());
         let lb = self.light_bounds[light];
         match (self.blocker(b).0, self.method) {
             (Body::Convex(p), Method::Silhouette) => {
-                let occ = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+                let occ = upper_part(&convex_silhouette(p, frame)?)?;
                 if !occ.is_empty() {
                     out.push(occ);
                 }
@@ -495,7 +492,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                         continue;
                     }
                     if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Blocker)? {
-                        let p = p.clip_to_hemisphere(up);
+                        let p = upper_part(&p)?;
                         if !p.is_empty() {
                             out.push(p);
                         }
@@ -541,7 +538,6 @@ fn subtract_cut(
     f: usize,
     frame: &ShadingFrame,
 ) -> Result<SphericalPolygon, GeomError> {
-    let up = DVec3::Z;
     let (x, up_world) = (frame.origin(), frame.normal());
     let face_bound = triangle_bound(light_mesh.triangle(f));
     let bm = blocker.mesh();
@@ -560,7 +556,7 @@ fn subtract_cut(
         // Cut by the same predicate that decided the blocker straddles the face.
         let dist = bm.triangle(t).map(|v| snapped_distance(light_mesh, f, v));
         if let Some(p) = clipped_triangle_polygon(bm, t, dist, frame)? {
-            let p = p.clip_to_hemisphere(up);
+            let p = upper_part(&p)?;
             if !p.is_empty() {
                 piece = piece
                     .boolean(&p, BoolOp::Difference)
@@ -572,6 +568,41 @@ fn subtract_cut(
         }
     }
     Ok(piece)
+}
+
+/// What a clip that grew its polygon reports (see [`upper_part`]).
+const CLIP_GREW: &str =
+    "the horizon clip of a region returned more than the region within rounding";
+
+/// Horizon edges (both ends within this of the horizon, in `z`) at least [`LONG_ARC`] long make
+/// [`upper_part`] check its result.
+const ON_HORIZON: f64 = 1e-12;
+
+/// See [`ON_HORIZON`]: arcs this long (radians) are what a clip that joins an exit to an entry
+/// the long way round the circle adds; short ones, the common case of a region cut by the
+/// horizon near the point, cost no check.
+const LONG_ARC: f64 = 0.5;
+
+/// The part of `p` in the upper hemisphere (`clip_to_hemisphere(+z)`), checked where the clip
+/// added a long arc of the horizon: the part cannot be larger than `p`. A part that is (the clip
+/// joined the points where a sliver leaves and re-enters the hemisphere the long way round the
+/// circle) would be integrated as most of the hemisphere, so it is a give-up,
+/// [`GeomError::Undecidable`]. The check costs two solid angles, only for parts with such an arc.
+fn upper_part(p: &SphericalPolygon) -> Result<SphericalPolygon, GeomError> {
+    let c = p.clip_to_hemisphere(DVec3::Z);
+    let long_arc = c.rings().any(|r| {
+        (0..r.len()).any(|k| {
+            let (a, b) = (r[k], r[(k + 1) % r.len()]);
+            a.z.abs() <= ON_HORIZON && b.z.abs() <= ON_HORIZON && a.angle_between(b) >= LONG_ARC
+        })
+    });
+    if long_arc && !p.is_full() {
+        let (sc, sp) = (c.solid_angle(), p.solid_angle());
+        if sc > sp * (1.0 + 1e-9) + 1e-12 {
+            return Err(GeomError::Undecidable(CLIP_GREW));
+        }
+    }
+    Ok(c)
 }
 
 /// What a region that left the upper hemisphere reports (see [`upper_pieces`]).
