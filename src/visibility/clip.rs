@@ -570,36 +570,46 @@ fn subtract_cut(
     Ok(piece)
 }
 
-/// What a clip that grew its polygon reports (see [`upper_part`]).
-const CLIP_GREW: &str =
-    "the horizon clip of a region returned more than the region within rounding";
+/// What a clip that added part of the horizon outside its polygon reports (see [`upper_part`]).
+const CLIP_LEFT_POLYGON: &str =
+    "the horizon clip of a region added a horizon arc outside the region within rounding";
 
-/// Horizon edges (both ends within this of the horizon, in `z`) at least [`LONG_ARC`] long make
-/// [`upper_part`] check its result.
+/// Both ends of an edge within this of the horizon (in `z`) make it a horizon edge for
+/// [`upper_part`].
 const ON_HORIZON: f64 = 1e-12;
 
-/// See [`ON_HORIZON`]: arcs this long (radians) are what a clip that joins an exit to an entry
-/// the long way round the circle adds; short ones, the common case of a region cut by the
-/// horizon near the point, cost no check.
+/// Horizon edges at least this long (radians) are checked by [`upper_part`]: what a clip that
+/// joins an exit to an entry the long way round the circle adds is this long (its arcs are up to
+/// `2 pi / 3`); the short ones of a region cut by the horizon near the point cost no check.
 const LONG_ARC: f64 = 0.5;
 
+/// How far above a horizon edge's midpoint (radians) [`upper_part`] looks for the region.
+const ABOVE_ARC: f64 = 1e-7;
+
 /// The part of `p` in the upper hemisphere (`clip_to_hemisphere(+z)`), checked where the clip
-/// added a long arc of the horizon: the part cannot be larger than `p`. A part that is (the clip
-/// joined the points where a sliver leaves and re-enters the hemisphere the long way round the
-/// circle) would be integrated as most of the hemisphere, so it is a give-up,
-/// [`GeomError::Undecidable`]. The check costs two solid angles, only for parts with such an arc.
+/// added a long arc of the horizon.
+///
+/// The clipped region lies above each of its horizon edges and inside `p`, so the direction
+/// [`ABOVE_ARC`] above such an edge's midpoint is in `p` (unless `p` is thinner than that there).
+/// A clip that joins the points where a sliver of `p` leaves and re-enters the hemisphere the
+/// long way round the circle breaks this (a whole hemisphere for a sliver, or a ring that runs
+/// over itself along the circle), and would be integrated as a large part of the sky: it is a
+/// give-up, [`GeomError::Undecidable`]. One containment test per long horizon edge.
 fn upper_part(p: &SphericalPolygon) -> Result<SphericalPolygon, GeomError> {
     let c = p.clip_to_hemisphere(DVec3::Z);
-    let long_arc = c.rings().any(|r| {
-        (0..r.len()).any(|k| {
+    if p.is_full() {
+        return Ok(c);
+    }
+    for r in c.rings() {
+        for k in 0..r.len() {
             let (a, b) = (r[k], r[(k + 1) % r.len()]);
-            a.z.abs() <= ON_HORIZON && b.z.abs() <= ON_HORIZON && a.angle_between(b) >= LONG_ARC
-        })
-    });
-    if long_arc && !p.is_full() {
-        let (sc, sp) = (c.solid_angle(), p.solid_angle());
-        if sc > sp * (1.0 + 1e-9) + 1e-12 {
-            return Err(GeomError::Undecidable(CLIP_GREW));
+            if a.z.abs() <= ON_HORIZON
+                && b.z.abs() <= ON_HORIZON
+                && a.angle_between(b) >= LONG_ARC
+                && !p.contains((a + b).normalize() + DVec3::Z * ABOVE_ARC)
+            {
+                return Err(GeomError::Undecidable(CLIP_LEFT_POLYGON));
+            }
         }
     }
     Ok(c)
