@@ -22,6 +22,11 @@ use crate::sphere::SphericalPolygon;
 /// any error of [`SphericalPolygon::boolean`] is a rounding give-up.
 const UNION_FAILED: &str = "the union of a mesh light's front triangles failed within rounding";
 
+/// What a face's piece that grew under subtractions reports (the face-by-face path of
+/// [`ClipVisibility::visible_region`]).
+const DIFFERENCE_GREW: &str =
+    "subtracting blockers from a light face returned more than the face within rounding";
+
 /// What a failed subtraction of a blocker's region reports (as [`UNION_FAILED`]).
 const DIFFERENCE_FAILED: &str =
     "subtracting a blocker's region from a light's region failed within rounding";
@@ -352,7 +357,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             let Some(piece) = triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? else {
                 continue;
             };
-            let mut piece = subtract_all(upper_part(&piece)?, &whole_regions)?;
+            let face_part = upper_part(&piece)?;
+            let mut piece = subtract_all(face_part.clone(), &whole_regions)?;
             for (k, (b, reach)) in straddling.iter().enumerate() {
                 let b = *b;
                 if piece.is_empty() {
@@ -378,6 +384,13 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 piece = subtract_cut(piece, body, false, mesh, f, frame)?;
             }
             if !piece.is_empty() {
+                // Differences only remove: a piece larger than the face's part it started from
+                // is a set operation gone wrong within rounding. The face-by-face path runs many
+                // differences of cut slivers, where the sphere layer is most exposed; two solid
+                // angles per face are small next to them.
+                if piece.solid_angle() > face_part.solid_angle() * (1.0 + 1e-9) + 1e-12 {
+                    return Err(GeomError::Undecidable(DIFFERENCE_GREW));
+                }
                 out.push(piece);
             }
         }
