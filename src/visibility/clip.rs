@@ -270,25 +270,34 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// [`ClipVisibility::visible_region`] with all blockers (`blocked`) or none but the light's
-    /// own triangles, its pieces checked by [`upper_pieces`].
+    /// own triangles. The pieces of the paths that run many set operations on single or cut
+    /// triangles (the per-triangle method, mesh lights, face by face) are checked by
+    /// [`upper_pieces`]; the silhouette of a convex light minus whole silhouettes, the path a
+    /// renderer runs most, costs no check.
     fn region(
         &self,
         light: usize,
         frame: &ShadingFrame,
         blocked: bool,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        upper_pieces(self.region_unchecked(light, frame, blocked)?)
+        let (pieces, checked) = self.region_unchecked(light, frame, blocked)?;
+        if checked {
+            upper_pieces(pieces)
+        } else {
+            Ok(pieces)
+        }
     }
 
+    /// The region and whether its pieces need [`upper_pieces`] (see [`ClipVisibility::region`]).
     fn region_unchecked(
         &self,
         light: usize,
         frame: &ShadingFrame,
         blocked: bool,
-    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+    ) -> Result<(Vec<SphericalPolygon>, bool), GeomError> {
         let body = self.light_body(light)?;
         if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[light]) {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), false));
         }
         let mesh = body.mesh();
         // Step 2: separated blockers (culled ones, behind the light, are not even listed).
@@ -342,7 +351,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 }
                 out.retain(|p| !p.is_empty());
             }
-            return Ok(out);
+            // Checked where pieces came out of set operations on single triangles: differences
+            // (whole blockers) or the union of a non-convex mesh light's front faces.
+            let silhouette = matches!((body, self.method), (Body::Convex(_), Method::Silhouette));
+            let combined =
+                !whole.is_empty() || (matches!(body, Body::Mesh(_)) && !mesh.is_planar());
+            return Ok((out, !silhouette && combined));
         }
         // Step 4: face by face.
         let mut whole_regions = Vec::new();
@@ -394,7 +408,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 out.push(piece);
             }
         }
-        Ok(out)
+        Ok((out, true))
     }
 
     /// How blocker `b` acts on front triangle `f` of light `light` (step 3 of
@@ -610,7 +624,15 @@ const ABOVE_ARC: f64 = 1e-7;
 /// give-up, [`GeomError::Undecidable`]. One containment test per long horizon edge.
 fn upper_part(p: &SphericalPolygon) -> Result<SphericalPolygon, GeomError> {
     let c = p.clip_to_hemisphere(DVec3::Z);
-    if p.is_full() {
+    // Most parts do not touch the horizon at all (a light above it): one pass over the
+    // vertices, without the edge pairs.
+    let mut touches = false;
+    for r in c.rings() {
+        for v in r {
+            touches |= v.z.abs() <= ON_HORIZON;
+        }
+    }
+    if !touches || p.is_full() {
         return Ok(c);
     }
     for r in c.rings() {

@@ -60,8 +60,7 @@ pub fn convex_silhouette(
     let mut contour: SmallVec<[(u32, u32); 24]> = SmallVec::new();
     for e in poly.edges() {
         // Every edge of a convex polyhedron has both faces (checked by `from_mesh`).
-        let Some(f1) = e.f1 else { continue };
-        match (front(s[e.f0 as usize]), front(s[f1 as usize])) {
+        match (front(s[e.f0 as usize]), front(s[e.f1 as usize])) {
             (true, false) => contour.push((e.b, e.a)),
             (false, true) => contour.push((e.a, e.b)),
             _ => {}
