@@ -18,8 +18,8 @@ use std::hint::black_box;
 use std::time::Duration;
 
 // The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
-#[path = "../tests/planar_support/mod.rs"]
-mod planar_support;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
@@ -43,8 +43,8 @@ fn bench(c: &mut Criterion) {
                 .warm_up_time(Duration::from_millis(300))
                 .measurement_time(Duration::from_millis(1200));
             for n in [4usize, 8, 16, 64] {
-                let pa = planar_support::bench_polygon(n, DVec2::ZERO, 0.0, star);
-                let pb = planar_support::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+                let pa = support::planar::bench_polygon(n, DVec2::ZERO, 0.0, star);
+                let pb = support::planar::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
                 let sa = Shape::new(vec![pa.clone()]).unwrap();
                 let sb = Shape::new(vec![pb.clone()]).unwrap();
                 g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {

@@ -44,8 +44,8 @@ pub mod visibility;
 
 /// Items public only for the crate's own tests, benchmarks, fuzz targets and examples: the
 /// planar fast path and robust pipeline called separately, the planar vertex classes, the demo
-/// scene, the reference's RNG, the silhouette and culling helpers. Not part of the API: they may
-/// change or vanish in any release.
+/// scene, the silhouette and culling helpers. Not part of the API: they may change or vanish in
+/// any release.
 #[doc(hidden)]
 pub mod internals {
     pub use crate::planar::boolean::intersect::MAX_PASSES;
@@ -54,7 +54,6 @@ pub mod internals {
         ContactClasses, boolean_fast, boolean_robust, contact_classes,
     };
     pub use crate::shade::demo::{Demo, DemoConfig, demo_scene};
-    pub use crate::shade::reference::Pcg32;
     pub use crate::solid::silhouette::{TriangleRole, convex_silhouette, triangle_polygon};
     pub use crate::visibility::cull::{above_horizon, may_occlude};
 }
