@@ -15,7 +15,7 @@
 //! Groups `planar/resolve/{star,valid}` turn raw rings into shapes under the non-zero rule, for
 //! 16 to 1024 vertices:
 //!
-//! - `star`: one self-intersecting star ring (`planar_support::self_intersecting_star`: every spike's edges cross
+//! - `star`: one self-intersecting star ring (`support::planar::self_intersecting_star`: every spike's edges cross
 //!   the neighbouring spikes', about two crossings per vertex); `arealight` is
 //!   `Shape::with_fill_rule`, `i_overlay` is `simplify_shape` (default i32 grid), `clipper2` is
 //!   the union of the ring as the only subject (`Paths<Fine>`, 2^-30 grid, built per call);
@@ -28,8 +28,8 @@ use std::hint::black_box;
 use std::time::Duration;
 
 // The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
-#[path = "../tests/planar_support/mod.rs"]
-mod planar_support;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, FillRule as Rule, Shape, boolean};
@@ -54,8 +54,8 @@ fn bench(c: &mut Criterion) {
                 .warm_up_time(Duration::from_millis(300))
                 .measurement_time(Duration::from_millis(1200));
             for n in [4usize, 8, 16, 64] {
-                let pa = planar_support::bench_polygon(n, DVec2::ZERO, 0.0, star);
-                let pb = planar_support::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+                let pa = support::planar::bench_polygon(n, DVec2::ZERO, 0.0, star);
+                let pb = support::planar::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
                 let sa = Shape::new(vec![pa.clone()]).unwrap();
                 let sb = Shape::new(vec![pb.clone()]).unwrap();
                 g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {
@@ -117,9 +117,9 @@ fn bench_resolve(c: &mut Criterion) {
             .measurement_time(Duration::from_millis(1500));
         for n in [16usize, 64, 256, 1024] {
             let ring = if star {
-                planar_support::self_intersecting_star(n)
+                support::planar::self_intersecting_star(n)
             } else {
-                planar_support::bench_polygon(n, DVec2::ZERO, 0.0, true)
+                support::planar::bench_polygon(n, DVec2::ZERO, 0.0, true)
             };
             g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {
                 bch.iter(|| {
@@ -138,9 +138,9 @@ fn bench_resolve(c: &mut Criterion) {
             let cr: Vec<(f64, f64)> = ring.iter().map(|p| (p.x, p.y)).collect();
             g.bench_with_input(BenchmarkId::new("clipper2", n), &n, |bch, _| {
                 bch.iter(|| {
-                    let subject: clipper2::Paths<planar_support::Fine> =
+                    let subject: clipper2::Paths<support::planar::Fine> =
                         vec![black_box(&cr).clone()].into();
-                    let none: clipper2::Paths<planar_support::Fine> =
+                    let none: clipper2::Paths<support::planar::Fine> =
                         Vec::<Vec<(f64, f64)>>::new().into();
                     clipper2::union(subject, none, clipper2::FillRule::NonZero).unwrap()
                 })

@@ -10,13 +10,13 @@ use arealight::sdf::{
     TraceLimits, Transformed, UnionAll, fast_soft_shadow, proxy_integral, proxy_quad_integral,
     quilez_improved_shadow, quilez_shadow, sphere_trace,
 };
-use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, Shape, TriangleMesh};
+use arealight::shade::{Body, ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 
 struct Bench {
     field: UnionAll,
-    occluders: Vec<Shape>,
+    occluders: Vec<Body>,
 }
 
 fn scene() -> Bench {
@@ -34,7 +34,7 @@ fn scene() -> Bench {
     ];
     let mut members: Vec<Box<dyn Sdf + Send + Sync>> =
         vec![Box::new(Plane::new(DVec3::ZERO, DVec3::Z).unwrap())];
-    let mut occluders: Vec<Shape> = Vec::new();
+    let mut occluders: Vec<Body> = Vec::new();
     for (c, r, s) in balls {
         members.push(Box::new(Sphere::new(c, r).unwrap()));
         occluders.push(ConvexPolyhedron::icosphere(c, r, s).unwrap().into());

@@ -2,12 +2,22 @@
 
 use core::fmt;
 
-/// Everything that can be wrong with the input of a public entry point.
+/// Everything that can go wrong in a public entry point.
 ///
 /// Every public function validates its input at the boundary and returns one of these instead of
-/// panicking or producing garbage. Locations are given as `(ring, vertex)` indices into the input as
-/// the caller passed it (a planar contour is a ring too), so the message points at the offending
-/// coordinate.
+/// panicking or producing garbage. There are two kinds, told apart by
+/// [`GeomError::is_undecidable`]:
+///
+/// - **Input faults** (every variant but [`GeomError::Undecidable`]): the input is invalid; skip
+///   it or fix it. Locations in vertex lists are `(ring, vertex)` indices into the input as the
+///   caller passed it (a planar contour is a ring too); a single argument that is not a vertex
+///   list (a shading point, a normal, a view direction, a primitive's center or axis) is named
+///   by [`GeomError::NonFiniteArgument`] or [`GeomError::ZeroLengthArgument`].
+/// - **Give-ups** ([`GeomError::Undecidable`]): the input is valid, but a configuration met on
+///   the way cannot be decided within rounding; a renderer falls back for this query.
+///
+/// More variants may be added (`#[non_exhaustive]`); match on the kind with
+/// [`GeomError::is_undecidable`] where only the kind matters.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum GeomError {
@@ -69,6 +79,19 @@ pub enum GeomError {
         /// Index of the second ring.
         other_ring: usize,
     },
+    /// An argument that is not part of a vertex list (a shading point, a normal or view
+    /// direction, a hemisphere's normal, a primitive's center, radii or axis) is NaN or
+    /// infinite.
+    NonFiniteArgument {
+        /// Which argument.
+        what: &'static str,
+    },
+    /// A direction argument (a normal, a view direction, an axis) has zero or subnormal length,
+    /// so it names no direction.
+    ZeroLengthArgument {
+        /// Which argument.
+        what: &'static str,
+    },
     /// A value lies outside the range the algorithm supports; the message names the range.
     OutOfRange {
         /// Which input is out of range.
@@ -103,8 +126,9 @@ pub enum GeomError {
     /// The directions are not contained in any open hemisphere, so no gnomonic projection maps them
     /// all to the plane.
     NotInOpenHemisphere,
-    /// The input is geometrically degenerate in a way the operation cannot resolve; the string
-    /// says how. This is a fault of the input: fix or drop it.
+    /// The input is geometrically degenerate in a way the operation cannot resolve (coplanar
+    /// points for a hull, collinear consecutive contour points, a singular map); the string says
+    /// how. This is a fault of the input: fix or drop it.
     Degenerate(&'static str),
     /// The input is valid, but the computation met a configuration it cannot decide exactly
     /// (near-degenerate within rounding) and declined to guess rather than return a possibly
@@ -184,6 +208,13 @@ impl fmt::Display for GeomError {
                 "rings {ring} and {other_ring} border the same face but disagree on which side is \
                  inside; reverse one of them (outer rings counter-clockwise, holes clockwise)"
             ),
+            GeomError::NonFiniteArgument { what } => {
+                write!(f, "the {what} is NaN or infinite; pass finite values")
+            }
+            GeomError::ZeroLengthArgument { what } => write!(
+                f,
+                "the {what} has zero (or subnormal) length and names no direction"
+            ),
             GeomError::OutOfRange { what, value, limit } => write!(
                 f,
                 "{what} is {value:e}, outside the supported range (magnitude at most {limit:e})"
@@ -246,6 +277,19 @@ impl GeomError {
     #[must_use]
     pub fn is_undecidable(&self) -> bool {
         matches!(self, GeomError::Undecidable(_))
+    }
+}
+
+impl GeomError {
+    /// This error, met on an intermediate result the crate built itself from valid input, as a
+    /// give-up: an [`GeomError::Undecidable`] stays as it is, any other error (a spherical
+    /// polygon the rounding made invalid, a planar operation that did not settle) becomes
+    /// `Undecidable(context)`, since nothing the caller passed was wrong.
+    pub(crate) fn give_up(self, context: &'static str) -> GeomError {
+        match self {
+            GeomError::Undecidable(_) => self,
+            _ => GeomError::Undecidable(context),
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 //! reference: Gauss–Legendre quadrature of the density over the region, the closed-form mass of
 //! an LTC above a plane, or an exact identity.
 
-mod common;
+mod support;
 
 use arealight::glam::{DMat3, DVec3};
 use arealight::ltc::{
@@ -13,8 +13,9 @@ use arealight::ltc::{
     ltc_integral_rational,
 };
 use arealight::sphere::SphericalPolygon;
-use common::{Rng, star_ring, triangle_quadrature};
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{star_ring, triangle_quadrature};
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
@@ -474,7 +475,7 @@ fn grazing_polygon(rng: &mut Rng, cos_v: f64, horizon_vertex: bool) -> Option<Sp
 
 proptest::proptest! {
     #![proptest_config(proptest::prelude::ProptestConfig {
-        cases: common::cases(48),
+        cases: support::cases(48),
         ..proptest::prelude::ProptestConfig::default()
     })]
 

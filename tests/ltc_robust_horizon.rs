@@ -11,7 +11,7 @@
 //! 1): their checks are in the test `exact_clip_paths_are_continuous_across_the_horizon`, ignored
 //! until the sphere layer's fix lands (`cargo test --test ltc_robust_horizon -- --ignored`).
 
-mod common;
+mod support;
 
 use arealight::glam::{DMat3, DVec3};
 use arealight::ltc::{
@@ -20,8 +20,8 @@ use arealight::ltc::{
     ltc_integral_rational,
 };
 use arealight::sphere::SphericalPolygon;
-use common::Rng;
 use std::f64::consts::PI;
+use support::Rng;
 
 /// The clamped-cosine integral `(1 / pi) int max(0, z)` over a convex ring (counter-clockwise
 /// seen from outside, within an open hemisphere, its horizon arc shorter than half a circle):

@@ -8,12 +8,12 @@
 //! The default run shades a few hundred points; `LTC_ROBUST_SCENE_POINTS=20000 cargo test
 //! --release --test ltc_robust_scene -- --nocapture` runs a longer sweep.
 
-mod ltc_common;
+mod support;
 
 use arealight::glam::DVec3;
 use arealight::ltc::lookup;
 use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
-use ltc_common::Rng;
+use support::Rng;
 
 /// A box on or just above the floor `z = 0`, at horizontal distance `dist` from the origin in
 /// direction `phi`.
@@ -44,7 +44,7 @@ fn case(rng: &mut Rng) -> Case {
     let b = low_box(rng, dist * scale, phi + turn);
     let mesh: TriangleMesh = a.mesh().merged(b.mesh()).unwrap();
     let light = Light::new(mesh, DVec3::ONE).unwrap();
-    let (c, _) = a.mesh().bounding_sphere();
+    let c = a.mesh().bounding_sphere().center;
     let occ_half = DVec3::new(
         rng.range(0.1, 1.0),
         rng.range(0.1, 1.0),
@@ -72,7 +72,7 @@ fn points() -> usize {
 
 #[test]
 fn occluders_never_add_light_at_grazing_mirror_views() {
-    let mut rng = Rng(0x5CE4E);
+    let mut rng = Rng::new(0x5CE4E);
     let n = points();
     let (mut shaded, mut undecidable, mut worst_gain, mut worst_bound) = (0, 0, 0f64, 0f64);
     let mut errors: Vec<String> = Vec::new();

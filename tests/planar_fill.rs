@@ -16,7 +16,7 @@
 //! area identities hold with a second resolved shape). 64 cases per property by default,
 //! `PLANAR_CASES=N` for more.
 
-mod planar_support;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::DVec2;
@@ -24,9 +24,9 @@ use arealight::planar::{BoolOp, FillRule, SNAP_REL, Shape, boolean};
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
 use i_overlay::float::single::SingleFloatOverlay;
-use planar_support::*;
 use proptest::prelude::*;
 use proptest::test_runner::FileFailurePersistence;
+use support::planar::*;
 
 const RULES: [FillRule; 4] = [
     FillRule::EvenOdd,

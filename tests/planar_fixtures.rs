@@ -18,7 +18,7 @@
 //!   `"expected"`: an object from operation (`intersection`, `union`, `difference`, `xor`) to
 //!   contours.
 
-mod planar_support;
+mod support;
 
 use std::collections::BTreeMap;
 
@@ -27,7 +27,7 @@ use arealight::planar::{BoolOp, FillRule, Shape, boolean};
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
 use i_overlay::float::single::SingleFloatOverlay;
-use planar_support::*;
+use support::planar::*;
 
 /// A JSON value: just what the fixtures use.
 #[derive(Debug, Clone)]

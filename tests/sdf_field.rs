@@ -14,7 +14,7 @@
 //! table of the CSG operations (the union's surface is each operand's surface outside the other).
 //! A proptest checks that every field, CSG and transform included, is 1-Lipschitz.
 
-mod common;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::{DQuat, DVec3};
@@ -22,9 +22,9 @@ use arealight::sdf::{
     Capsule, Cuboid, Cylinder, Difference, Exactness, Intersection, Plane, RoundedBox, Sdf,
     SmoothUnion, Sphere, Torus, Transformed, Union, UnionAll, normal,
 };
-use common::Rng;
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
 
 /// A dense sample of a surface with its covering radius.
 struct Samples {
@@ -709,7 +709,7 @@ fn zoo(params: &[f64]) -> Vec<Box<dyn Sdf>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(common::cases(300)))]
+    #![proptest_config(ProptestConfig::with_cases(support::cases(300)))]
 
     /// Every field is 1-Lipschitz: `|f(p) - f(q)| <= |p - q|`, at far pairs and at pairs a
     /// hair apart (where a wrong gradient shows).

@@ -2,12 +2,12 @@
 //! RMSE against direct sums, SSIM against its closed form for constant images, against a
 //! separate single-window evaluation written out term by term, and for its basic properties.
 
-mod common;
 #[path = "../examples/sdf_shadows/metrics.rs"]
 mod metrics;
+mod support;
 
-use common::Rng;
 use metrics::{Gray, SIGMA, WINDOW, mae, rmse, ssim};
+use support::Rng;
 
 fn random(rng: &mut Rng, w: usize, h: usize) -> Gray {
     Gray {

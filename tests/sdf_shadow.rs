@@ -10,7 +10,7 @@
 //! - The Quilez shadow against the minimum of `k h / t` over a dense scan of the ray.
 //! - Visibility in `[0, 1]`, and 1 with no occluders, for every method (proptests).
 
-mod common;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::{DQuat, DVec3};
@@ -21,9 +21,9 @@ use arealight::sdf::{
     quilez_improved_shadow, quilez_shadow, smoothstep_visibility,
 };
 use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
-use common::Rng;
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
 
 #[test]
 fn chord_visibility_is_the_visible_share_of_a_cut_disk() {
@@ -74,7 +74,7 @@ fn scene(params: &[f64], floor: bool) -> UnionAll {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(common::cases(150)))]
+    #![proptest_config(ProptestConfig::with_cases(support::cases(150)))]
 
     /// Alg. 2: when the search completes, the true minimum of the clamped `m(t)` over
     /// `[t_min, t_max]` lies in `[m - epsilon, m]`, and `m` is the value at the reported `t`.

@@ -3,15 +3,15 @@
 //! that no trace steps over a surface (a dense march finds no earlier contact), and grazing rays
 //! that the step cap ends every trace.
 
-mod common;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::sdf::{
     Cuboid, Plane, Sdf, Sphere, Trace, TraceLimits, Union, UnionAll, cone_trace, sphere_trace,
 };
-use common::Rng;
 use proptest::prelude::*;
+use support::Rng;
 
 /// First `t >= 0` where `|o + t d - c| = r + r0 + t k` (the cone of radius `r0 + t k` around the
 /// ray touches the ball `(c, r)`), from the quadratic `|w + t d|^2 = (a + t k)^2` with
@@ -187,7 +187,7 @@ fn scene(params: &[f64]) -> UnionAll {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(common::cases(200)))]
+    #![proptest_config(ProptestConfig::with_cases(support::cases(200)))]
 
     /// No trace passes a point where the cone's gap `f - r0 - t k` is negative: a dense march
     /// over the traced range finds none before the reported end.

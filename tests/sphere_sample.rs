@@ -6,12 +6,12 @@
 //! Fixed seeds. Every statistical check is at significance 1e-9 before a Bonferroni factor over
 //! the checks of its test, so a correct sampler fails none of them in practice.
 
-mod common;
+mod support;
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::sphere::{SAMPLE_TOLERANCE, SphericalTriangle};
-use common::Rng;
 use std::f64::consts::PI;
+use support::Rng;
 
 /// A named family of triangles.
 struct Case {

@@ -7,12 +7,13 @@
 
 #[path = "sphere_triangulate_check/mod.rs"]
 mod check;
-mod common;
+mod support;
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::sphere::{PolygonSampler, SphericalPolygon};
-use common::{Rng, assert_mc_agrees, crossed_cells, mc_integral};
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{assert_mc_agrees, crossed_cells, mc_integral};
 
 fn at(c: DVec3, x: f64, y: f64) -> DVec3 {
     let (u, v) = c.any_orthonormal_pair();

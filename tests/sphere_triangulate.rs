@@ -7,13 +7,14 @@
 
 #[path = "sphere_triangulate_check/mod.rs"]
 mod check;
-mod common;
+mod support;
 
 use arealight::glam::DVec3;
 use arealight::planar::BoolOp;
 use arealight::sphere::SphericalPolygon;
-use common::{Rng, star_ring};
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::star_ring;
 
 /// The direction of the point `(x, y)` of the plane tangent at `c` (gnomonic coordinates):
 /// planar shapes keep their combinatorics, and small offsets keep their relative precision.

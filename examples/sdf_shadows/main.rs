@@ -43,7 +43,7 @@ use arealight::sdf::{
     proxy_quad_integral, quilez_improved_shadow, quilez_shadow, sphere_trace,
 };
 use arealight::shade::{
-    ConvexPolyhedron, Light, Material, MonteCarlo, ReferenceBrdf, Scene, Shape, TriangleMesh,
+    Body, ConvexPolyhedron, Light, Material, MonteCarlo, ReferenceBrdf, Scene, TriangleMesh,
 };
 use metrics::{Gray, mae, rmse, ssim};
 use std::path::PathBuf;
@@ -396,7 +396,7 @@ struct Lighting {
 
 fn lighting(kind: LightKind, world: &World, light_tolerance: f64) -> Lighting {
     let center = DVec3::new(0.7, 1.5, 3.0);
-    let (shape, bound, quad): (Shape, SphereLight, Option<QuadLight>) = match kind {
+    let (shape, bound, quad): (Body, SphereLight, Option<QuadLight>) = match kind {
         LightKind::Sphere => {
             let r = 0.45;
             let (s, gap) = subdivisions_for(r, light_tolerance);
@@ -415,7 +415,7 @@ fn lighting(kind: LightKind, world: &World, light_tolerance: f64) -> Lighting {
         }
     };
     let light = || vec![Light::new(shape.clone(), DVec3::ONE).unwrap()];
-    let occ = |keep: &dyn Fn(usize) -> bool| -> Vec<Shape> {
+    let occ = |keep: &dyn Fn(usize) -> bool| -> Vec<Body> {
         world
             .objects
             .iter()

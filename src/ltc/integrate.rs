@@ -30,8 +30,8 @@ impl Ray {
 ///
 /// Always inlined, like [`rational_edge_term`] and [`ClipFree::finish`]: out of line (the
 /// compiler's choice in callers that do not inline the whole integral) the rays and the running
-/// state went through memory, and the reloads of separately stored fields stalled store-to-load
-/// forwarding (see BENCHMARKS.md, "ltc shading", session 4).
+/// state go through memory, and the reloads of separately stored fields stall store-to-load
+/// forwarding (see BENCHMARKS.md, "ltc shading").
 #[inline(always)]
 fn edge_term(a: Ray, b: Ray) -> f64 {
     // Invariant under positive scaling of `a` and `b`, so the endpoints need not be unit vectors.
@@ -344,7 +344,7 @@ fn rational_edge_term(a: Ray, b: Ray) -> f64 {
 /// [`rational_edge_term`] of the two edges `a[k] -> b[k]`, written lane by lane with one branch
 /// for both, so that the compiler evaluates them with two-lane operations (one packed square root
 /// and one packed division for two edges): two edge terms side by side instead of two chains of
-/// scalar ones in a row (see BENCHMARKS.md, session 5). Edges longer than a quarter circle take
+/// scalar ones in a row (see BENCHMARKS.md, "ltc shading"). Edges longer than a quarter circle take
 /// the scalar terms.
 #[inline(always)]
 fn rational_edge_term_pair(a: [Ray; 2], b: [Ray; 2]) -> [f64; 2] {
@@ -858,8 +858,8 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
         return single_ring_sum(quad, map, edge);
     }
     // The images in the run's order, by a match rather than by a computed index: indexing the
-    // array put it through memory, and reloading parts of its stores stalled store-to-load
-    // forwarding (the crossing quad then took 29% longer than in the general loop).
+    // array puts it through memory, and reloading parts of its stores stalls store-to-load
+    // forwarding, enough to make the kernel slower than the general loop.
     let [a0, a1, a2, a3] = match first {
         0 => [v[0], v[1], v[2], v[3]],
         1 => [v[1], v[2], v[3], v[0]],

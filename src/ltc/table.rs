@@ -48,8 +48,8 @@ pub(crate) const CHANNELS: usize = 7;
 /// `(M02, M22)`, then the scalars. (`norm` is not stored: it follows from the matrix and the
 /// albedo, see [`LtcLookup::norm`].) The columns are what a vertex's `x` and `z` are multiplied by,
 /// so each comes out of the bilinear lookup as one two-lane value that the transform uses as it
-/// is; with the rows stored together the compiler shuffled them apart on every lookup (28 more
-/// instructions per shaded quad, see BENCHMARKS.md, session 6).
+/// is; stored by rows, they would have to be shuffled apart on every lookup (see BENCHMARKS.md,
+/// "ltc shading").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Channel {
     /// `M^-1[0][0]` (row, column), with `M^-1` scaled so that its first row `(M00, 0, M02)` is a
@@ -572,7 +572,10 @@ impl LtcTable {
     /// let lean = ltc.density(DVec3::new(-0.6, 0.0, 0.8)) > ltc.density(DVec3::new(0.6, 0.0, 0.8));
     /// assert!(lean);
     /// assert!(l.albedo > 0.0 && l.albedo <= 1.0);
-    /// assert!(table.lookup(f64::NAN, 0.25).is_err());
+    /// assert!(matches!(
+    ///     table.lookup(f64::NAN, 0.25),
+    ///     Err(arealight::GeomError::OutOfRange { what: "cos_theta_v", .. })
+    /// ));
     /// ```
     #[inline]
     pub fn lookup(&self, cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
@@ -665,8 +668,8 @@ fn interpolate<const UPPER: bool>(
     let (w01, w11) = ((1.0 - tx) * ty, tx * ty);
     // Each channel summed in corner order: the compiler then pairs neighbouring channels of a
     // node (one 16-byte load per pair and corner). The balanced sum `(c00 + c10) + (c01 + c11)`
-    // made it pair corners of one channel instead, gathering each operand from two nodes: 137
-    // instead of 115 instructions and about 25% more time per lookup (BENCHMARKS.md, session 6).
+    // makes it pair corners of one channel instead, gathering each operand from two nodes, for
+    // about a fifth more instructions and a quarter more time per lookup (BENCHMARKS.md).
     let mut v = [0.0; 8];
     for (ch, out) in v.iter_mut().enumerate() {
         *out = w00 * c00[ch] + w10 * c10[ch] + w01 * c01[ch] + w11 * c11[ch];

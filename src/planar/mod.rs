@@ -86,20 +86,16 @@
 //! # Ok::<(), arealight::GeomError>(())
 //! ```
 
-mod boolean;
+pub(crate) mod boolean;
 mod contour;
 mod fill;
 mod predicates;
 mod shape;
 mod triangulate;
 
-pub use boolean::intersect::{MAX_PASSES, SNAP_REL};
-pub use boolean::label::VertexClass;
+pub use boolean::intersect::SNAP_REL;
 pub use boolean::trace::SLIVER_REL;
-pub use boolean::{
-    BoolOp, ContactClasses, Workspace, boolean, boolean_fast, boolean_robust, boolean_with,
-    contact_classes,
-};
+pub use boolean::{BoolOp, Workspace, boolean, boolean_with};
 pub use contour::Contour;
 pub use fill::FillRule;
 pub use predicates::MAX_COORD;

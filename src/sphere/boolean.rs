@@ -60,9 +60,10 @@ impl SphericalPolygon {
     ///
     /// # Errors
     ///
-    /// Only when the planar operation cannot resolve a configuration in `f64`
-    /// ([`GeomError::Degenerate`]), or when the merged pieces fail to close into valid rings;
-    /// valid operands in exactly degenerate positions (shared vertices and edges) are supported.
+    /// Only [`GeomError::Undecidable`] (both operands are valid polygons, so nothing else can be
+    /// wrong with the input): when the planar operation cannot resolve a configuration in `f64`,
+    /// or when the merged pieces fail to close into valid rings; valid operands in exactly
+    /// degenerate positions (shared vertices and edges) are supported.
     pub fn boolean(
         &self,
         other: &SphericalPolygon,
@@ -84,13 +85,18 @@ impl SphericalPolygon {
                 // The planar operation could not settle a configuration within rounding in this
                 // projection; the octant split sees it in other coordinates (and usually in
                 // simpler pieces), so it gets a second, deterministic attempt.
-                Err(GeomError::Degenerate(_)) => {}
-                done => return done,
+                Err(GeomError::Degenerate(_) | GeomError::Undecidable(_)) => {}
+                done => return done.map_err(|e| e.give_up(BOOLEAN_FAILED)),
             }
         }
-        split(self, other, op)
+        split(self, other, op).map_err(|e| e.give_up(BOOLEAN_FAILED))
     }
 }
+
+/// What [`SphericalPolygon::boolean`] reports when its pieces fail within rounding in a way that
+/// is not already an [`GeomError::Undecidable`] (a planar contour or a ring the rounding made
+/// invalid).
+const BOOLEAN_FAILED: &str = "a spherical set operation produced an invalid piece within rounding";
 
 /// Results that need no geometry: an empty or full operand.
 fn trivial(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<SphericalPolygon> {
@@ -135,7 +141,7 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
     for ring in q.rings() {
         let mut c = Vec::with_capacity(ring.len());
         for &v in ring {
-            c.push(g.project(v).ok_or(GeomError::Degenerate(
+            c.push(g.project(v).ok_or(GeomError::Undecidable(
                 "a vertex left the projection hemisphere",
             ))?);
         }
@@ -432,8 +438,8 @@ fn cancel_cut_edges(edges: Vec<(DVec3, DVec3)>) -> Result<Vec<(DVec3, DVec3)>, G
                     1 => out.push((p0, p)),
                     -1 => out.push((p, p0)),
                     _ => {
-                        return Err(GeomError::Degenerate(
-                            "octant pieces overlap along a cut; the operands are not valid",
+                        return Err(GeomError::Undecidable(
+                            "octant pieces overlap along a cut; the octant solutions disagree within rounding",
                         ));
                     }
                 }

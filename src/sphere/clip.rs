@@ -62,12 +62,14 @@ impl SphericalPolygon {
     ///
     /// # Errors
     ///
-    /// [`GeomError::NonFinite`] or [`GeomError::ZeroVector`] (ring 0, vertex 0) for the normal.
+    /// [`GeomError::NonFiniteArgument`] or [`GeomError::ZeroLengthArgument`] (`what` is
+    /// `"hemisphere normal"`) for the normal.
     pub fn try_clip_to_hemisphere(&self, normal: DVec3) -> Result<SphericalPolygon, GeomError> {
+        const WHAT: &str = "hemisphere normal";
         if !normal.is_finite() {
-            return Err(GeomError::NonFinite { ring: 0, vertex: 0 });
+            return Err(GeomError::NonFiniteArgument { what: WHAT });
         }
-        let n = normalize_any(normal).ok_or(GeomError::ZeroVector { ring: 0, vertex: 0 })?;
+        let n = normalize_any(normal).ok_or(GeomError::ZeroLengthArgument { what: WHAT })?;
         Ok(clip_polygon(self, n))
     }
 }
@@ -300,8 +302,8 @@ fn entry_turn(scratch: &[DVec3], n: DVec3, to: &Chain) -> f64 {
 /// total signed area is negative (nested rings alternate and are smaller than their parents).
 /// Each ring's shoelace sum is taken about its own first vertex: summing `P_i x P_{i+1}` about the
 /// plane's origin instead adds terms of the size of the ring's distance from `c` times its width,
-/// whose rounding swamps the area of a ring of 1e-8 rad or less (fuzz-like finding: a polygon of
-/// 3e-12 rad clipped to its complement).
+/// whose rounding swamps the area of a ring of 1e-8 rad or less (a polygon of 3e-12 rad clipped
+/// to its complement is such a case).
 fn winds_clockwise_about(poly: &SphericalPolygon, c: DVec3) -> Option<bool> {
     let mut area2 = 0.0;
     for ring in poly.rings() {

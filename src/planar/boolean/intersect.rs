@@ -37,7 +37,7 @@ pub const SNAP_REL: f64 = 64.0 * f64::EPSILON;
 
 /// Bound on the number of splitting passes. In practice the second pass finds nothing new; more
 /// than a handful of passes means the input is pathological (edges almost overlapping over long
-/// stretches), and the operation returns [`GeomError::Degenerate`] instead of looping.
+/// stretches), and the operation returns [`GeomError::Undecidable`] instead of looping.
 pub const MAX_PASSES: usize = 8;
 
 /// The vertices of both operands sorted by x, built once more than a few computed crossings
@@ -92,7 +92,7 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
         apply(a, &mut ins_a, &mut dirty_a);
         apply(b, &mut ins_b, &mut dirty_b);
     }
-    Err(GeomError::Degenerate(
+    Err(GeomError::Undecidable(
         "edge intersections did not settle; the operands have long nearly-overlapping edges",
     ))
 }

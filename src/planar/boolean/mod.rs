@@ -179,9 +179,9 @@ impl Bbox {
 ///
 /// # Errors
 ///
-/// [`GeomError::Degenerate`] when `f64` cannot resolve the configuration consistently (edge
-/// splitting does not settle, or the labels are inconsistent); never for well-separated or exactly
-/// degenerate inputs such as shared edges and vertices.
+/// [`GeomError::Undecidable`] when `f64` cannot resolve the configuration consistently (edge
+/// splitting does not settle, or the result's boundary does not close); never for well-separated
+/// or exactly degenerate inputs such as shared edges and vertices.
 ///
 /// # References
 ///

@@ -185,7 +185,7 @@ pub(crate) fn trace(
             // Each iteration uses one edge, so `n` iterations bound the whole trace.
             steps += 1;
             if steps > n {
-                return Err(GeomError::Degenerate(
+                return Err(GeomError::Undecidable(
                     "result boundary tracing did not terminate; the operands are too close to \
                      degenerate for f64",
                 ));
@@ -231,7 +231,7 @@ pub(crate) fn trace(
                     break;
                 }
                 None => {
-                    return Err(GeomError::Degenerate(
+                    return Err(GeomError::Undecidable(
                         "result boundary does not close; the operands are too close to \
                          degenerate for f64",
                     ));

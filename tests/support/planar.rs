@@ -1,6 +1,5 @@
-//! Helpers shared by the planar integration tests: a compact text format for shapes, the
-//! identity checks, and adapters to the reference clippers (i_overlay, clipper2).
-#![allow(dead_code)]
+//! Planar shapes: a compact text format, the identity checks, generators (proptest strategies
+//! and the benchmark polygons), and adapters to the reference clippers (i_overlay, clipper2).
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
