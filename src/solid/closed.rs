@@ -42,6 +42,14 @@ use crate::sphere::predicates::c3;
 #[derive(Debug, Clone, PartialEq)]
 pub struct ClosedMesh {
     mesh: TriangleMesh,
+    /// Per edge (in [`TriangleMesh::edges`] order), an id shared exactly by the edges that lie
+    /// on one line (their four endpoints collinear, exactly): such edges never cross when seen
+    /// from a point, which the silhouette then knows without evaluating a predicate.
+    line: Vec<u32>,
+    /// Per edge, the vertices known to lie exactly on its line (`on_line[on_line_start[e]..
+    /// on_line_start[e + 1]]`): the endpoints of the edges that share its line id.
+    on_line_start: Vec<u32>,
+    on_line: Vec<u32>,
 }
 
 impl ClosedMesh {
@@ -70,7 +78,29 @@ impl ClosedMesh {
         }
         check_fans(&mesh)?;
         check_self_intersections(&mesh)?;
-        Ok(ClosedMesh { mesh })
+        let line = edge_lines(&mesh);
+        let (on_line_start, on_line) = line_vertices(&mesh, &line);
+        Ok(ClosedMesh {
+            mesh,
+            line,
+            on_line_start,
+            on_line,
+        })
+    }
+
+    /// Whether vertex `v` is known to lie on the line of edge `e` (exactly; `false` may still
+    /// be collinear, when no edge of that line ends at `v`).
+    pub(crate) fn on_edge_line(&self, e: u32, v: u32) -> bool {
+        let (a, b) = (
+            self.on_line_start[e as usize] as usize,
+            self.on_line_start[e as usize + 1] as usize,
+        );
+        self.on_line[a..b].contains(&v)
+    }
+
+    /// The line ids of the edges (see the field).
+    pub(crate) fn edge_lines(&self) -> &[u32] {
+        &self.line
     }
 
     /// The mesh.
@@ -90,6 +120,103 @@ impl AsRef<TriangleMesh> for ClosedMesh {
     fn as_ref(&self) -> &TriangleMesh {
         &self.mesh
     }
+}
+
+/// Line ids of the edges: edges are bucketed by their line's direction and foot point rounded
+/// to about `1e-9` of the mesh's size, and within a bucket grouped when exactly collinear
+/// (`orient2d` on the three coordinate planes). Edges of one line that land in different
+/// buckets keep different ids, which only costs the silhouette exact predicates.
+fn edge_lines(mesh: &TriangleMesh) -> Vec<u32> {
+    let v = mesh.vertices();
+    let edges = mesh.edges();
+    let b = mesh.bounding_sphere();
+    let q = 1e-9 * b.radius.max(f64::MIN_POSITIVE);
+    let key = |i: usize| -> [i64; 6] {
+        let (a, c) = (
+            v[edges[i].a as usize] - b.center,
+            v[edges[i].b as usize] - b.center,
+        );
+        let mut d = (c - a).normalize();
+        let k = if d.x.abs() >= d.y.abs() && d.x.abs() >= d.z.abs() {
+            d.x
+        } else if d.y.abs() >= d.z.abs() {
+            d.y
+        } else {
+            d.z
+        };
+        if k < 0.0 {
+            d = -d;
+        }
+        let foot = a - d * a.dot(d);
+        let r = |x: f64, s: f64| (x / s).round() as i64;
+        [
+            r(d.x, 1e-9),
+            r(d.y, 1e-9),
+            r(d.z, 1e-9),
+            r(foot.x, q),
+            r(foot.y, q),
+            r(foot.z, q),
+        ]
+    };
+    let mut order: Vec<u32> = (0..edges.len() as u32).collect();
+    let keys: Vec<[i64; 6]> = (0..edges.len()).map(key).collect();
+    order.sort_unstable_by_key(|&i| keys[i as usize]);
+    let mut line: Vec<u32> = (0..edges.len() as u32).collect();
+    let mut start = 0;
+    while start < order.len() {
+        let mut end = start + 1;
+        while end < order.len() && keys[order[end] as usize] == keys[order[start] as usize] {
+            end += 1;
+        }
+        for i in start..end {
+            let ei = order[i] as usize;
+            if line[ei] != ei as u32 {
+                continue; // already joined to an earlier edge's line
+            }
+            let (a, c) = (v[edges[ei].a as usize], v[edges[ei].b as usize]);
+            for &ej in &order[i + 1..end] {
+                let ej = ej as usize;
+                let (p, r) = (v[edges[ej].a as usize], v[edges[ej].b as usize]);
+                if on_line(a, c, p) && on_line(a, c, r) {
+                    line[ej] = ei as u32;
+                }
+            }
+        }
+        start = end;
+    }
+    line
+}
+
+/// Per edge, the endpoints of all edges with its line id (see [`ClosedMesh::on_edge_line`]).
+fn line_vertices(mesh: &TriangleMesh, line: &[u32]) -> (Vec<u32>, Vec<u32>) {
+    let edges = mesh.edges();
+    // Endpoints per line id (ids are edge indices).
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); edges.len()];
+    for (e, &l) in edges.iter().zip(line) {
+        let m = &mut members[l as usize];
+        for v in [e.a, e.b] {
+            if !m.contains(&v) {
+                m.push(v);
+            }
+        }
+    }
+    let mut start = Vec::with_capacity(edges.len() + 1);
+    let mut out = Vec::new();
+    start.push(0);
+    for &l in line {
+        let m = &members[l as usize];
+        // An edge alone on its line knows only its own endpoints: nothing to store.
+        if m.len() > 2 {
+            out.extend_from_slice(m);
+        }
+        start.push(out.len() as u32);
+    }
+    (start, out)
+}
+
+/// Whether `p` lies on the line through `a` and `c` (exact).
+fn on_line(a: DVec3, c: DVec3, p: DVec3) -> bool {
+    (0..3).all(|k| orient2d(p2(a, k), p2(c, k), p2(p, k)) == 0.0)
 }
 
 /// Checks that the triangles around each vertex form one fan. In a closed mesh each corner

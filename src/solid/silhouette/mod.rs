@@ -3,10 +3,12 @@
 //! whole or cut by a plane (the per-triangle method), and the silhouette of any closed mesh
 //! (non-convex, thesis 003 section 4.3).
 
+mod bsp;
 mod convex;
 mod nonconvex;
 mod triangle;
 
+pub use bsp::{DEFAULT_REGION_RADII, SilhouetteBsp};
 pub use convex::convex_silhouette;
 pub use nonconvex::nonconvex_silhouette;
 #[allow(unused_imports)]

@@ -36,7 +36,12 @@ use crate::sphere::predicates::c3;
 /// two vectors from the point to mesh vertices), relative to the product of the six lengths:
 /// the normals carry about `4 eps` relative error each and the determinant adds `5 eps`
 /// (`eps = 2^-53`), about `2e-15`; the bound keeps a factor 5 on top.
-const ORDER_ERROR: f64 = 1e-14;
+pub(crate) const ORDER_ERROR: f64 = 1e-14;
+
+/// Relative error bound of `((a - x) x (b - x)) . (c - x)` evaluated in floating point,
+/// relative to `|a - x| |b - x| |c - x|`: the differences, the cross and the dot product carry
+/// a few `eps` each (`eps = 2^-53`); beyond the bound the sign is exact without `orient3d`.
+const CROSS_ERROR: f64 = 1e-14;
 
 /// Angular gap (radians) below which two contour edges leaving a vertex are too close in
 /// direction to be ordered (their tangents carry about `1e-16` of rounding relative to the
@@ -108,7 +113,7 @@ pub fn nonconvex_silhouette(
     frame: &ShadingFrame,
 ) -> Result<SphericalPolygon, GeomError> {
     let mesh = solid.mesh();
-    let outline = outline(mesh, frame.origin())?;
+    let outline = outline(solid, frame.origin())?;
     match &outline {
         Outline::Empty => Ok(SphericalPolygon::empty()),
         Outline::Full => Ok(SphericalPolygon::full()),
@@ -133,6 +138,8 @@ struct Contour {
     t: DVec3,
     /// `s x t`: the normal of the plane through the point and the edge, in the edge's direction.
     n: DVec3,
+    /// `|s| |t|`, the scale of `n`.
+    nlen: f64,
 }
 
 /// A crossing on a contour edge: the other contour edge, the sign `sigma` with which
@@ -169,8 +176,23 @@ fn o3(p: DVec3, q: DVec3, r: DVec3, x: DVec3) -> i8 {
     sign(orient3d(c3(p), c3(q), c3(r), c3(x)))
 }
 
-/// The combinatorial silhouette of `mesh` (closed and validated by the caller) seen from `x`.
-pub(crate) fn outline(mesh: &TriangleMesh, x: DVec3) -> Result<Outline, GeomError> {
+/// The combinatorial silhouette of a solid seen from `x`.
+pub(crate) fn outline(solid: &ClosedMesh, x: DVec3) -> Result<Outline, GeomError> {
+    outline_with(solid, x, None)
+}
+
+/// [`outline`], also reporting, for every contour edge crossed at least twice, its mesh edge
+/// and the mesh edges crossing it (whose order along it the outline depends on).
+pub(crate) fn outline_with(
+    solid: &ClosedMesh,
+    x: DVec3,
+    mut crossed: Option<&mut Vec<(u32, Vec<u32>)>>,
+) -> Result<Outline, GeomError> {
+    if let Some(out) = crossed.as_deref_mut() {
+        out.clear();
+    }
+    let mesh = solid.mesh();
+    let lines = solid.edge_lines();
     let verts = mesh.vertices();
     let mut dist = Vec::new();
     let tol = face_distances(mesh, x, &mut dist);
@@ -203,6 +225,7 @@ pub(crate) fn outline(mesh: &TriangleMesh, x: DVec3) -> Result<Outline, GeomErro
             s,
             t,
             n: s.cross(t),
+            nlen: s.length() * t.length(),
         });
     }
     if contour.is_empty() {
@@ -217,23 +240,74 @@ pub(crate) fn outline(mesh: &TriangleMesh, x: DVec3) -> Result<Outline, GeomErro
     // crossing rule). All four signs are exact.
     let mut crossings: Vec<Vec<Crossing>> = vec![Vec::new(); k];
     let mut next_node = nv;
+    let lens: Vec<(f64, f64)> = contour
+        .iter()
+        .map(|c| (c.s.length(), c.t.length()))
+        .collect();
+    // Bounding caps of the arcs: a minor arc lies within half its angle of its midpoint
+    // direction. (center, cos, sin of the radius)
+    let caps: Vec<(DVec3, f64, f64)> = contour
+        .iter()
+        .zip(&lens)
+        .map(|(c, &(ls, lt))| {
+            let (us, ut) = (c.s / ls, c.t / lt);
+            match (us + ut).try_normalize() {
+                Some(m) if us.dot(ut) > -0.99 => {
+                    let cr = m.dot(us);
+                    (m, cr, crate::math::sqrt((1.0 - cr * cr).max(0.0)))
+                }
+                _ => (DVec3::Z, -1.0, 0.0),
+            }
+        })
+        .collect();
     for i in 0..k {
         let ci = contour[i];
         let (a, b) = (verts[ci.start as usize], verts[ci.end as usize]);
+        let (mi, ci_cos, ci_sin) = caps[i];
         for j in i + 1..k {
             let cj = contour[j];
-            if cj.start == ci.start || cj.start == ci.end || cj.end == ci.start || cj.end == ci.end
+            let (mj, cj_cos, cj_sin) = caps[j];
+            // Disjoint caps (with a margin far above the rounding of the caps): no crossing.
+            if ci_cos > -1.0
+                && cj_cos > -1.0
+                && mi.dot(mj) < ci_cos * cj_cos - ci_sin * cj_sin - 1e-9
             {
                 continue;
             }
+            if cj.start == ci.start
+                || cj.start == ci.end
+                || cj.end == ci.start
+                || cj.end == ci.end
+                || lines[ci.edge as usize] == lines[cj.edge as usize]
+                || solid.on_edge_line(ci.edge, cj.start)
+                || solid.on_edge_line(ci.edge, cj.end)
+                || solid.on_edge_line(cj.edge, ci.start)
+                || solid.on_edge_line(cj.edge, ci.end)
+            {
+                // Shared vertex (handled at the vertex), or one edge's endpoint on the other's
+                // line: its arc meets the other's circle only there, off the other's arc.
+                continue;
+            }
             let (c, d) = (verts[cj.start as usize], verts[cj.end as usize]);
-            let abc = o3(a, b, c, x);
-            let abd = o3(a, b, d, x);
+            // det(a - x, b - x, c - x) ~ n_i . (c - x), exact where the filter decides.
+            let sign_of = |n: DVec3, nlen: f64, w: DVec3, wlen: f64, p, q, r| {
+                let v = n.dot(w);
+                let bound = CROSS_ERROR * nlen * wlen;
+                if v > bound {
+                    1
+                } else if v < -bound {
+                    -1
+                } else {
+                    o3(p, q, r, x)
+                }
+            };
+            let abc = sign_of(ci.n, ci.nlen, cj.s, lens[j].0, a, b, c);
+            let abd = sign_of(ci.n, ci.nlen, cj.t, lens[j].1, a, b, d);
             if abc * abd > 0 {
                 continue;
             }
-            let cda = o3(c, d, a, x);
-            let cdb = o3(c, d, b, x);
+            let cda = sign_of(cj.n, cj.nlen, ci.s, lens[i].0, c, d, a);
+            let cdb = sign_of(cj.n, cj.nlen, ci.t, lens[i].1, c, d, b);
             if cda * cdb > 0 {
                 continue;
             }
@@ -305,6 +379,20 @@ pub(crate) fn outline(mesh: &TriangleMesh, x: DVec3) -> Result<Outline, GeomErro
                 }
                 list.swap(p - 1, p);
                 p -= 1;
+            }
+        }
+    }
+
+    if let Some(out) = crossed {
+        out.clear();
+        for (i, list) in crossings.iter().enumerate() {
+            if list.len() >= 2 {
+                out.push((
+                    contour[i].edge,
+                    list.iter()
+                        .map(|c| contour[c.other as usize].edge)
+                        .collect(),
+                ));
             }
         }
     }
@@ -404,7 +492,7 @@ pub(crate) fn outline(mesh: &TriangleMesh, x: DVec3) -> Result<Outline, GeomErro
 
 /// Whether the points `a`, `b`, `c` lie on one line (exact: the three coordinate-plane
 /// projections of the triangle have zero area).
-fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+pub(crate) fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
     use robust::{Coord, orient2d};
     let xy = |p: DVec3| Coord { x: p.x, y: p.y };
     let yz = |p: DVec3| Coord { x: p.y, y: p.z };
