@@ -207,14 +207,32 @@ fn ray_hits_front(mesh: &TriangleMesh, x: DVec3, w: DVec3) -> Option<bool> {
     Some(hit)
 }
 
+/// Whether the ray from `x` along the world direction `w` lies in the closed cone of a front
+/// triangle, by exact `orient3d` on `x` and `x + w`.
+fn exactly_covered(mesh: &TriangleMesh, x: DVec3, w: DVec3) -> bool {
+    let c = |p: DVec3| robust::Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    };
+    let q = x + w;
+    (0..mesh.triangle_count())
+        .filter(|&f| face_side(mesh, f, x) == Side::Front)
+        .any(|f| {
+            let t = mesh.triangle(f);
+            (0..3).all(|e| robust::orient3d(c(t[e]), c(t[(e + 1) % 3]), c(q), c(x)) <= 0.0)
+        })
+}
+
 /// Checks one silhouette against both references; returns whether the set-operation
-/// reference could be computed.
+/// reference could be computed and agreed.
 fn check(
     name: &str,
     mesh: &TriangleMesh,
     frame: &ShadingFrame,
     sil: &SphericalPolygon,
     rng: &mut Rng,
+    min_directions: usize,
 ) -> bool {
     let x = frame.origin();
     // Valid: the rings rebuild into the same polygon.
@@ -249,20 +267,33 @@ fn check(
         checked += 1;
     }
     assert!(
-        checked >= 40,
+        checked >= min_directions,
         "{name} x {x}: only {checked} directions checked"
     );
     // Symmetric difference with the union of the front triangles.
     match front_union(mesh, frame).and_then(|u| Ok((sil.boolean(&u, BoolOp::Xor)?, u))) {
         Ok((xor, u)) => {
             let area = xor.solid_angle();
+            if area <= 1e-10 * 4.0 * PI {
+                return true;
+            }
+            // The set operations can be wrong themselves (see the ignored test below): decide
+            // with exact cone tests where they disagree with the silhouette.
+            let wrong = (0..2000)
+                .filter(|_| {
+                    let d = rng.dir();
+                    boundary_distance(sil, d) > 1e-9
+                        && sil.contains(d) != exactly_covered(mesh, x, frame.dir_to_world(d))
+                })
+                .count();
             assert!(
-                area <= 1e-10 * 4.0 * PI,
-                "{name} x {x}: symmetric difference {area} (silhouette {}, union {})",
+                wrong == 0,
+                "{name} x {x}: symmetric difference {area} (silhouette {}, union {}); the \
+                 silhouette is wrong at {wrong} of 2000 directions by exact tests",
                 sil.solid_angle(),
                 u.solid_angle()
             );
-            true
+            false
         }
         Err(e) => {
             assert!(e.is_undecidable(), "{name} x {x}: reference failed: {e}");
@@ -286,7 +317,7 @@ fn silhouettes_equal_the_union_of_front_faces() {
                     if sil.ring_count() > 1 {
                         holes += 1;
                     }
-                    if !check(name, mesh, &frame, &sil, &mut rng) {
+                    if !check(name, mesh, &frame, &sil, &mut rng, 40) {
                         reference_failed += 1;
                     }
                 }
@@ -365,7 +396,7 @@ fn degenerate_viewpoints_give_valid_polygons_or_give_ups() {
             match nonconvex_silhouette(solid, &frame) {
                 Ok(sil) => {
                     ok += 1;
-                    check(name, mesh, &frame, &sil, &mut rng);
+                    check(name, mesh, &frame, &sil, &mut rng, 40);
                 }
                 Err(e) => {
                     assert!(e.is_undecidable(), "{name} x {x}: {e}");
@@ -376,4 +407,96 @@ fn degenerate_viewpoints_give_valid_polygons_or_give_ups() {
     }
     eprintln!("degenerate viewpoints: {ok} valid, {gave_up} give-ups");
     assert!(ok > 100);
+}
+
+#[test]
+fn viewpoint_next_to_a_vertex() {
+    // Fuzz finding (solid_silhouette): seen from 5e-8 off a torus vertex, inside, the crossing
+    // and foot points near that vertex were computed from the far end of their edge, as the
+    // small difference of long vectors, and the silhouette was off by a sliver of 1e-8 sr
+    // (about 1e-9 rad wide) against the union of front faces; an exact cone test confirmed
+    // the sliver is not covered. Both points are now computed from the nearer end.
+    let m = torus(1.0, 0.8, 16, 4).unwrap();
+    let r = DMat3::from_quat(arealight::glam::DQuat::from_xyzw(1.0, 1.0, 1.0, 1.0).normalize());
+    let m = TriangleMesh::new(
+        m.vertices().iter().map(|&v| r * v).collect(),
+        m.triangles().to_vec(),
+    )
+    .unwrap();
+    let solid = ClosedMesh::new(m.clone()).unwrap();
+    let size = m.bounding_sphere().radius;
+    let mut rng = Rng::new(5);
+    let mut checked = 0;
+    for t in 0..m.triangle_count() {
+        for exp in [25, 35, 45] {
+            let [a, _, _] = m.triangle(t);
+            for side in [1.0, -1.0] {
+                let x = a + m.triangle_normal(t) * side * size * 2f64.powi(-exp);
+                for view in [DVec3::Z, DVec3::new(-2.0, -2.0, -1.9)] {
+                    let frame = ShadingFrame::new(x, DVec3::Z, view).unwrap();
+                    if let Ok(sil) = nonconvex_silhouette(&solid, &frame)
+                        // Rays from so close to a vertex meet its faces within the ray cast's
+                        // margin: the set operations are the reference here.
+                        && check("torus near a vertex", &m, &frame, &sil, &mut rng, 0)
+                    {
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 400, "{checked}");
+}
+
+#[test]
+#[ignore = "sphere layer: wrong union, found by the solid_silhouette fuzz target (report to the sphere engineers)"]
+fn sphere_union_of_a_near_hemisphere_triangle_and_a_sliver() {
+    // Two front triangles of an extruded star seen from 2.4e-7 off a face: A spans nearly a
+    // hemisphere (two vertices 1.7e-6 from antipodal), B is a 3.4e-7 sr sliver sharing the edge
+    // from A's first to its third vertex. Their union is about 4.05 sr; the sphere layer returns
+    // 8.83 sr (a ring along the x = 0 great circle appears), wrong for 1556 of 4000 random
+    // directions. The silhouette, which uses no set operation, was right there.
+    let a = SphericalPolygon::new(vec![vec![
+        DVec3::new(
+            -4.4481329916957083e-7,
+            -0.9999999999997875,
+            -4.769385735380907e-7,
+        ),
+        DVec3::new(
+            -1.1527555922126974e-6,
+            0.9999999999985718,
+            -1.2360098243789015e-6,
+        ),
+        DVec3::new(
+            0.9398671813687637,
+            0.18472134254898276,
+            -0.28727635996168666,
+        ),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        DVec3::new(
+            0.8597540945310062,
+            -0.4379094511686852,
+            -0.26278928728985607,
+        ),
+        DVec3::new(
+            -4.4481329916957083e-7,
+            -0.9999999999997875,
+            -4.769385735380907e-7,
+        ),
+        DVec3::new(
+            0.9398671813687637,
+            0.18472134254898276,
+            -0.28727635996168666,
+        ),
+    ]])
+    .unwrap();
+    let u = a.boolean(&b, BoolOp::Union).unwrap();
+    let expect = a.solid_angle() + b.solid_angle();
+    assert!(
+        (u.solid_angle() - expect).abs() < 1e-9,
+        "{} vs {expect}",
+        u.solid_angle()
+    );
 }

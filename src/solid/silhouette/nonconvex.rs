@@ -523,12 +523,33 @@ fn on_arc(p: DVec3, a: DVec3, b: DVec3, x: DVec3) -> Result<bool, GeomError> {
 }
 
 /// The crossing of the segment `s -> t` (vectors from the point) with the plane through the
-/// point with normal `n`: `s + u (t - s)` with `u = (n . s) / (n . s - n . t)`.
+/// point with normal `n`: `s + u (t - s)` with `u = (n . s) / (n . s - n . t)`, evaluated from
+/// the end nearer the plane (`u <= 1/2`), so that a crossing near an end close to the point
+/// is not the small difference of two long vectors (its direction would lose the ratio of the
+/// lengths in precision).
 #[inline]
 fn crossing_point(s: DVec3, t: DVec3, n: DVec3) -> DVec3 {
     let (ds, dt) = (n.dot(s), n.dot(t));
-    let u = (ds / (ds - dt)).clamp(0.0, 1.0);
-    s + (t - s) * if u.is_finite() { u } else { 0.5 }
+    let (base, other, db, dother) = if ds.abs() <= dt.abs() {
+        (s, t, ds, dt)
+    } else {
+        (t, s, dt, ds)
+    };
+    let u = (db / (db - dother)).clamp(0.0, 1.0);
+    base + (other - base) * if u.is_finite() { u } else { 0.5 }
+}
+
+/// The foot of the perpendicular from the point to the line through `s` and `t` (vectors from
+/// the point), from the end nearer the point, for the reason of [`crossing_point`].
+#[inline]
+fn foot_point(s: DVec3, t: DVec3) -> DVec3 {
+    let (p, q) = if s.length_squared() <= t.length_squared() {
+        (s, t)
+    } else {
+        (t, s)
+    };
+    let d = q - p;
+    p - d * (p.dot(d) / d.length_squared())
 }
 
 /// Pairs the kept pieces that end at a vertex (`ins`) with those that start there (`outs`):
@@ -715,9 +736,7 @@ pub(crate) fn evaluate_rings(
                 // The foot of the perpendicular from the point to the edge's line lies between
                 // the two ends of an arc wider than 90 degrees.
                 let (s, t) = ends_of(&ring[k]);
-                let d = t - s;
-                let foot = s - d * (s.dot(d) / d.length_squared());
-                if let Some(f) = foot.try_normalize() {
+                if let Some(f) = foot_point(s, t).try_normalize() {
                     out.push(f);
                 }
             }
