@@ -161,6 +161,22 @@ pub enum GeomError {
         /// Index of the vertex in front of it.
         vertex: usize,
     },
+    /// (solid) A mesh that must bound a solid has two triangles that cross, overlap or touch
+    /// anywhere but along an edge or at a vertex they share as neighbours on the surface.
+    SelfIntersectingMesh {
+        /// Index of the first triangle.
+        triangle: usize,
+        /// Index of the second triangle.
+        other: usize,
+    },
+    /// (solid) A mesh that must bound a solid has a vertex whose triangles form more than one
+    /// fan (two parts of the surface touch at the vertex, as two cones tip to tip).
+    NonManifoldVertex {
+        /// Index of the vertex.
+        vertex: usize,
+        /// Index of a triangle of a second fan at that vertex.
+        triangle: usize,
+    },
 }
 
 impl fmt::Display for GeomError {
@@ -258,7 +274,19 @@ impl fmt::Display for GeomError {
             GeomError::OpenMesh { triangle } => write!(
                 f,
                 "triangle {triangle} has an edge not shared by exactly one other triangle running \
-                 the opposite way; a convex polyhedron must be a closed, consistently oriented mesh"
+                 the opposite way; a convex polyhedron or a solid must be a closed, consistently \
+                 oriented mesh"
+            ),
+            GeomError::SelfIntersectingMesh { triangle, other } => write!(
+                f,
+                "triangles {triangle} and {other} cross or touch away from a shared edge or \
+                 vertex: the mesh does not bound a solid; fix the mesh or use it per triangle"
+            ),
+            GeomError::NonManifoldVertex { vertex, triangle } => write!(
+                f,
+                "vertex {vertex} joins separate fans of triangles (triangle {triangle} is in a \
+                 second one): the surface touches itself there; split the vertex or use the mesh \
+                 per triangle"
             ),
             GeomError::NotConvex { face, vertex } => write!(
                 f,

@@ -57,6 +57,7 @@ pub mod internals {
         ContactClasses, boolean_fast, boolean_robust, contact_classes,
     };
     pub use crate::shade::demo::{Demo, DemoConfig, demo_scene};
+    pub use crate::solid::fixtures::{bumpy_sphere, extruded_star, thesis_polyhedra, torus};
     pub use crate::solid::silhouette::{TriangleRole, convex_silhouette, triangle_polygon};
     pub use crate::visibility::cull::{above_horizon, may_occlude};
 }

@@ -13,9 +13,10 @@ use crate::planar::BoolOp;
 use crate::solid::facing::{Side, face_side, snapped_distance};
 use crate::solid::separation::{Separation, separating_plane};
 use crate::solid::silhouette::{
-    TriangleRole, clipped_triangle_polygon, convex_silhouette, triangle_polygon,
+    TriangleRole, clipped_triangle_polygon, convex_silhouette, nonconvex_silhouette,
+    triangle_polygon,
 };
-use crate::solid::{Body, BoundingSphere, ShadingFrame, TriangleMesh};
+use crate::solid::{Body, BoundingSphere, ClosedMesh, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
 
 /// What a failed union of a mesh light's front faces reports: the faces are valid polygons, so
@@ -59,6 +60,9 @@ pub struct ClipVisibility<L> {
     light_bounds: Vec<BoundingSphere>,
     occluder_bounds: Vec<BoundingSphere>,
     method: Method,
+    /// Per light: its mesh validated as a solid ([`ClosedMesh`]) when it is a closed,
+    /// non-planar mesh light that bounds one (then its region is its non-convex silhouette).
+    solids: Vec<Option<ClosedMesh>>,
     /// Per light `i` and blocker slot `j` (occluders first, then lights, see
     /// [`ClipVisibility::slot`]), at `i * blockers + j`: a plane separating the convex hulls of
     /// the two, or `None` when they overlap (the blocker interpenetrates the light, or is the
@@ -83,7 +87,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// Computes, once, a separating plane between every light and every other object (the fast
     /// path of [`ClipVisibility::visible_region`]): `lights x (occluders + lights)`
     /// minimum-norm-point runs, each a few passes over the two vertex lists (and, only for hulls
-    /// that touch, one scan of their face normals).
+    /// that touch, one scan of their face normals); and validates each closed non-planar mesh
+    /// light as a solid ([`ClosedMesh::new`], about `n log n` in its triangle count), which
+    /// lets its region be its silhouette.
     #[must_use]
     pub fn new(lights: Vec<L>, occluders: Vec<Body>) -> Self {
         let light_bounds = lights
@@ -105,12 +111,20 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 });
             }
         }
+        let solids = lights
+            .iter()
+            .map(|l| match l.as_ref() {
+                Body::Mesh(m) if m.is_closed() && !m.is_planar() => ClosedMesh::new(m.clone()).ok(),
+                _ => None,
+            })
+            .collect();
         ClipVisibility {
             lights,
             occluders,
             light_bounds,
             occluder_bounds,
             method: Method::Silhouette,
+            solids,
             separations,
         }
     }
@@ -438,6 +452,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// - a convex light with [`Method::PerTriangle`], or a planar mesh light: each front-facing
     ///   triangle, one piece each (seed 000 section 4.4). Their projections cannot overlap, so
     ///   their integrals add up exactly;
+    /// - a closed mesh light that bounds a solid ([`ClosedMesh`]) with [`Method::Silhouette`]:
+    ///   its silhouette ([`nonconvex_silhouette`], thesis 003 section 4.3), one piece: the union
+    ///   of its front faces' projections without computing a union. Where the silhouette gives
+    ///   up (the point in the plane of a face that bounds it, or on the surface), the union
+    ///   below is computed instead;
     /// - any other mesh light: the union of its front-facing triangles, one piece. The union, not
     ///   the sum, makes a non-convex light's self-occlusion right: where front faces overlap in
     ///   projection, the nearer one is seen, with the same radiance.
@@ -461,13 +480,22 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
         let body = self.light_body(light)?;
-        if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
-            let s = upper_part(&convex_silhouette(p, frame)?)?;
-            return Ok(if s.is_empty() {
+        let one = |s: SphericalPolygon| {
+            if s.is_empty() {
                 Vec::new()
             } else {
                 alloc::vec![s]
-            });
+            }
+        };
+        if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
+            return Ok(one(upper_part(&convex_silhouette(p, frame)?)?));
+        }
+        if let (Some(solid), Method::Silhouette) = (&self.solids[light], self.method) {
+            match nonconvex_silhouette(solid, frame) {
+                Ok(s) => return Ok(one(upper_part(&s)?)),
+                Err(e) if e.is_undecidable() => {}
+                Err(e) => return Err(e),
+            }
         }
         let mesh = body.mesh();
         let mut pieces = Vec::new();

@@ -120,7 +120,7 @@ fn order_edges_of(
 /// Walks directed edges (vertex index pairs) as one loop: `Some(vertex indices)` when every
 /// vertex used has exactly one outgoing edge and the walk from the first edge uses all of them,
 /// `None` otherwise (several loops or pinches: left to the general path).
-fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<SmallVec<[u32; 24]>> {
+pub(crate) fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<SmallVec<[u32; 24]>> {
     const NONE: u32 = u32::MAX;
     if edges.len() < 3 {
         return None;
