@@ -411,7 +411,13 @@ impl SphericalPolygon {
             if group.len() > 1 {
                 let x = group[0].0;
                 let (u, v) = super::predicates::tangent_frame(x);
-                let ang = |p: DVec3| crate::math::atan2(p.dot(v), p.dot(u));
+                // Directions of the neighbours in the tangent plane at x, from the differences
+                // q - x (exact for close points): x . u is zero only to rounding, which would
+                // swamp the direction of an edge shorter than about 1e-13.
+                let ang = |p: DVec3| {
+                    let d = p - x;
+                    crate::math::atan2(d.dot(v), d.dot(u))
+                };
                 let two_pi = 2.0 * PI;
                 for (gi, &(_, ri, pi, ni)) in group.iter().enumerate() {
                     let (lo, span) = (ang(ni), (ang(pi) - ang(ni)).rem_euclid(two_pi));
@@ -442,16 +448,7 @@ impl SphericalPolygon {
     /// well-shaped rings (a square `1e-7` rad across) are accepted.
     fn check_area(&self) -> Result<(), GeomError> {
         for (r, ring) in self.rings().enumerate() {
-            let left = ring_left_area(ring);
-            let area = left.min(4.0 * PI - left);
-            let n = ring.len();
-            let perimeter: f64 = (0..n)
-                .map(|i| {
-                    let (a, b) = (ring[i], ring[(i + 1) % n]);
-                    crate::math::atan2(a.cross(b).length(), a.dot(b))
-                })
-                .sum();
-            if !(area > 1e-12 * perimeter * perimeter) {
+            if is_sliver(ring) {
                 return Err(GeomError::ZeroArea { ring: r });
             }
         }
@@ -502,6 +499,22 @@ impl SphericalPolygon {
         }
         Ok(())
     }
+}
+
+/// Whether a ring's smaller side is below `1e-12` times its squared perimeter: the
+/// [`GeomError::ZeroArea`] criterion of [`SphericalPolygon::new`], which operations also apply
+/// to their results (a ring that thin is dropped as an artifact of rounding).
+pub(crate) fn is_sliver(ring: &[DVec3]) -> bool {
+    let left = ring_left_area(ring);
+    let area = left.min(4.0 * PI - left);
+    let n = ring.len();
+    let perimeter: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            crate::math::atan2(a.cross(b).length(), a.dot(b))
+        })
+        .sum();
+    !(area > 1e-12 * perimeter * perimeter)
 }
 
 /// Ends the ring begun at `start`: drops vertices that coincide with their predecessor, and the
@@ -611,11 +624,14 @@ pub(crate) fn nearest_feature<'a>(
         for i in 0..n {
             let a = ring[i];
             let b = ring[(i + 1) % n];
-            let nrm = a.cross(b);
+            // a x (b - a) = a x b, without the cancellation that would leave a short edge's
+            // normal with a relative error of 1e-16 over its length.
+            let nrm = a.cross(b - a);
             // p's nearest point on the great circle lies inside the arc iff turning from a to p
             // and from p to b both go the arc's way round.
             if a.cross(p).dot(nrm) > 0.0 && p.cross(b).dot(nrm) > 0.0 {
-                let s = p.dot(nrm) / nrm.length(); // sine of the distance to the circle
+                // Sine of the distance to the circle (p - a is exact for close points).
+                let s = (p - a).dot(nrm) / nrm.length();
                 let s2 = (s * s).min(1.0);
                 // Squared chord to the nearest point, 2 - 2 cos(d), without cancellation.
                 let d = 2.0 * s2 / (1.0 + crate::math::sqrt(1.0 - s2));
@@ -628,17 +644,22 @@ pub(crate) fn nearest_feature<'a>(
     Some((d, what.unwrap_or_else(|v| vertex_side(rings, v, p))))
 }
 
-/// Whether `p` (a point, or a tangent direction at `v`) lies inside the region near the vertex
-/// `v`, from every visit of the rings to `v` (a pinch vertex is visited more than once). Around `v`, the sector just counter-clockwise of
-/// an edge direction is inside iff that edge leaves `v` (the interior is on the left of every
-/// edge); so the answer is the kind of the edge met first turning clockwise from `p`.
+/// Whether the point `p` lies inside the region near the vertex `v`, from every visit of the
+/// rings to `v` (a pinch vertex is visited more than once). Around `v`, the sector just
+/// counter-clockwise of an edge direction is inside iff that edge leaves `v` (the interior is on
+/// the left of every edge); so the answer is the kind of the edge met first turning clockwise
+/// from `p`.
 pub(crate) fn vertex_side<'a>(
     rings: impl Iterator<Item = &'a [DVec3]>,
     v: DVec3,
     p: DVec3,
 ) -> bool {
     let (u, w) = super::predicates::tangent_frame(v);
-    let ang = |q: DVec3| crate::math::atan2(q.dot(w), q.dot(u));
+    // Directions in the tangent plane at v from the differences q - v, as in `check_pinches`.
+    let ang = |q: DVec3| {
+        let d = q - v;
+        crate::math::atan2(d.dot(w), d.dot(u))
+    };
     let target = ang(p);
     // (clockwise turn from p's direction to the edge's, edge leaves v)
     let mut best = (f64::INFINITY, false);
