@@ -181,7 +181,8 @@ impl Frame {
     }
 
     fn angle(&self, p: DVec3) -> f64 {
-        crate::math::atan2(p.dot(self.v), p.dot(self.u)).rem_euclid(2.0 * PI)
+        let t = crate::math::atan2(p.dot(self.v), p.dot(self.u));
+        if t < 0.0 { t + 2.0 * PI } else { t }
     }
 
     fn point(&self, angle: f64) -> DVec3 {
@@ -355,10 +356,12 @@ impl Frame {
 /// lying along the circle within [`FLAT_SLOPE`] are snapped too, and result rings thinner than
 /// validation accepts are dropped, so that every result is a valid input.
 fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
-    let frame = Frame::new(n);
     if poly.is_full() {
-        return hemisphere(&frame);
+        return hemisphere(&Frame::new(n));
     }
+    // Built on first use: polygons that do not cross the circle rarely need it.
+    let mut frame_cell: Option<Frame> = None;
+    let mut frame = || *frame_cell.get_or_insert_with(|| Frame::new(n));
 
     let mut out_verts = Verts::new();
     let mut out_ends: SmallVec<[u32; 2]> = SmallVec::new();
@@ -369,9 +372,10 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     let mut split = Verts::new();
     for ring in poly.rings() {
         let mut s: SmallVec<[f64; 12]> = ring.iter().map(|p| p.dot(n)).collect();
-        // Vertices that may be snapped must have short edges (see SNAP_CHORD2).
-        let ring = if s.iter().any(|x| x.abs() <= 2.0 * FLAT_SLOPE) && has_long_edge_near(ring, &s)
-        {
+        // Vertices that may be snapped must have short edges (see SNAP_CHORD2). Without any
+        // vertex that close to the circle (the common case), sides are the signs of heights.
+        let near = s.iter().any(|x| x.abs() <= 2.0 * FLAT_SLOPE);
+        let ring = if near && has_long_edge_near(ring, &s) {
             split_long_edges(ring, &mut split);
             s = split.iter().map(|p| p.dot(n)).collect();
             &split[..]
@@ -379,35 +383,48 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             ring
         };
         let m = ring.len();
-        let side = |i: usize| classify(ring, &s, i);
-        let sides: SmallVec<[Side; 12]> = (0..m).map(side).collect();
-        let n_in = sides.iter().filter(|&&x| x == Side::Above).count();
+        let side = |i: usize| {
+            if near {
+                classify(ring, &s, i)
+            } else if s[i] > 0.0 {
+                Side::Above
+            } else {
+                Side::Below
+            }
+        };
+        let n_in = if near {
+            (0..m).filter(|&i| side(i) == Side::Above).count()
+        } else {
+            s.iter().filter(|&&x| x > 0.0).count()
+        };
         if n_in == m {
             out_verts.extend_from_slice(ring);
             out_ends.push(out_verts.len() as u32);
             continue;
         }
         if n_in == 0 {
-            if sides.iter().all(|&x| x == Side::On) {
+            if (0..m).all(|i| side(i) == Side::On) {
                 // Every vertex on the circle: if the ring winds round it, it is the circle itself
                 // and, counter-clockwise about n, bounds H; otherwise it is a sliver along the
                 // circle, outside H up to the tolerance.
-                if let Some(ccw) = winding_about(ring, &frame) {
+                if let Some(ccw) = winding_about(ring, &frame()) {
                     on_circle_ring = Some(ccw);
                 }
             }
             continue;
         }
+        let frame = frame();
         // Walk from a vertex not above so that every chain is complete within one pass.
-        let first_out = sides.iter().position(|&x| x != Side::Above).unwrap_or(0);
+        let first_out = (0..m).position(|i| side(i) != Side::Above).unwrap_or(0);
         let mut open: Option<(usize, Crossing)> = None;
         for k in 0..m {
             let i = (first_out + k) % m;
             let j = (i + 1) % m;
             let (a, b) = (ring[i], ring[j]);
-            match (sides[i] == Side::Above, sides[j] == Side::Above) {
+            let (si, sj) = (side(i), side(j));
+            match (si == Side::Above, sj == Side::Above) {
                 (false, true) => {
-                    let c = if sides[i] == Side::On {
+                    let c = if si == Side::On {
                         frame.vertex_crossing(a, s[i])
                     } else {
                         frame.edge_crossing(b, a, s[j], s[i])
@@ -418,7 +435,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                 }
                 (true, true) => scratch.push(b),
                 (true, false) => {
-                    let c = if sides[j] == Side::On {
+                    let c = if sj == Side::On {
                         frame.vertex_crossing(b, s[j])
                     } else {
                         frame.edge_crossing(a, b, s[i], s[j])
@@ -443,16 +460,78 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             poly.ring_count() > 0
                 && winds_clockwise_about(poly, n)
                     .or_else(|| winds_clockwise_about(poly, -n))
-                    .unwrap_or_else(|| circle_point_inside(poly, &frame))
+                    .unwrap_or_else(|| circle_point_inside(poly, &frame()))
         });
         if circle_inside {
-            push_circle(&mut out_verts, &mut out_ends, &frame);
+            push_circle(&mut out_verts, &mut out_ends, &frame());
         }
         return finish(out_verts, out_ends);
     }
 
+    let frame = frame();
     let k = chains.len();
-    let order = sorted_crossings(&chains, &frame);
+    let next = if k == 1 {
+        single_chain_gap(&chains[0], &scratch, &frame)
+    } else {
+        join_chains(&chains, &scratch, &frame)
+    };
+    let mut visited: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
+    for first in 0..k {
+        if visited[first] {
+            continue;
+        }
+        let ring_start = out_verts.len();
+        let mut c = first;
+        for _ in 0..k {
+            if visited[c] {
+                break;
+            }
+            visited[c] = true;
+            let ch = &chains[c];
+            out_verts.extend_from_slice(&scratch[ch.start..ch.end]);
+            let (d, gap, from) = next[c];
+            if d == usize::MAX {
+                break;
+            }
+            // Intermediate vertices keep every circle edge a minor arc.
+            let steps = crate::math::floor(gap / MAX_CIRCLE_STEP) as usize + 1;
+            for t in 1..steps {
+                out_verts.push(frame.point(from + gap * t as f64 / steps as f64));
+            }
+            c = d;
+        }
+        close_ring(&mut out_verts, &mut out_ends, ring_start);
+        // A ring cut from the boundary can be thinner than validation accepts (a thin spike or
+        // neck of the input cut by the circle, a chain running just above the circle): such a
+        // ring bounds nothing this crate can resolve and is dropped, as validation would
+        // reject it. Its region, within the circle's hemisphere, is the thin side.
+        if out_ends.last().is_some_and(|&e| e as usize > ring_start)
+            && may_be_sliver(&out_verts[ring_start..], n)
+            && is_sliver(&out_verts[ring_start..])
+            && ring_left_area(&out_verts[ring_start..]) < 2.0 * PI
+        {
+            out_verts.truncate(ring_start);
+            out_ends.pop();
+        }
+    }
+    finish(out_verts, out_ends)
+}
+
+/// The circle arc from the exit of each chain to the entry it joins: `(chain, angle of the
+/// arc, polar angle of the exit)`, or `(usize::MAX, ..)` for none.
+///
+/// Each exit joins the entry that follows it counter-clockwise about `n`. At the exit's own point
+/// (a ring touching the circle at a vertex, a pinch on the circle) the corner rule decides
+/// whether the boundary turns into an entry there at once; otherwise it runs along the circle to
+/// the nearest point holding an entry, where it turns into the entry met first clockwise from
+/// the circle behind it. See [`first_clockwise`] for the corner rule.
+fn join_chains(
+    chains: &[Chain],
+    scratch: &[DVec3],
+    frame: &Frame,
+) -> SmallVec<[(usize, f64, f64); 4]> {
+    let k = chains.len();
+    let order = sorted_crossings(chains, frame);
     // Rank of each crossing's point along the circle (crossings at exactly the same point share
     // one), and angles made consistent with that order: inside [0, pi] or [pi, 2 pi] as the
     // exact half says, non-decreasing along it, equal at equal points.
@@ -460,8 +539,8 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     let mut angle: SmallVec<[f64; 8]> = SmallVec::from_elem(0.0, 2 * k);
     let mut groups = 0usize;
     for (w, &i) in order.iter().enumerate() {
-        let c = crossing(&chains, i);
-        let same = w > 0 && frame.cmp(crossing(&chains, order[w - 1]), c) == Ordering::Equal;
+        let c = crossing(chains, i);
+        let same = w > 0 && frame.cmp(crossing(chains, order[w - 1]), c) == Ordering::Equal;
         if w > 0 && !same {
             groups += 1;
         }
@@ -487,7 +566,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     // decides whether the boundary turns into an entry there at once; otherwise it runs along
     // the circle to the nearest point holding an entry, where it turns into the entry met first
     // clockwise from the circle behind it. See `first_clockwise` for the corner rule.
-    let mut next: SmallVec<[(usize, f64); 4]> = SmallVec::from_elem((usize::MAX, 0.0), k);
+    let mut next: SmallVec<[(usize, f64, f64); 4]> = SmallVec::from_elem((usize::MAX, 0.0, 0.0), k);
     let mut taken: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
     for c in 0..k {
         let (xr, xa) = (rank[2 * c + 1], angle[2 * c + 1]);
@@ -498,7 +577,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
         // circle ahead), the one met first.
         let here = (0..k).filter(|&d| !taken[d] && rank[2 * d] == xr);
         let join = first_clockwise(
-            &frame,
+            frame,
             exit,
             here.filter(|&d| frame.around_sign(exit, first_in(d), arrived) > 0),
             first_in,
@@ -516,7 +595,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                 open().map(ahead).min().and_then(|r| {
                     let at = open().filter(|&d| ahead(d) == r);
                     let d =
-                        first_clockwise(&frame, &chains[at.clone().next()?].entry, at, first_in)?;
+                        first_clockwise(frame, &chains[at.clone().next()?].entry, at, first_in)?;
                     let er = rank[2 * d];
                     let gap = if r == groups {
                         2.0 * PI
@@ -528,55 +607,77 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             }
         };
         if let Some((d, gap)) = choice {
-            next[c] = (d, gap.clamp(0.0, 2.0 * PI));
+            next[c] = (d, gap.clamp(0.0, 2.0 * PI), xa);
             taken[d] = true;
         }
     }
-    let mut visited: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
-    for first in 0..k {
-        if visited[first] {
-            continue;
+    next
+}
+
+/// [`join_chains`] for a single chain, whose exit can only join its own entry: only the arc
+/// between them is to be decided, by the rounded angles where it is clear of both `0` and a full
+/// turn by their error bounds (no order along the circle is needed), else exactly.
+fn single_chain_gap(
+    chain: &Chain,
+    scratch: &[DVec3],
+    frame: &Frame,
+) -> SmallVec<[(usize, f64, f64); 4]> {
+    let (x, e) = (&chain.exit, &chain.entry);
+    let gap = e.angle - x.angle;
+    let gap = if gap < 0.0 { gap + 2.0 * PI } else { gap };
+    let tol = x.err + e.err;
+    let gap = if gap > tol && gap < 2.0 * PI - tol {
+        gap
+    } else {
+        match frame.turn_sign(x.feature, e.feature) {
+            // The entry just after the exit (or just before it): a short arc, or nearly all.
+            1 => gap.min(2.0 * PI - gap),
+            -1 => gap.max(2.0 * PI - gap),
+            // The same point: the corner rule, with the circle ahead as the alternative.
+            _ => {
+                let first_in = |_: usize| scratch[chain.start + 1];
+                let arrived = scratch[chain.end - 2];
+                let join = frame.around_sign(x, first_in(0), arrived) > 0;
+                if join { 0.0 } else { 2.0 * PI }
+            }
         }
-        let ring_start = out_verts.len();
-        let mut c = first;
-        for _ in 0..k {
-            if visited[c] {
-                break;
-            }
-            visited[c] = true;
-            let ch = &chains[c];
-            out_verts.extend_from_slice(&scratch[ch.start..ch.end]);
-            let (d, gap) = next[c];
-            if d == usize::MAX {
-                break;
-            }
-            // Intermediate vertices keep every circle edge a minor arc.
-            let steps = crate::math::floor(gap / MAX_CIRCLE_STEP) as usize + 1;
-            let from = angle[2 * c + 1];
-            for t in 1..steps {
-                out_verts.push(frame.point(from + gap * t as f64 / steps as f64));
-            }
-            c = d;
-        }
-        close_ring(&mut out_verts, &mut out_ends, ring_start);
-        // A ring cut from the boundary can be thinner than validation accepts (a thin spike or
-        // neck of the input cut by the circle, a chain running just above the circle): such a
-        // ring bounds nothing this crate can resolve and is dropped, as validation would
-        // reject it. Its region, within the circle's hemisphere, is the thin side.
-        if out_ends.last().is_some_and(|&e| e as usize > ring_start)
-            && is_sliver(&out_verts[ring_start..])
-            && ring_left_area(&out_verts[ring_start..]) < 2.0 * PI
-        {
-            out_verts.truncate(ring_start);
-            out_ends.pop();
+    };
+    smallvec::smallvec![(0, gap, x.angle)]
+}
+
+/// `false` when a ring of the result is certainly not a sliver ([`is_sliver`]), by a bound that
+/// costs no trigonometry and is conclusive for ordinary rings; `true` leaves it to the exact
+/// criterion.
+///
+/// The ring's region `W` lies in the hemisphere, so its area is at least its shadow on the
+/// circle's plane, `int_W (x . n) dA`, which is the boundary's vector area along `n`:
+/// `1/2 sum theta_i (m_i . n)` over the arcs (angle `theta_i`, unit normal `m_i`). The chord
+/// polygon gives `1/2 sum sin(theta_i) (m_i . n)`; an arc on the circle (both ends on it) only
+/// adds to it (`m_i = n`), any other arc changes it by at most `(theta - sin theta) / 2 <=
+/// theta^3 / 12`, with `theta <= (pi / 2) chord`. The perimeter is at most `(pi / 2)` times the
+/// sum of the chords.
+fn may_be_sliver(ring: &[DVec3], n: DVec3) -> bool {
+    let m = ring.len();
+    let (mut shadow2, mut chords, mut cubes) = (0.0, 0.0, 0.0);
+    for i in 0..m {
+        let (a, b) = (ring[i], ring[(i + 1) % m]);
+        shadow2 += a.cross(b).dot(n);
+        let c = (b - a).length();
+        chords += c;
+        if a.dot(n).abs() > HORIZON_TOLERANCE || b.dot(n).abs() > HORIZON_TOLERANCE {
+            cubes += c * c * c;
         }
     }
-    finish(out_verts, out_ends)
+    let half_pi = 0.5 * PI;
+    let shadow = 0.5 * shadow2 - half_pi * half_pi * half_pi / 12.0 * cubes - 1e-15 * m as f64;
+    let perimeter = half_pi * chords;
+    !(shadow > 1e-12 * perimeter * perimeter)
 }
 
 /// Where vertex `i` of `ring` (with heights `s`) lies against the circle: on it when within
 /// [`HORIZON_TOLERANCE`] or at the end of a flat edge ([`FLAT_SLOPE`]). Vertices this close to
 /// the circle have short edges ([`SNAP_CHORD2`]; the caller splits longer ones).
+#[inline]
 fn classify(ring: &[DVec3], s: &[f64], i: usize) -> Side {
     let x = s[i];
     // Chords are at most 2, so beyond this no edge can be flat: the common case.
@@ -717,8 +818,7 @@ fn winding_about(ring: &[DVec3], frame: &Frame) -> Option<bool> {
 /// 3e-12 rad clipped to its complement). A total within rounding of zero (nested rings of
 /// almost equal areas) decides nothing (`None`).
 fn winds_clockwise_about(poly: &SphericalPolygon, c: DVec3) -> Option<bool> {
-    let mut area2 = 0.0;
-    let mut size = 0.0;
+    let (mut area2, mut size2) = (0.0, 0.0f64);
     for ring in poly.rings() {
         let project = |p: DVec3| {
             let w = p.dot(c);
@@ -729,11 +829,15 @@ fn winds_clockwise_about(poly: &SphericalPolygon, c: DVec3) -> Option<bool> {
         for &p in &ring[1..] {
             let d = project(p)? - origin;
             area2 += prev.cross(d).dot(c);
-            size += prev.length() * d.length();
+            let d2 = d.length_squared();
+            if d2 > size2 {
+                size2 = d2;
+            }
             prev = d;
         }
     }
-    (area2.abs() > 1e-12 * size).then_some(area2 < 0.0)
+    // Each of the (fewer than vertex_count) terms rounds by a few ulps of |prev| |d| <= size2.
+    (area2.abs() > 1e-12 * poly.vertex_count() as f64 * size2).then_some(area2 < 0.0)
 }
 
 /// Whether the clipping circle lies inside the region, when no ring crosses it: the region's side
