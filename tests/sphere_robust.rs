@@ -48,3 +48,245 @@ fn issue24_repro1_vertex_just_above_the_horizon() {
         }
     }
 }
+
+/// Issue 24, reproducer 4: two tiny triangles (about 1e-8 rad across).
+fn repro4() -> (Vec<DVec3>, Vec<DVec3>) {
+    let a = vec![
+        v(
+            -0.8808244660352511,
+            0.4253250368434574,
+            -0.20795882541461533,
+        ),
+        v(
+            -0.8808244652937371,
+            0.4253250372042162,
+            -0.20795882781751376,
+        ),
+        v(-0.880824466703089, 0.4253250344811195, -0.20795882741748045),
+    ];
+    let b = vec![
+        v(-0.8808244647598551, 0.4253250385412877, -0.2079588273441812),
+        v(
+            -0.8808244677441167,
+            0.42532503101018465,
+            -0.2079588301070171,
+        ),
+        v(
+            -0.8808244679380557,
+            0.4253250347805775,
+            -0.20795882157422876,
+        ),
+    ];
+    (a, b)
+}
+
+/// Area of `a op b` for two rings by i_overlay in the gnomonic plane about their center: for
+/// regions within `r` of the center the solid angle is the planar area to `1.5 r^2` relative.
+fn reference_area(
+    a: &[DVec3],
+    b: &[DVec3],
+    rule: i_overlay::core::overlay_rule::OverlayRule,
+) -> f64 {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::float::single::SingleFloatOverlay;
+    let sum: DVec3 = a.iter().chain(b).copied().sum();
+    let g = arealight::sphere::Gnomonic::new(sum).unwrap();
+    let plane = |r: &[DVec3]| -> Vec<[f64; 2]> {
+        r.iter()
+            .map(|&p| {
+                let q = g.project(p).unwrap();
+                [q.x, q.y]
+            })
+            .collect()
+    };
+    let shapes = vec![plane(a)].overlay_as::<i64>(&vec![plane(b)], rule, FillRule::NonZero);
+    let area = |c: &[[f64; 2]]| {
+        0.5 * (1..c.len() - 1)
+            .map(|k| {
+                let (o, p, q) = (c[0], c[k], c[k + 1]);
+                (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
+            })
+            .sum::<f64>()
+    };
+    shapes
+        .iter()
+        .map(|sh| {
+            sh.iter()
+                .enumerate()
+                .map(|(k, c)| area(c).abs() * if k == 0 { 1.0 } else { -1.0 })
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+/// The union of the two tiny triangles had solid angle 4 pi (the test of the far side of the
+/// projection, `contains(-center)`, answered from a feature a half turn away), and the other
+/// operations matched it. Checked against i_overlay in the gnomonic plane.
+#[test]
+fn issue24_repro4_union_of_tiny_triangles() {
+    use arealight::planar::BoolOp;
+    use i_overlay::core::overlay_rule::OverlayRule;
+    let (ra, rb) = repro4();
+    let (a, b) = (
+        SphericalPolygon::new(vec![ra.clone()]).unwrap(),
+        SphericalPolygon::new(vec![rb.clone()]).unwrap(),
+    );
+    for (op, rule) in [
+        (BoolOp::Union, OverlayRule::Union),
+        (BoolOp::Intersection, OverlayRule::Intersect),
+        (BoolOp::Difference, OverlayRule::Difference),
+        (BoolOp::Xor, OverlayRule::Xor),
+    ] {
+        let w = a.boolean(&b, op).unwrap().solid_angle();
+        let expect = reference_area(&ra, &rb, rule);
+        // The vertices carry 1e-16 of rounding over a perimeter of about 3e-8.
+        assert!(
+            (w - expect).abs() <= 1e-22 + 1e-6 * expect,
+            "{op:?}: {w:e} vs {expect:e}"
+        );
+    }
+}
+
+/// `new` rejected the complement of B (its ring reversed) with ZeroArea: the left area of a tiny
+/// clockwise ring, 4 pi - 3e-17, was measured with an absolute error of 1e-15. The complement of
+/// a valid region is valid, and its small side keeps full precision.
+#[test]
+fn issue24_repro4_complement_of_a_tiny_polygon_is_valid() {
+    let (_, rb) = repro4();
+    let b = SphericalPolygon::new(vec![rb.clone()]).unwrap();
+    let mut rev = rb;
+    rev.reverse();
+    let c = SphericalPolygon::new(vec![rev]).expect("the complement of a valid region");
+    assert_eq!(c, b.complement());
+    let w = b.solid_angle();
+    // The complement's complement measures the tiny side again, exactly as B does.
+    assert_eq!(c.complement().solid_angle(), w);
+    assert!((c.solid_angle() - (4.0 * std::f64::consts::PI - w)).abs() <= 2e-15);
+    // Its area within the planar reference (gnomonic plane about B, i_overlay).
+    let expect = reference_area(
+        &repro4().1,
+        &repro4().1,
+        i_overlay::core::overlay_rule::OverlayRule::Union,
+    );
+    assert!((w - expect).abs() <= 1e-6 * expect, "{w:e} vs {expect:e}");
+}
+
+/// `contains` near the boundary of a 1e-8 rad triangle: points 1e-9, 1e-12 and 1e-14 rad off
+/// each edge's midpoint (both sides), and far points (the antipode: outside; for the
+/// complement, inside). The expected side of a point that close to one edge of a convex
+/// triangle and far from the others is the exact orientation of the point against that edge.
+#[test]
+fn issue24_repro4_contains_near_a_tiny_boundary() {
+    let (ra, _) = repro4();
+    let a = SphericalPolygon::new(vec![ra.clone()]).unwrap();
+    let center = ra.iter().copied().sum::<DVec3>().normalize();
+    for p in [a.clone(), a.complement()] {
+        let flip = p != a;
+        for i in 0..3 {
+            let (x, y) = (ra[i], ra[(i + 1) % 3]);
+            let mid = (x + y).normalize();
+            let normal = x.cross(y).normalize();
+            for d in [1e-9, 1e-12, 1e-14, -1e-14, -1e-12, -1e-9] {
+                let q = (mid + normal * d).normalize();
+                let left = robust::orient3d(
+                    robust::Coord3D {
+                        x: x.x,
+                        y: x.y,
+                        z: x.z,
+                    },
+                    robust::Coord3D {
+                        x: y.x,
+                        y: y.y,
+                        z: y.z,
+                    },
+                    robust::Coord3D {
+                        x: q.x,
+                        y: q.y,
+                        z: q.z,
+                    },
+                    robust::Coord3D {
+                        x: 0.0,
+                        y: 0.0,
+                        z: 0.0,
+                    },
+                ) > 0.0;
+                assert_eq!(
+                    p.contains(q),
+                    left != flip,
+                    "edge {i}, offset {d:e}, complement {flip}"
+                );
+            }
+        }
+        assert_eq!(p.contains(-center), flip);
+        assert_eq!(p.contains(center.any_orthonormal_vector()), flip);
+    }
+}
+
+/// A tiny triangle and the antipodal image of another (near antipodal, so no cap holds both:
+/// the operation used to go through the octant split, whose reassembly merged the tiny pieces'
+/// endpoints at 1e-9 and failed with TooFewVertices, InconsistentOrientation or Degenerate).
+/// The operands are disjoint: every result follows from their areas, with complements too.
+#[test]
+fn issue24_repro4_near_antipodal_tiny_pair() {
+    let (ra, rb) = repro4();
+    // As given (1e-8 rad), and shrunk a hundredfold about their center (1e-10 rad).
+    let c = ra.iter().chain(&rb).copied().sum::<DVec3>().normalize();
+    for shrink in [1.0, 0.01] {
+        let scaled = |r: &[DVec3]| -> Vec<DVec3> {
+            r.iter()
+                .map(|&p| (c + (p - c) * shrink).normalize())
+                .collect()
+        };
+        let (ra, rb) = (scaled(&ra), scaled(&rb));
+        // The point reflection reverses orientation; reversing the order restores it.
+        let far: Vec<DVec3> = rb.iter().rev().map(|&p| -p).collect();
+        let (a, b) = (
+            SphericalPolygon::new(vec![ra]).unwrap(),
+            SphericalPolygon::new(vec![far]).unwrap(),
+        );
+        antipodal_pair_follows_from_areas(&a, &b, shrink);
+    }
+}
+
+/// Every operation on disjoint `a`, `b` (and their complements) against the value that
+/// disjointness gives, measured on the result's small side.
+fn antipodal_pair_follows_from_areas(a: &SphericalPolygon, b: &SphericalPolygon, shrink: f64) {
+    use arealight::planar::BoolOp;
+    let (wa, wb) = (a.solid_angle(), b.solid_angle());
+    let tol = 1e-6 * (wa + wb);
+    for (ca, cb) in [(false, false), (true, false), (false, true), (true, true)] {
+        let x = if ca { a.complement() } else { a.clone() };
+        let y = if cb { b.complement() } else { b.clone() };
+        // (small side, whether the result is its complement), from disjointness.
+        let expect = |op: BoolOp| match (op, ca, cb) {
+            (BoolOp::Intersection, false, false) => (0.0, false),
+            (BoolOp::Intersection, true, false) => (wb, false),
+            (BoolOp::Intersection, false, true) => (wa, false),
+            (BoolOp::Intersection, true, true) => (wa + wb, true),
+            (BoolOp::Union, false, false) => (wa + wb, false),
+            (BoolOp::Union, true, false) => (wa, true),
+            (BoolOp::Union, false, true) => (wb, true),
+            (BoolOp::Union, true, true) => (0.0, true),
+            (BoolOp::Difference, false, false) => (wa, false),
+            (BoolOp::Difference, true, false) => (wa + wb, true),
+            (BoolOp::Difference, false, true) => (0.0, false),
+            (BoolOp::Difference, true, true) => (wb, false),
+            (BoolOp::Xor, false, false) | (BoolOp::Xor, true, true) => (wa + wb, false),
+            (BoolOp::Xor, ..) => (wa + wb, true),
+        };
+        for op in [
+            BoolOp::Intersection,
+            BoolOp::Union,
+            BoolOp::Difference,
+            BoolOp::Xor,
+        ] {
+            let what = format!("{op:?}, complements {ca} {cb}, shrink {shrink}");
+            let r = x.boolean(&y, op).unwrap_or_else(|e| panic!("{what}: {e}"));
+            let again = SphericalPolygon::new(r.rings().map(<[DVec3]>::to_vec).collect());
+            assert!(r.is_full() || again.is_ok(), "{what}: {again:?}");
+            let (small, comp) = expect(op);
+            let got = if comp { r.complement() } else { r }.solid_angle();
+            assert!((got - small).abs() <= tol, "{what}: {got:e} vs {small:e}");
+        }
+    }
+}

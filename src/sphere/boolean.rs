@@ -80,13 +80,17 @@ impl SphericalPolygon {
         if let Ok((c, cos_r)) = enclosing_cap(&verts)
             && cos_r >= MIN_CAP_COS
         {
-            match projected(self, other, op, c) {
+            let sin_r = crate::math::sqrt((1.0 - cos_r * cos_r).max(0.0));
+            match projected(self, other, op, c, weld_tolerance(sin_r)) {
                 // The planar operation could not settle a configuration within rounding in this
                 // projection; the octant split sees it in other coordinates (and usually in
                 // simpler pieces), so it gets a second, deterministic attempt.
                 Err(GeomError::Degenerate(_)) => {}
                 done => return done,
             }
+        }
+        if let Some(r) = separated(self, other, op) {
+            return Ok(r);
         }
         split(self, other, op)
     }
@@ -112,6 +116,63 @@ fn trivial(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<Sph
         _ => return None,
     };
     Some(r)
+}
+
+/// Operands whose boundaries lie in disjoint caps (each smaller than a hemisphere): no edge of
+/// one meets the other, so each result ring is a ring of an operand, kept, dropped or reversed,
+/// and the operation is decided exactly by two containment tests. This is how tiny polygons far
+/// apart (near antipodal, for which no cap holds both operands) are combined without the
+/// octant split, whose reassembly merges endpoints at a fixed `1e-9`.
+///
+/// Outside both caps each operand is constant; inside `A`'s cap, `B` is constant and equals its
+/// value at `A`'s center (`a_in_b`), and the other way round. The result's boundary near `A` is
+/// `A`'s rings where the operation depends on `A` there: always for `Xor` (reversed where `B`
+/// holds), for `Intersection` where `B` holds, for `Union` where it does not, and so on. With no
+/// boundary left the result is constant: empty, except for a union of two regions each
+/// containing the other's boundary (full).
+fn separated(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<SphericalPolygon> {
+    let cap = |p: &SphericalPolygon| {
+        let verts: SmallVec<[DVec3; 16]> = p.rings().flatten().copied().collect();
+        enclosing_cap(&verts).ok()
+    };
+    let ((ca, cos_a), (cb, cos_b)) = (cap(a)?, cap(b)?);
+    let angle = |cos: f64| crate::math::atan2(crate::math::sqrt((1.0 - cos * cos).max(0.0)), cos);
+    let between = crate::math::atan2(ca.cross(cb).length(), ca.dot(cb));
+    // The caps' radii are rounded to about 1e-16 (and come out of an iteration stopped at
+    // 1e-15 of optimality): a margin far above that.
+    if !(between > angle(cos_a) + angle(cos_b) + 1e-9) {
+        return None;
+    }
+    let (a_in_b, b_in_a) = (b.contains(ca), a.contains(cb));
+    // For each operand: keep its rings, keep them reversed, or drop them.
+    let (keep_a, keep_b) = match op {
+        BoolOp::Intersection => (a_in_b.then_some(false), b_in_a.then_some(false)),
+        BoolOp::Union => ((!a_in_b).then_some(false), (!b_in_a).then_some(false)),
+        BoolOp::Difference => ((!a_in_b).then_some(false), b_in_a.then_some(true)),
+        BoolOp::Xor => (Some(a_in_b), Some(b_in_a)),
+    };
+    let mut verts = Verts::new();
+    let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
+    for (p, keep) in [(a, keep_a), (b, keep_b)] {
+        let Some(reverse) = keep else { continue };
+        for ring in p.rings() {
+            let start = verts.len();
+            verts.extend_from_slice(ring);
+            if reverse {
+                verts[start..].reverse();
+            }
+            ends.push(verts.len() as u32);
+        }
+    }
+    if ends.is_empty() {
+        let full = op == BoolOp::Union && a_in_b && b_in_a;
+        return Some(if full {
+            SphericalPolygon::full()
+        } else {
+            SphericalPolygon::empty()
+        });
+    }
+    Some(SphericalPolygon::from_parts(verts, ends))
 }
 
 /// One operand in the plane: a bounded shape, and whether the region is its complement (the
@@ -152,14 +213,25 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
 /// mesh vertex can reach a later operation as several copies a few ulps apart (up to about
 /// `1e-13` for vertices far from the projection center); the planar operation must see them as
 /// one vertex, or it meets edges that overlap within rounding but not exactly.
+///
+/// The tolerance shrinks with the operands' extent ([`weld_tolerance`]): vertices near the
+/// projection center carry only the rounding of unit vectors (about `1e-16`), and the operands
+/// of a tiny operation (polygons `1e-10` rad across) must not be distorted by it.
 const WELD_TOLERANCE: f64 = 1e-12;
 
+/// [`WELD_TOLERANCE`] for operands within a cap of radius `r` about the projection center
+/// (`sin r` given): in proportion to the cap from a thousandth of a radian up.
+fn weld_tolerance(sin_r: f64) -> f64 {
+    WELD_TOLERANCE * sin_r.clamp(1e-3, 1.0)
+}
+
 /// Both operands with every vertex replaced by the first vertex (in either operand) within
-/// [`WELD_TOLERANCE`] of it; repeats that this creates along a ring are dropped. `None` when no
+/// `tolerance` of it; repeats that this creates along a ring are dropped. `None` when no
 /// two vertices are that close (the common case), so the operands are used as they are.
 fn weld(
     a: &SphericalPolygon,
     b: &SphericalPolygon,
+    tolerance: f64,
 ) -> Option<(SphericalPolygon, SphericalPolygon)> {
     let all: Vec<DVec3> = a.rings().chain(b.rings()).flatten().copied().collect();
     // Sort by x so that each vertex is compared only with those within the tolerance window.
@@ -168,10 +240,10 @@ fn weld(
     let mut rep: Vec<usize> = (0..all.len()).collect();
     for (k, &i) in order.iter().enumerate() {
         for &j in &order[k + 1..] {
-            if all[j].x - all[i].x > WELD_TOLERANCE {
+            if all[j].x - all[i].x > tolerance {
                 break;
             }
-            if (all[i] - all[j]).length() <= WELD_TOLERANCE {
+            if (all[i] - all[j]).length() <= tolerance {
                 // The earliest vertex (by input position) represents the group.
                 let (ri, rj) = (rep[i], rep[j]);
                 let r = ri.min(rj);
@@ -238,9 +310,10 @@ fn projected(
     b: &SphericalPolygon,
     op: BoolOp,
     c: DVec3,
+    weld_tol: f64,
 ) -> Result<SphericalPolygon, GeomError> {
     let g = Gnomonic::new(c)?;
-    let welded = weld(a, b);
+    let welded = weld(a, b, weld_tol);
     let (a, b) = welded.as_ref().map_or((a, b), |(wa, wb)| (wa, wb));
     let (pa, pb) = (to_plane(a, &g)?, to_plane(b, &g)?);
     let (ca, cb) = (pa.complemented, pb.complemented);
@@ -337,7 +410,7 @@ fn split(
         // holds with a margin (cosine 1/sqrt 3).
         let piece = match trivial(&pa, &pb, op) {
             Some(r) => r,
-            None => projected(&pa, &pb, op, DVec3::new(sx, sy, sz))?,
+            None => projected(&pa, &pb, op, DVec3::new(sx, sy, sz), WELD_TOLERANCE)?,
         };
         for ring in piece.rings() {
             any = true;

@@ -8,7 +8,8 @@ use smallvec::SmallVec;
 
 use super::exact;
 use super::polygon::{
-    SphericalPolygon, Verts, close_ring, is_sliver, nearest_feature, ring_left_area,
+    SphericalPolygon, Verts, close_ring, far_side_inside, is_sliver, nearest_feature,
+    ring_left_area, rings_contain,
 };
 use super::predicates::{normalize_any, orient};
 use crate::GeomError;
@@ -458,8 +459,8 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     if chains.is_empty() {
         let circle_inside = on_circle_ring.unwrap_or_else(|| {
             poly.ring_count() > 0
-                && winds_clockwise_about(poly, n)
-                    .or_else(|| winds_clockwise_about(poly, -n))
+                && far_side_inside(poly.rings(), n)
+                    .or_else(|| far_side_inside(poly.rings(), -n))
                     .unwrap_or_else(|| circle_point_inside(poly, &frame()))
         });
         if circle_inside {
@@ -806,53 +807,19 @@ fn winding_about(ring: &[DVec3], frame: &Frame) -> Option<bool> {
     (total.abs() > PI).then_some(total > 0.0)
 }
 
-/// When every vertex lies strictly inside the open hemisphere about `c`: whether the circle
-/// bounding that hemisphere lies inside the region, else `None`.
-///
-/// In the gnomonic plane about `c` the rings are closed polygons and the circle is at infinity;
-/// the unbounded face is inside the region iff the outermost rings run clockwise, i.e. iff the
-/// total signed area is negative (nested rings alternate and are smaller than their parents).
-/// Each ring's shoelace sum is taken about its own first vertex: summing `P_i x P_{i+1}` about the
-/// plane's origin instead adds terms of the size of the ring's distance from `c` times its width,
-/// whose rounding swamps the area of a ring of 1e-8 rad or less (fuzz-like finding: a polygon of
-/// 3e-12 rad clipped to its complement). A total within rounding of zero (nested rings of
-/// almost equal areas) decides nothing (`None`).
-fn winds_clockwise_about(poly: &SphericalPolygon, c: DVec3) -> Option<bool> {
-    let (mut area2, mut size2) = (0.0, 0.0f64);
-    for ring in poly.rings() {
-        let project = |p: DVec3| {
-            let w = p.dot(c);
-            (w > HORIZON_TOLERANCE).then(|| p / w)
-        };
-        let origin = project(*ring.first()?)?;
-        let mut prev = DVec3::ZERO;
-        for &p in &ring[1..] {
-            let d = project(p)? - origin;
-            area2 += prev.cross(d).dot(c);
-            let d2 = d.length_squared();
-            if d2 > size2 {
-                size2 = d2;
-            }
-            prev = d;
-        }
-    }
-    // Each of the (fewer than vertex_count) terms rounds by a few ulps of |prev| |d| <= size2.
-    (area2.abs() > 1e-12 * poly.vertex_count() as f64 * size2).then_some(area2 < 0.0)
-}
-
 /// Whether the clipping circle lies inside the region, when no ring crosses it: the region's side
 /// at the circle point farthest from the boundary, among 16 evenly spaced ones.
 fn circle_point_inside(poly: &SphericalPolygon, frame: &Frame) -> bool {
-    let mut best = (f64::NEG_INFINITY, false);
+    let mut best = (f64::NEG_INFINITY, frame.u);
     for k in 0..16 {
         let p = frame.point(k as f64 * (PI / 8.0));
-        if let Some((d, inside)) = nearest_feature(poly.rings(), p)
+        if let Some((d, _)) = nearest_feature(poly.rings(), p)
             && d > best.0
         {
-            best = (d, inside);
+            best = (d, p);
         }
     }
-    best.1
+    rings_contain(poly.rings(), best.1)
 }
 
 /// The closed hemisphere about `n` as a polygon: its boundary circle, counter-clockwise about `n`.

@@ -258,10 +258,13 @@ impl SphericalPolygon {
     /// its own vertices (chosen so that no vertex is near its antipode, where the triangle formula
     /// is ill-conditioned); a triangle's area is only defined modulo `4 pi` when its far edge
     /// passes near the apex's antipode, but the sum modulo `4 pi` is exact. The rings' areas add
-    /// up to the region's area modulo `4 pi`. Accuracy: about `1e-15 * n` absolute for `n`
-    /// vertices, and full relative precision for small polygons (the determinant is evaluated on
-    /// edge differences), so a polygon of 1e-6 rad across keeps about 1e-10 relative accuracy,
-    /// which is what its unit-vector vertices determine.
+    /// up to the region's area modulo `4 pi`; they are summed as the signed areas of their
+    /// smaller sides, so that a small region with holes (an annulus 1e-16 sr wide) keeps its
+    /// precision, and a total within its rounding bound of zero is resolved by one point far
+    /// from the boundary (empty or full). Accuracy: about `1e-15 * n` absolute for `n`
+    /// vertices, and full relative precision for small polygons and their complements' small
+    /// sides (the determinant is evaluated on edge differences), so a polygon of 1e-6 rad across
+    /// keeps about 1e-10 relative accuracy, which is what its unit-vector vertices determine.
     #[must_use]
     pub fn solid_angle(&self) -> f64 {
         const FOUR_PI: f64 = 4.0 * PI;
@@ -272,20 +275,36 @@ impl SphericalPolygon {
             0 => 0.0,
             1 => ring_left_area(&self.verts),
             _ => {
-                let total: f64 = self.rings().map(ring_left_area).sum();
-                let omega = total.rem_euclid(FOUR_PI);
-                // Modulo 4 pi, a nearly empty and a nearly full region look alike; one point far
-                // from the boundary tells them apart.
-                let tol = 1e-9;
-                if omega < tol || omega > FOUR_PI - tol {
-                    let full_ish = self.contains(self.far_point());
-                    return match (full_ish, omega < tol) {
-                        (true, true) => FOUR_PI,
-                        (false, false) => 0.0,
-                        _ => omega,
-                    };
+                // The rings' areas add up to the region's modulo 4 pi. Summing their smaller sides
+                // (each with its own relative precision) keeps a small total precise, where the
+                // left areas of holes (4 pi - epsilon each) would swamp it.
+                let (mut total, mut err) = (0.0, 0.0);
+                for ring in self.rings() {
+                    let (a, e) = ring_small_area_err(ring);
+                    total += a;
+                    err += e + f64::EPSILON * total.abs();
                 }
-                omega
+                let r = if (-2.0 * PI..=2.0 * PI).contains(&total) {
+                    total
+                } else {
+                    let left = total.rem_euclid(FOUR_PI);
+                    err += 4.0 * f64::EPSILON * FOUR_PI;
+                    if left > 2.0 * PI {
+                        left - FOUR_PI
+                    } else {
+                        left
+                    }
+                };
+                if r.abs() > err {
+                    return if r > 0.0 { r } else { FOUR_PI + r };
+                }
+                // Within rounding of both the empty and the full region, which look alike modulo
+                // 4 pi: one point far from the boundary tells them apart.
+                if self.contains(self.far_point()) {
+                    FOUR_PI + r.min(0.0)
+                } else {
+                    r.max(0.0)
+                }
             }
         }
     }
@@ -304,7 +323,7 @@ impl SphericalPolygon {
         if self.full {
             return true;
         }
-        nearest_feature(self.rings(), p).is_some_and(|(_, inside)| inside)
+        rings_contain(self.rings(), p)
     }
 
     /// A direction well away from the boundary: the best of the six axis directions.
@@ -480,8 +499,7 @@ impl SphericalPolygon {
                         .find(|p| !rings[i].contains(p))
                         .copied()
                         .unwrap_or_else(|| (rings[j][0] + rings[j][1]).normalize());
-                    side[i * k + j] = nearest_feature(core::iter::once(rings[i]), probe)
-                        .is_some_and(|(_, inside)| inside);
+                    side[i * k + j] = rings_contain(core::iter::once(rings[i]), probe);
                 }
             }
         }
@@ -505,8 +523,7 @@ impl SphericalPolygon {
 /// [`GeomError::ZeroArea`] criterion of [`SphericalPolygon::new`], which operations also apply
 /// to their results (a ring that thin is dropped as an artifact of rounding).
 pub(crate) fn is_sliver(ring: &[DVec3]) -> bool {
-    let left = ring_left_area(ring);
-    let area = left.min(4.0 * PI - left);
+    let area = ring_small_area(ring).abs();
     let n = ring.len();
     let perimeter: f64 = (0..n)
         .map(|i| {
@@ -566,20 +583,122 @@ fn scale_pow2(p: DVec3) -> DVec3 {
 
 /// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
 pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
+    let small = ring_small_area(ring);
+    // A tiny clockwise ring gives -epsilon and maps to 4 pi - epsilon, as it should.
+    if small >= 0.0 {
+        small
+    } else {
+        4.0 * PI + small
+    }
+}
+
+/// The solid angle of a ring's smaller side, positive when that side is on the left (the ring
+/// runs counter-clockwise around it), negative when on the right: in `[-2 pi, 2 pi]`, with full
+/// relative precision for small rings of either orientation.
+///
+/// The fan of Van Oosterom-Strackee triangles gives the left area modulo `4 pi`; for a small
+/// ring that is `+-epsilon` directly, with the relative precision of its edge differences, which
+/// the left area of a clockwise ring (`4 pi - epsilon`, absolute error about `1e-15`) loses.
+pub(crate) fn ring_small_area(ring: &[DVec3]) -> f64 {
+    ring_small_area_with::<false>(ring).0
+}
+
+/// [`ring_small_area`] with a bound on its rounding error: each triangle's determinant on edge
+/// differences rounds by a few ulps of the product of the two edge lengths (bounded by half the
+/// sum of their squares), its angle by that over the denominator, plus the rounding of the
+/// angle and of the sum.
+pub(crate) fn ring_small_area_err(ring: &[DVec3]) -> (f64, f64) {
+    ring_small_area_with::<true>(ring)
+}
+
+fn ring_small_area_with<const ERR: bool>(ring: &[DVec3]) -> (f64, f64) {
     let n = ring.len();
     let apex = fan_apex(ring);
-    let mut sum = 0.0;
+    let (mut sum, mut err) = (0.0, 0.0);
     for i in 0..n {
         let (b, c) = (ring[i], ring[(i + 1) % n]);
         // Triangles through the apex vertex itself are degenerate and contribute exactly zero.
         if b != apex && c != apex {
-            sum += triangle_solid_angle(apex, b, c);
+            let t = triangle_solid_angle(apex, b, c);
+            sum += t;
+            if ERR {
+                let den = 1.0 + apex.dot(b) + b.dot(c) + c.dot(apex);
+                let sides = 0.5 * ((b - apex).length_squared() + (c - apex).length_squared());
+                err += 32.0 * f64::EPSILON * (sides / den.abs() + t.abs() + sum.abs());
+            }
         }
     }
-    // A ring's left area is in (0, 4 pi); the fan gives it modulo 4 pi. A tiny clockwise ring
-    // gives -epsilon and maps to 4 pi - epsilon, as it should.
-    let area = sum.rem_euclid(4.0 * PI);
-    area.clamp(0.0, 4.0 * PI)
+    if (-2.0 * PI..=2.0 * PI).contains(&sum) {
+        return (sum, err);
+    }
+    let left = sum.rem_euclid(4.0 * PI);
+    let small = if left > 2.0 * PI {
+        left - 4.0 * PI
+    } else {
+        left
+    };
+    (small, err + 8.0 * f64::EPSILON * 4.0 * PI)
+}
+
+/// Whether the unit vector `p` lies in the region bounded by `rings` (none: no region): the test
+/// of [`SphericalPolygon::contains`], also for a subset of a polygon's rings (one ring alone
+/// bounds the region on its left).
+///
+/// The side of the nearest boundary feature decides, where it is well-conditioned: within a
+/// quarter turn (squared chord at most 2). Farther away (for a tiny polygon all features are
+/// then almost equally far, and the direction from each towards `p` is almost normal to the
+/// sphere) every vertex lies in the open hemisphere about `-p`, whose gnomonic plane holds the
+/// whole boundary with `p` at infinity: `p` is inside iff the outermost rings run clockwise
+/// there ([`far_side_inside`]).
+pub(crate) fn rings_contain<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]> + Clone,
+    p: DVec3,
+) -> bool {
+    let Some((d, inside)) = nearest_feature(rings.clone(), p) else {
+        return false;
+    };
+    if d <= 2.0 {
+        return inside;
+    }
+    far_side_inside(rings, -p).unwrap_or(inside)
+}
+
+/// When every vertex of `rings` lies in the open hemisphere about `c` (by more than
+/// [`super::HORIZON_TOLERANCE`]): whether the region contains the far side of that hemisphere
+/// (its bounding circle and `-c`), else `None`.
+///
+/// In the gnomonic plane about `c` the rings are closed polygons and the far side is at
+/// infinity; the unbounded face is inside the region iff the outermost rings run clockwise,
+/// i.e. iff the total signed area is negative (nested rings alternate and are smaller than their
+/// parents). Each ring's shoelace sum is taken about its own first vertex: summing
+/// `P_i x P_{i+1}` about the plane's origin instead adds terms of the size of the ring's distance
+/// from `c` times its width, whose rounding swamps the area of a ring of 1e-8 rad or less. A
+/// total within rounding of zero (nested rings of almost equal areas) decides nothing (`None`).
+pub(crate) fn far_side_inside<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    c: DVec3,
+) -> Option<bool> {
+    let (mut area2, mut size2, mut terms) = (0.0, 0.0f64, 0usize);
+    for ring in rings {
+        let project = |p: DVec3| {
+            let w = p.dot(c);
+            (w > super::HORIZON_TOLERANCE).then(|| p / w)
+        };
+        let origin = project(*ring.first()?)?;
+        let mut prev = DVec3::ZERO;
+        for &p in &ring[1..] {
+            let d = project(p)? - origin;
+            area2 += prev.cross(d).dot(c);
+            let d2 = d.length_squared();
+            if d2 > size2 {
+                size2 = d2;
+            }
+            prev = d;
+        }
+        terms += ring.len();
+    }
+    // Each term rounds by a few ulps of |prev| |d| <= size2.
+    (area2.abs() > 1e-12 * terms as f64 * size2).then_some(area2 < 0.0)
 }
 
 /// The fan apex for [`ring_left_area`]: the first vertex when no vertex lies near its antipode
