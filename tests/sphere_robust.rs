@@ -290,3 +290,134 @@ fn antipodal_pair_follows_from_areas(a: &SphericalPolygon, b: &SphericalPolygon,
         }
     }
 }
+
+/// Issue 24, reproducer 5: B is A with vertex 1 moved by 2e-12 (inside A). A - B is the sliver
+/// between the two paths a0 -> a1 -> a2 and a0 -> b1 -> a2, of area
+/// `area(a0, a1, a2) - area(a0, b1, a2)` (about 9e-13 sr) over a perimeter of about 3.5 rad:
+/// thinner than validation's ZeroArea limit, and the boolean's resolution (it welds vertex
+/// copies 1e-11 apart) makes B equal to A. The result used to be a ring that `new` rejected as
+/// SelfIntersecting (a 4e-13 rad wedge at a2). Whatever the result, it must be a valid input,
+/// and within the documented resolution of the exact sliver.
+#[test]
+fn issue24_repro5_difference_of_a_polygon_and_its_jittered_copy() {
+    use arealight::planar::BoolOp;
+    let a = vec![
+        v(0.10233659699160604, 0.25398986142578966, 0.9617777140322425),
+        v(0.39331240650366617, 0.7847612292732739, 0.4790147846567948),
+        v(-0.3058421822761067, 0.8568233840972002, 0.4151075137898743),
+    ];
+    let mut b = a.clone();
+    b[1] = v(0.3933124065018691, 0.7847612292738442, 0.47901478465733544);
+    let (pa, pb) = (
+        SphericalPolygon::new(vec![a.clone()]).unwrap(),
+        SphericalPolygon::new(vec![b.clone()]).unwrap(),
+    );
+    // The exact sliver, by Van Oosterom-Strackee on the two triangles sharing a0 and a2.
+    let tri = |p: DVec3, q: DVec3, r: DVec3| {
+        let (p, q, r) = (p.normalize(), q.normalize(), r.normalize());
+        2.0 * p
+            .dot((q - p).cross(r - p))
+            .atan2(1.0 + p.dot(q) + q.dot(r) + r.dot(p))
+    };
+    let sliver = tri(a[0], a[1], a[2]) - tri(b[0], b[1], b[2]);
+    assert!(sliver > 0.0 && sliver < 1e-12, "{sliver:e}");
+    for op in [
+        BoolOp::Difference,
+        BoolOp::Xor,
+        BoolOp::Intersection,
+        BoolOp::Union,
+    ] {
+        let r = pa.boolean(&pb, op).unwrap();
+        r.validate()
+            .unwrap_or_else(|e| panic!("{op:?}: {e}: {r:?}"));
+        let again = SphericalPolygon::new(r.rings().map(<[DVec3]>::to_vec).collect());
+        assert!(again.is_ok(), "{op:?}: {again:?}");
+        // B lies inside A.
+        let expect = match op {
+            BoolOp::Difference | BoolOp::Xor => sliver,
+            BoolOp::Intersection => pb.solid_angle(),
+            BoolOp::Union => pa.solid_angle(),
+        };
+        // Snap rounding at 1e-11 moves edges by at most that: the area by that times their
+        // length (3.5 rad per operand).
+        assert!(
+            (r.solid_angle() - expect).abs() <= 1e-11 * 7.0,
+            "{op:?}: {:e} vs {expect:e}",
+            r.solid_angle()
+        );
+    }
+}
+
+/// Issue 24, reproducer 5: the seed's per-triangle workflow over a planar grid whose triangles
+/// carry their own copies of the shared vertices, jittered by 1e-12 (relative): a quad light
+/// minus each of the 72 triangles in turn. Used to fail with SelfIntersecting and
+/// Degenerate("edge intersections did not settle"). Every intermediate result must be a valid
+/// input, and the final one the light minus the grid's outline (exact, unjittered) up to the
+/// jitter times the edges' length.
+#[test]
+fn issue24_repro5_per_triangle_chain_over_a_jittered_grid() {
+    use arealight::planar::BoolOp;
+    let light = SphericalPolygon::new(vec![vec![
+        v(-1.0, -1.0, 3.0),
+        v(1.0, -1.0, 3.0),
+        v(1.0, 1.0, 3.0),
+        v(-1.0, 1.0, 3.0),
+    ]])
+    .unwrap();
+    // A fixed pseudo-random jitter (SplitMix64), 1e-12 of the distance in each coordinate.
+    let mut state = 24u64;
+    let mut jitter = |p: DVec3| {
+        let mut unit = || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        p + v(unit(), unit(), unit()) * 1e-12 * p.length()
+    };
+    let k = 6;
+    let corner = |i: usize, j: usize| {
+        v(
+            -0.7 + 1.1 * i as f64 / k as f64,
+            -0.4 + 0.9 * j as f64 / k as f64,
+            1.8,
+        )
+    };
+    let mut chain = light.clone();
+    let mut edges = 0.0;
+    for i in 0..k {
+        for j in 0..k {
+            let quad = [
+                corner(i, j),
+                corner(i + 1, j),
+                corner(i + 1, j + 1),
+                corner(i, j + 1),
+            ];
+            for t in [[0, 1, 2], [0, 2, 3]] {
+                let tri: Vec<DVec3> = t.iter().map(|&c| jitter(quad[c])).collect();
+                let tri = SphericalPolygon::new(vec![tri]).unwrap();
+                edges += 3.0 * 0.2;
+                chain = chain
+                    .boolean(&tri, BoolOp::Difference)
+                    .unwrap_or_else(|e| panic!("cell ({i}, {j}): {e}"));
+                chain
+                    .validate()
+                    .unwrap_or_else(|e| panic!("cell ({i}, {j}): {e}: {chain:?}"));
+            }
+        }
+    }
+    let outline = SphericalPolygon::new(vec![vec![
+        corner(0, 0),
+        corner(k, 0),
+        corner(k, k),
+        corner(0, k),
+    ]])
+    .unwrap();
+    let expect = light
+        .boolean(&outline, BoolOp::Difference)
+        .unwrap()
+        .solid_angle();
+    let w = chain.solid_angle();
+    assert!((w - expect).abs() <= 1e-11 * edges, "{w} vs {expect}");
+}

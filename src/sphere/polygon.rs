@@ -120,6 +120,88 @@ impl SphericalPolygon {
         Ok(poly)
     }
 
+    /// Checks every invariant that [`SphericalPolygon::new`] establishes and that every result of
+    /// the crate's operations keeps: unit vertices (to within `1e-14`), rings of at least three vertices with no two
+    /// consecutive ones coincident or antipodal, rings simple, disjoint except at shared
+    /// vertices and not folding back on themselves (exact predicates, and the `1e-12` rad fold
+    /// test), no ring thinner than [`GeomError::ZeroArea`] allows, and consistent orientation.
+    /// Equivalently: `SphericalPolygon::new(p.rings().map(<[_]>::to_vec).collect())` succeeds
+    /// and gives `p` back.
+    ///
+    /// This is the one invariant checker shared by the tests and the fuzz targets. It costs
+    /// about `n log n` in the number of edges (a sweep over their bounding boxes) plus the
+    /// exact tests of the pairs it finds.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::planar::BoolOp;
+    /// use arealight::sphere::SphericalPolygon;
+    ///
+    /// let a = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, DVec3::Z]])?;
+    /// // B is A with one vertex moved by 2e-12: A - B is a sliver no operation can resolve.
+    /// let moved = (DVec3::Y + DVec3::new(1e-12, 0.0, 1e-12)).normalize();
+    /// let b = SphericalPolygon::new(vec![vec![DVec3::X, moved, DVec3::Z]])?;
+    /// let d = a.boolean(&b, BoolOp::Difference)?;
+    /// d.validate()?; // every result is a valid input
+    /// assert!(d.solid_angle() < 1e-11);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// The first violated invariant, as the error [`SphericalPolygon::new`] would report for it,
+    /// or [`GeomError::Degenerate`] for storage that no input could have produced (a vertex
+    /// that is not a unit vector, the full sphere with rings).
+    pub fn validate(&self) -> Result<(), GeomError> {
+        if self.full {
+            return if self.ends.is_empty() && self.verts.is_empty() {
+                Ok(())
+            } else {
+                Err(GeomError::Degenerate("the full sphere has rings"))
+            };
+        }
+        let mut start = 0usize;
+        for (r, &end) in self.ends.iter().enumerate() {
+            let end = end as usize;
+            if end < start || end > self.verts.len() {
+                return Err(GeomError::Degenerate("ring bounds out of order"));
+            }
+            let ring = &self.verts[start..end];
+            let n = ring.len();
+            for (i, p) in ring.iter().enumerate() {
+                if !p.is_finite() {
+                    return Err(GeomError::NonFinite { ring: r, vertex: i });
+                }
+                // Unit to within a few dozen ulps (points made on a circle from a rounded frame
+                // carry a few): every use is scale-invariant or far coarser than that.
+                if !((p.length_squared() - 1.0).abs() <= 1e-14) {
+                    return Err(GeomError::Degenerate("a vertex is not a unit vector"));
+                }
+            }
+            if n < 3 {
+                return Err(GeomError::TooFewVertices { ring: r, count: n });
+            }
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                if (a - b).length() <= COINCIDENT_TOLERANCE {
+                    return Err(GeomError::CoincidentVertices { ring: r, vertex: i });
+                }
+                if (a + b).length() <= ANTIPODAL_TOLERANCE {
+                    return Err(GeomError::AntipodalVertices { ring: r, vertex: i });
+                }
+            }
+            start = end;
+        }
+        if start != self.verts.len() {
+            return Err(GeomError::Degenerate("vertices after the last ring"));
+        }
+        self.check_simple(&self.verts)?;
+        self.check_area()?;
+        self.check_consistent()
+    }
+
     /// The empty region (no rings).
     #[must_use]
     pub fn empty() -> Self {
@@ -347,7 +429,8 @@ impl SphericalPolygon {
     fn check_simple(&self, raw: &[DVec3]) -> Result<(), GeomError> {
         // Every edge as (ring, index in ring, start, end), with start and end as indices into
         // `verts` (unit vectors) and `raw` (exactly scaled input).
-        let mut edges: Vec<(usize, usize, usize, usize)> = Vec::with_capacity(self.verts.len());
+        let mut edges: SmallVec<[(usize, usize, usize, usize); 32]> =
+            SmallVec::with_capacity(self.verts.len());
         let mut start = 0usize;
         for (r, &end) in self.ends.iter().enumerate() {
             let end = end as usize;
@@ -362,8 +445,24 @@ impl SphericalPolygon {
             other_ring: s,
         };
         let v = &self.verts;
-        for (k, &(r, i, a, b)) in edges.iter().enumerate() {
-            for &(s, j, c, d) in &edges[k + 1..] {
+        // Only arcs whose bounding boxes overlap can meet: boxes of the endpoints grown by the
+        // arc's sagitta 1 - |a + b| / 2 (the farthest a minor arc strays from its chord), with a
+        // margin for rounding.
+        let boxes: SmallVec<[(DVec3, DVec3); 32]> = edges
+            .iter()
+            .map(|&(_, _, a, b)| {
+                let (p, q) = (v[a], v[b]);
+                let grow = DVec3::splat((1.0 - 0.5 * (p + q).length()).max(0.0) + 1e-15);
+                (p.min(q) - grow, p.max(q) + grow)
+            })
+            .collect();
+        let overlap = |k: usize, l: usize| {
+            let (bk, bl) = (boxes[k], boxes[l]);
+            !(bl.0.cmpgt(bk.1).any() || bk.0.cmpgt(bl.1).any())
+        };
+        let check = |k: usize, l: usize| -> Result<(), GeomError> {
+            let ((r, i, a, b), (s, j, c, d)) = (edges[k], edges[l]);
+            {
                 let n = self.ring_len(r);
                 let consecutive = r == s && (j == (i + 1) % n || i == (j + 1) % n);
                 // A shared endpoint (the same direction) is allowed; the two edges may not leave
@@ -385,11 +484,10 @@ impl SphericalPolygon {
                         // Within rounding of the same direction counts as overlapping: a spike
                         // narrower than 1e-12 rad has no side any later operation can resolve
                         // (an exactly collinear spike in the caller's coordinates is no longer
-                        // exactly collinear once normalized).
+                        // exactly collinear once normalized, hence the test on those too).
                         let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
-                        let parallel = orient(raw[xi], raw[pi], raw[qi]) == 0
-                            || tp.cross(tq).length() <= 1e-12 * tp.length() * tq.length();
-                        if parallel && tp.dot(tq) > 0.0 {
+                        let exact_fold = tp.dot(tq) > 0.0 && orient(raw[xi], raw[pi], raw[qi]) == 0;
+                        if exact_fold || folds_back(p, x, q) {
                             return Err(err(r, s));
                         }
                         // The far ends may still meet the other edge (two edges sharing both
@@ -402,6 +500,38 @@ impl SphericalPolygon {
                         }
                     }
                 }
+            }
+            Ok(())
+        };
+        let ne = edges.len();
+        if ne <= 48 {
+            // Few edges (the common case): every pair, in input order.
+            for k in 0..ne {
+                for l in k + 1..ne {
+                    if overlap(k, l) {
+                        check(k, l)?;
+                    }
+                }
+            }
+        } else {
+            // A sweep along x, then the pairs found in input order, so that the first violation
+            // reported is the first in the input.
+            let mut order: Vec<usize> = (0..ne).collect();
+            order.sort_by(|&x, &y| boxes[x].0.x.total_cmp(&boxes[y].0.x));
+            let mut pairs: Vec<(usize, usize)> = Vec::new();
+            for (w, &k) in order.iter().enumerate() {
+                for &l in &order[w + 1..] {
+                    if boxes[l].0.x > boxes[k].1.x {
+                        break;
+                    }
+                    if overlap(k, l) {
+                        pairs.push((k.min(l), k.max(l)));
+                    }
+                }
+            }
+            pairs.sort_unstable();
+            for (k, l) in pairs {
+                check(k, l)?;
             }
         }
         self.check_pinches()
@@ -519,10 +649,39 @@ impl SphericalPolygon {
     }
 }
 
+/// `false` when a ring is certainly not a sliver ([`is_sliver`]), by a bound without
+/// trigonometry that is conclusive for ordinary rings.
+///
+/// The vector area of the ring's arcs, `1/2 sum theta_i m_i` (angle `theta_i`, unit normal `m_i`
+/// of edge `i`), is `int_W x dA` over either side `W` (the two integrals cancel over the sphere),
+/// so its length is at most the smaller side's area. The chords' vector area
+/// `1/2 sum sin(theta_i) m_i` differs from it by at most `sum (theta_i - sin theta_i) / 2 <=
+/// sum theta_i^3 / 12`, with `theta <= (pi / 2) chord`; the perimeter is at most `pi / 2` times
+/// the sum of the chords.
+pub(crate) fn may_be_sliver(ring: &[DVec3]) -> bool {
+    let m = ring.len();
+    let (mut area2, mut chords, mut cubes) = (DVec3::ZERO, 0.0, 0.0);
+    for i in 0..m {
+        let (a, b) = (ring[i], ring[(i + 1) % m]);
+        area2 += a.cross(b);
+        let c = (b - a).length();
+        chords += c;
+        cubes += c * c * c;
+    }
+    let half_pi = 0.5 * PI;
+    let lower =
+        0.5 * area2.length() - half_pi * half_pi * half_pi / 12.0 * cubes - 1e-15 * m as f64;
+    let perimeter = half_pi * chords;
+    !(lower > 1e-12 * perimeter * perimeter)
+}
+
 /// Whether a ring's smaller side is below `1e-12` times its squared perimeter: the
 /// [`GeomError::ZeroArea`] criterion of [`SphericalPolygon::new`], which operations also apply
 /// to their results (a ring that thin is dropped as an artifact of rounding).
 pub(crate) fn is_sliver(ring: &[DVec3]) -> bool {
+    if !may_be_sliver(ring) {
+        return false;
+    }
     let area = ring_small_area(ring).abs();
     let n = ring.len();
     let perimeter: f64 = (0..n)
@@ -532,6 +691,87 @@ pub(crate) fn is_sliver(ring: &[DVec3]) -> bool {
         })
         .sum();
     !(area > 1e-12 * perimeter * perimeter)
+}
+
+/// Whether the ring folds back at `x` between its neighbours `p` and `q`: the two edges leave
+/// `x` in the same direction, exactly or within `1e-12` rad (a spike, or a notch of the same
+/// width). This is the test [`SphericalPolygon::new`] applies to edges sharing an endpoint: a
+/// wedge that narrow has no side any later operation can resolve.
+pub(crate) fn folds_back(p: DVec3, x: DVec3, q: DVec3) -> bool {
+    let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
+    tp.dot(tq) > 0.0
+        && (orient(x, p, q) == 0 || tp.cross(tq).length() <= 1e-12 * tp.length() * tq.length())
+}
+
+/// The result of an operation, built from rings that may hold what validation rejects (the
+/// operations are exact up to rounding, and rounding can leave features below the resolution
+/// validation demands): consecutive vertices closer than `merge` (the operation's weld
+/// distance, so that the next operation does not weld them itself) become one, vertices where a
+/// ring folds back ([`folds_back`]) are removed (this cuts a spike or fills a notch narrower
+/// than `1e-12` rad), and rings left with fewer than three vertices or thinner than
+/// [`is_sliver`] are dropped. The region moves by at most those edges, wedges and slivers. When
+/// every ring is dropped, the result is empty or full as the rings' region was (small or
+/// large).
+///
+/// Also returns whether anything was changed.
+pub(crate) fn regularized(
+    verts: Verts,
+    ends: SmallVec<[u32; 2]>,
+    merge: f64,
+) -> (SphericalPolygon, bool) {
+    let mut out = Verts::new();
+    let mut out_ends: SmallVec<[u32; 2]> = SmallVec::new();
+    let mut dropped_large = false;
+    let mut changed = false;
+    let mut start = 0usize;
+    for &end in &ends {
+        let ring = &verts[start..end as usize];
+        start = end as usize;
+        let mut r: Verts = ring.iter().copied().collect();
+        // Remove short edges' second ends and fold vertices until none is left; each pass
+        // removes a vertex or stops.
+        loop {
+            let m = r.len();
+            if m < 3 {
+                break;
+            }
+            let fold = (0..m).find(|&i| {
+                let (p, x, q) = (r[(i + m - 1) % m], r[i], r[(i + 1) % m]);
+                p == q || (x - p).length() <= merge || folds_back(p, x, q)
+            });
+            match fold {
+                Some(i) => {
+                    r.remove(i);
+                    changed = true;
+                }
+                None => break,
+            }
+        }
+        let begin = out.len();
+        out.extend_from_slice(&r);
+        let before = out_ends.len();
+        close_ring(&mut out, &mut out_ends, begin);
+        if out_ends.len() > before && is_sliver(&out[begin..]) {
+            dropped_large |= ring_small_area(ring) < 0.0;
+            out.truncate(begin);
+            out_ends.pop();
+            changed = true;
+        } else if out_ends.len() == before {
+            dropped_large |= ring.len() >= 3 && ring_small_area(ring) < 0.0;
+            changed = true;
+        } else if out.len() - begin != r.len() {
+            changed = true;
+        }
+    }
+    if out_ends.is_empty() && !ends.is_empty() {
+        let r = if dropped_large {
+            SphericalPolygon::full()
+        } else {
+            SphericalPolygon::empty()
+        };
+        return (r, true);
+    }
+    (SphericalPolygon::from_parts(out, out_ends), changed)
 }
 
 /// Ends the ring begun at `start`: drops vertices that coincide with their predecessor, and the
@@ -906,6 +1146,44 @@ mod tests {
             SphericalPolygon::full().complement(),
             SphericalPolygon::empty()
         );
+    }
+
+    /// `regularized` removes a spike narrower than the fold test and a repeated vertex, drops a
+    /// sliver ring, and says empty or full when every ring goes.
+    #[test]
+    fn regularized_removes_what_validation_rejects() {
+        let (a, b, c, d) = (
+            DVec3::new(1.0, 0.0, 0.2).normalize(),
+            DVec3::new(0.0, 1.0, 0.3).normalize(),
+            DVec3::new(0.1, 0.2, 1.0).normalize(),
+            DVec3::new(0.2, 0.1, 1.0).normalize(),
+        );
+        // A spike from c out towards d and back, 1e-14 rad wide, and a repeated vertex.
+        let tip = (d + (d - c).cross(c) * 1e-14).normalize();
+        let spiky: Verts = [a, b, b, c, tip, c, d].into_iter().collect();
+        let ends: SmallVec<[u32; 2]> = SmallVec::from_slice(&[spiky.len() as u32]);
+        assert!(
+            SphericalPolygon::from_parts(spiky.clone(), ends.clone())
+                .validate()
+                .is_err()
+        );
+        let (r, changed) = regularized(spiky, ends, 1e-13);
+        assert!(changed);
+        r.validate().unwrap();
+        let clean = SphericalPolygon::new(vec![vec![a, b, c, d]]).unwrap();
+        assert!((r.solid_angle() - clean.solid_angle()).abs() < 1e-13);
+        // A sliver ring alone (counter-clockwise: the path out bulges to the right of the arc
+        // back): dropped, leaving the empty region; reversed, the full sphere.
+        let mid = (a + b).normalize();
+        let sliver: Verts = [a, (mid - a.cross(b) * 1e-14).normalize(), b, mid]
+            .into_iter()
+            .collect();
+        let ends: SmallVec<[u32; 2]> = SmallVec::from_slice(&[4]);
+        let (r, _) = regularized(sliver.clone(), ends.clone(), 1e-13);
+        assert!(r.is_empty());
+        let reversed: Verts = sliver.into_iter().rev().collect();
+        let (r, _) = regularized(reversed, ends, 1e-13);
+        assert!(r.is_full());
     }
 
     #[test]
