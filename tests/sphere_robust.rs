@@ -421,3 +421,60 @@ fn issue24_repro5_per_triangle_chain_over_a_jittered_grid() {
     let w = chain.solid_angle();
     assert!((w - expect).abs() <= 1e-11 * edges, "{w} vs {expect}");
 }
+
+/// Issue 24, reproducer 8 (sphere part): "a spherical polygon touching itself at a vertex is
+/// accepted though the docs say it is rejected". Pinches are allowed, as ARCHITECTURE.md says
+/// (operations produce them: a hole touching its outer ring, two parts meeting at a corner);
+/// the docs now say so. A ring visiting the pole twice, with a lobe on each side, is valid and
+/// is the same region as the two lobes as separate rings sharing the pole; visits that cross at
+/// the pinch are rejected, and so is touching at a point that is a vertex of only one ring.
+#[test]
+fn issue24_repro8_pinched_ring_is_valid_and_crossing_pinch_is_not() {
+    use arealight::GeomError;
+    let c = v(0.0, 0.0, 1.0);
+    let (a1, a2) = (v(0.3, -0.1, 1.0), v(0.3, 0.1, 1.0));
+    let (b1, b2) = (v(-0.3, 0.1, 1.0), v(-0.3, -0.1, 1.0));
+    // Van Oosterom-Strackee on unit vectors: each lobe's area, independently of the crate.
+    let tri = |p: DVec3, q: DVec3, r: DVec3| {
+        let (p, q, r) = (p.normalize(), q.normalize(), r.normalize());
+        2.0 * p
+            .dot(q.cross(r))
+            .atan2(1.0 + p.dot(q) + q.dot(r) + r.dot(p))
+    };
+    let lobes = tri(c, a1, a2) + tri(c, b1, b2);
+    let pinched =
+        SphericalPolygon::new(vec![vec![c, a1, a2, c, b1, b2]]).expect("a pinch is valid");
+    pinched.validate().unwrap();
+    assert!(
+        (pinched.solid_angle() - lobes).abs() <= 1e-15,
+        "{} vs {lobes}",
+        pinched.solid_angle()
+    );
+    let two = SphericalPolygon::new(vec![vec![c, a1, a2], vec![c, b1, b2]])
+        .expect("rings sharing a vertex");
+    assert!((two.solid_angle() - lobes).abs() <= 1e-15);
+    for (q, inside) in [
+        (v(0.2, 0.0, 1.0), true),
+        (v(-0.2, 0.0, 1.0), true),
+        (v(0.0, 0.2, 1.0), false),
+        (v(0.0, -0.2, 1.0), false),
+    ] {
+        assert_eq!(pinched.contains(q), inside, "{q}");
+        assert_eq!(two.contains(q), inside, "{q}");
+    }
+    // The second lobe run the other way: the visits interleave around the pole (they cross).
+    assert!(matches!(
+        SphericalPolygon::new(vec![vec![c, a1, a2, c, b2, b1]]),
+        Err(GeomError::SelfIntersecting { .. })
+    ));
+    // A ring touching the first lobe at the midpoint of its edge a1-a2 (exactly on it: a1 + a2),
+    // which is a vertex of the touching ring only.
+    let m = a1 + a2;
+    let (d1, d2) = (v(0.6, -0.2, 1.0), v(0.6, 0.2, 1.0));
+    assert!(matches!(
+        SphericalPolygon::new(vec![vec![c, a1, a2], vec![m, d1, d2]]),
+        Err(GeomError::SelfIntersecting { .. })
+    ));
+    // The same ring touching at a2 itself (a shared vertex) is a valid pinch.
+    assert!(SphericalPolygon::new(vec![vec![c, a1, a2], vec![a2, d1, d2]]).is_ok());
+}

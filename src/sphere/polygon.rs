@@ -37,7 +37,12 @@ pub(crate) type Verts = SmallVec<[DVec3; 12]>;
 /// empty region; the full sphere, which has no boundary, is [`SphericalPolygon::full`].
 ///
 /// Values built with [`SphericalPolygon::new`] are valid: vertices are unit vectors, rings are
-/// simple, disjoint and consistently oriented. Every operation of the crate returns valid values.
+/// simple and disjoint except at pinches, and consistently oriented. A pinch is a vertex shared
+/// (the same direction) by two rings, or visited twice by one ring: rings may touch there, as
+/// long as they do not cross there (the visits' edges do not interleave around the vertex);
+/// results of clipping and set operations have them where a hole touches an outer boundary or
+/// two parts meet at a corner. Every operation of the crate returns valid values
+/// ([`SphericalPolygon::validate`]).
 ///
 /// # Examples
 ///
@@ -76,8 +81,11 @@ impl SphericalPolygon {
     ///   [`COINCIDENT_TOLERANCE`], [`GeomError::AntipodalVertices`] for consecutive vertices within
     ///   [`ANTIPODAL_TOLERANCE`] of antipodal;
     /// - [`GeomError::TooFewVertices`] for a ring of fewer than three vertices;
-    /// - [`GeomError::SelfIntersecting`] when a ring crosses or touches itself or another ring
-    ///   (checked exactly, with Shewchuk's `orient3d`; the check is quadratic in the vertex count);
+    /// - [`GeomError::SelfIntersecting`] when a ring crosses itself or another ring, touches one
+    ///   anywhere but at a pinch (a vertex shared by both, or visited twice by one ring, where
+    ///   touching is allowed), crosses one at a pinch, or leaves a vertex along the direction of
+    ///   another edge there (within `1e-12` rad: a spike, or an overlap); checked exactly, with
+    ///   Shewchuk's `orient3d`, on the pairs of edges whose bounding boxes meet;
     /// - [`GeomError::ZeroArea`] for a ring whose vertices lie on one great circle to within
     ///   rounding (its smaller side is below `1e-12` times its squared perimeter);
     /// - [`GeomError::InconsistentOrientation`] when two rings bounding the same face disagree on
