@@ -478,3 +478,146 @@ fn issue24_repro8_pinched_ring_is_valid_and_crossing_pinch_is_not() {
     // The same ring touching at a2 itself (a shared vertex) is a valid pinch.
     assert!(SphericalPolygon::new(vec![vec![c, a1, a2], vec![a2, d1, d2]]).is_ok());
 }
+
+/// Found by fuzz target sphere_horizon: the complement of a triangle T whose first vertex lies
+/// on the circle twice over (two vertices 1.5e-15 apart, 8e-17 and 1.6e-15 below it, joined by
+/// an almost vertical edge). Both were snapped onto the circle separately, in an order along it
+/// set by rounding, which twisted the polygon: the clip returned 9.92 sr, more than the
+/// hemisphere. T lies in the hemisphere but for that dip, so the clip is H minus T, of area
+/// `area(P) - 2 pi`, and the other side is the whole lower hemisphere.
+#[test]
+fn fuzz_sphere_horizon_two_vertices_on_the_circle_a_rounding_apart() {
+    let p = SphericalPolygon::new(vec![vec![
+        v(
+            0.03790236755916766,
+            0.0031054209547305136,
+            -0.9992766218090484,
+        ),
+        v(0.03790236755916624, 0.0031054209547301, -0.9992766218090484),
+        v(0.4386694850345994, -0.891489598618702, -0.11320502839602564),
+        v(0.5294985019756618, 0.6516904639700454, 0.5430753866417045),
+    ]])
+    .unwrap();
+    let n = v(
+        0.9594376516352019,
+        0.27944785969957336,
+        0.037259714626609784,
+    );
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+    up.validate().unwrap();
+    down.validate().unwrap();
+    assert!(
+        (up.solid_angle() - (p.solid_angle() - two_pi)).abs() <= 1e-12,
+        "{}",
+        up.solid_angle()
+    );
+    assert!(
+        (down.solid_angle() - two_pi).abs() <= 1e-12,
+        "{}",
+        down.solid_angle()
+    );
+}
+
+/// Found by fuzz target sphere_horizon: a triangle with one vertex 1.02e-14 above the circle
+/// (just above the tolerance) clips to a triangle of 2.8e-29 sr whose two other vertices lie on
+/// the circle 5.5e-15 apart along it. Clipping that again gave the whole hemisphere: the two
+/// were merged into one point (the closing edge was taken for a point of the circle), and the
+/// corner rule then went round. An edge along the circle keeps its ends apart, however short.
+/// Clipping is idempotent, and the region is the tiny triangle (at most its crossings' distance
+/// times the height, over two).
+#[test]
+fn fuzz_sphere_horizon_clip_of_a_tiny_clip_is_itself() {
+    let p = SphericalPolygon::new(vec![vec![
+        v(
+            0.047321908516333805,
+            0.26815748159255826,
+            0.9622121398321207,
+        ),
+        v(
+            0.014723851588582606,
+            -0.7142680120998522,
+            -0.6997173822946824,
+        ),
+        v(0.24253562503633297, 0.0, 0.9701425001453319),
+    ]])
+    .unwrap();
+    let n = v(0.572795325801396, 0.5796143177752222, -0.5796143177752222);
+    let up = p.clip_to_hemisphere(n);
+    let twice = up.clip_to_hemisphere(n);
+    twice.validate().unwrap();
+    let (w, w2) = (up.solid_angle(), twice.solid_angle());
+    // Its apex is 1.02e-14 above the circle and its base shorter than 2e-14.
+    assert!(w > 0.0 && w <= 0.5 * 2e-14 * 1.1e-14, "{w:e}");
+    assert!((w2 - w).abs() <= 1e-2 * w, "{w2:e} vs {w:e}");
+}
+
+/// Found by fuzz target sphere_horizon: a vertex 1.07e-9 straight above another (both moved down
+/// one meridian) and the next edge running back down the same meridian: a spike 1.5e-16 wide
+/// (at its tip the edges are 1.4e-7 rad apart, the rounding of a 1e-9 edge's direction). It
+/// passed validation's 1e-12 rad fold test, and its clip was a ring that validation rejected.
+/// Validation now also rejects a fold whose width (the shorter edge's far end off the other's
+/// great circle) is within rounding; a short edge at a wide angle is not one (see
+/// fuzz_sphere_horizon_two_vertices_on_the_circle_a_rounding_apart, an edge of 1.5e-15).
+#[test]
+fn fuzz_sphere_horizon_spike_as_wide_as_rounding_is_rejected() {
+    use arealight::GeomError;
+    let spike = vec![
+        v(
+            -0.7118043953792214,
+            0.009241013651701949,
+            -0.7023169557867092,
+        ),
+        v(
+            -0.5773502691896258,
+            -0.5773502691896258,
+            -0.5773502691896258,
+        ),
+        v(
+            -0.02498438963319538,
+            0.9993755853278152,
+            -0.02498438963319538,
+        ),
+        v(
+            -0.7118043953792214,
+            0.009241012576327111,
+            -0.7023169558008588,
+        ),
+    ];
+    assert!(matches!(
+        SphericalPolygon::new(vec![spike]),
+        Err(GeomError::SelfIntersecting { .. })
+    ));
+}
+
+/// Found by fuzz target sphere_horizon: the complement of a triangle with a sharp corner (2 deg)
+/// 1.5e-14 below the horizon. Clipping to the lower side keeps the corner's tip, whose entry and
+/// exit crossings are 5e-16 apart, below their rounding: the order used was the exact one, but
+/// the rounded points showed it reversed, and the result crossed itself. Where crossings lie
+/// within their rounding of each other, the clip now cuts the folds that leaves and merges the
+/// points. Both sides must be valid and partition the polygon.
+#[test]
+fn fuzz_sphere_horizon_corner_tip_narrower_than_rounding() {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    for h in [1.51171875e-14f64, -1.51171875e-14, 0.0] {
+        let tip = v(51.0, 1.0, 0.0).normalize() * (1.0 - h * h).sqrt() + DVec3::Z * h;
+        let p = SphericalPolygon::new(vec![vec![v(-11.0, 49.0, 51.0), tip, v(53.0, 52.0, 51.0)]])
+            .unwrap()
+            .complement();
+        let (up, down) = (
+            p.clip_to_hemisphere(DVec3::Z),
+            p.clip_to_hemisphere(-DVec3::Z),
+        );
+        up.validate()
+            .unwrap_or_else(|e| panic!("h = {h:e}: {e}: {up:?}"));
+        down.validate()
+            .unwrap_or_else(|e| panic!("h = {h:e}: {e}: {down:?}"));
+        // The triangle lies above the horizon but for its corner: the lower side is all of it.
+        assert!(
+            (down.solid_angle() - two_pi).abs() <= 1e-12,
+            "{}",
+            down.solid_angle()
+        );
+        assert!((up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() <= 1e-12);
+    }
+}

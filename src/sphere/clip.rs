@@ -8,8 +8,8 @@ use smallvec::SmallVec;
 
 use super::exact;
 use super::polygon::{
-    SphericalPolygon, Verts, close_ring, far_side_inside, is_sliver, nearest_feature,
-    ring_left_area, rings_contain,
+    COINCIDENT_TOLERANCE, SphericalPolygon, Verts, close_ring, far_side_inside, is_sliver,
+    nearest_feature, regularized, ring_left_area, rings_contain,
 };
 use super::predicates::{normalize_any, orient};
 use crate::GeomError;
@@ -415,6 +415,30 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             continue;
         }
         let frame = frame();
+        // An edge between two vertices on the circle that is steeper than it is long along the
+        // circle (a few ulps across it, more up or down it) is one point of the circle: snapping
+        // its ends turns it by up to a right angle, so which side of it is inside would be set
+        // by rounding, and the order of the chain's exit and entry there with it (twisting the
+        // polygon). A run of such edges snaps to the run's first vertex, so that an exit into it
+        // and an entry out of it meet at one point and the corner rule joins them. An edge along
+        // the circle, however short, keeps its ends apart: its direction there is meaningful.
+        let run_start = |i: usize| {
+            let mut k = i;
+            for _ in 1..m {
+                let prev = (k + m - 1) % m;
+                let d = ring[k] - ring[prev];
+                let rise = (s[k] - s[prev]).abs();
+                let along = (d - n * d.dot(n)).length();
+                if side(prev) != Side::On
+                    || d.length() > 2.0 * HORIZON_TOLERANCE
+                    || along > rise + 4e-16
+                {
+                    break;
+                }
+                k = prev;
+            }
+            k
+        };
         // Walk from a vertex not above so that every chain is complete within one pass.
         let first_out = (0..m).position(|i| side(i) != Side::Above).unwrap_or(0);
         let mut open: Option<(usize, Crossing)> = None;
@@ -426,7 +450,8 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             match (si == Side::Above, sj == Side::Above) {
                 (false, true) => {
                     let c = if si == Side::On {
-                        frame.vertex_crossing(a, s[i])
+                        let r = run_start(i);
+                        frame.vertex_crossing(ring[r], s[r])
                     } else {
                         frame.edge_crossing(b, a, s[j], s[i])
                     };
@@ -437,7 +462,8 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                 (true, true) => scratch.push(b),
                 (true, false) => {
                     let c = if sj == Side::On {
-                        frame.vertex_crossing(b, s[j])
+                        let r = run_start(j);
+                        frame.vertex_crossing(ring[r], s[r])
                     } else {
                         frame.edge_crossing(a, b, s[i], s[j])
                     };
@@ -471,7 +497,9 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
 
     let frame = frame();
     let k = chains.len();
-    let next = if k == 1 {
+    // Whether two crossings lie within their rounding of each other: the order used is the
+    // exact one, but their rounded points may not show it, and the result is regularized.
+    let (next, delicate) = if k == 1 {
         single_chain_gap(&chains[0], &scratch, &frame)
     } else {
         join_chains(&chains, &scratch, &frame)
@@ -515,24 +543,40 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             out_ends.pop();
         }
     }
+    if delicate {
+        // Crossings a rounding apart can leave a spike of that width (the tip of a sharp
+        // corner just above the circle) or its rounded points out of the exact order: the folds
+        // validation rejects are cut, and the points they leave merged.
+        return regularized(out_verts, out_ends, COINCIDENT_TOLERANCE).0;
+    }
     finish(out_verts, out_ends)
 }
 
+/// Per chain, the entry its exit joins, the angle of the circle arc between them and the polar
+/// angle of the exit (`usize::MAX` for none).
+type Joins = SmallVec<[(usize, f64, f64); 4]>;
+
 /// The circle arc from the exit of each chain to the entry it joins: `(chain, angle of the
-/// arc, polar angle of the exit)`, or `(usize::MAX, ..)` for none.
+/// arc, polar angle of the exit)`, or `(usize::MAX, ..)` for none; and whether two crossings
+/// lie within their rounding of each other.
 ///
 /// Each exit joins the entry that follows it counter-clockwise about `n`. At the exit's own point
 /// (a ring touching the circle at a vertex, a pinch on the circle) the corner rule decides
 /// whether the boundary turns into an entry there at once; otherwise it runs along the circle to
 /// the nearest point holding an entry, where it turns into the entry met first clockwise from
 /// the circle behind it. See [`first_clockwise`] for the corner rule.
-fn join_chains(
-    chains: &[Chain],
-    scratch: &[DVec3],
-    frame: &Frame,
-) -> SmallVec<[(usize, f64, f64); 4]> {
+fn join_chains(chains: &[Chain], scratch: &[DVec3], frame: &Frame) -> (Joins, bool) {
     let k = chains.len();
     let order = sorted_crossings(chains, frame);
+    // Neighbours along the circle (cyclically) within their rounding of each other.
+    let delicate = (0..order.len()).any(|w| {
+        let (a, b) = (
+            crossing(chains, order[w]),
+            crossing(chains, order[(w + 1) % order.len()]),
+        );
+        let d = (b.angle - a.angle).rem_euclid(2.0 * PI);
+        d <= a.err + b.err || d >= 2.0 * PI - a.err - b.err
+    });
     // Rank of each crossing's point along the circle (crossings at exactly the same point share
     // one), and angles made consistent with that order: inside [0, pi] or [pi, 2 pi] as the
     // exact half says, non-decreasing along it, equal at equal points.
@@ -612,22 +656,20 @@ fn join_chains(
             taken[d] = true;
         }
     }
-    next
+    (next, delicate)
 }
 
 /// [`join_chains`] for a single chain, whose exit can only join its own entry: only the arc
 /// between them is to be decided, by the rounded angles where it is clear of both `0` and a full
-/// turn by their error bounds (no order along the circle is needed), else exactly.
-fn single_chain_gap(
-    chain: &Chain,
-    scratch: &[DVec3],
-    frame: &Frame,
-) -> SmallVec<[(usize, f64, f64); 4]> {
+/// turn by their error bounds (no order along the circle is needed), else exactly (and then
+/// the second value is `true`).
+fn single_chain_gap(chain: &Chain, scratch: &[DVec3], frame: &Frame) -> (Joins, bool) {
     let (x, e) = (&chain.exit, &chain.entry);
     let gap = e.angle - x.angle;
     let gap = if gap < 0.0 { gap + 2.0 * PI } else { gap };
     let tol = x.err + e.err;
-    let gap = if gap > tol && gap < 2.0 * PI - tol {
+    let clear = gap > tol && gap < 2.0 * PI - tol;
+    let gap = if clear {
         gap
     } else {
         match frame.turn_sign(x.feature, e.feature) {
@@ -643,7 +685,7 @@ fn single_chain_gap(
             }
         }
     };
-    smallvec::smallvec![(0, gap, x.angle)]
+    (smallvec::smallvec![(0, gap, x.angle)], !clear)
 }
 
 /// `false` when a ring of the result is certainly not a sliver ([`is_sliver`]), by a bound that

@@ -84,7 +84,8 @@ impl SphericalPolygon {
     /// - [`GeomError::SelfIntersecting`] when a ring crosses itself or another ring, touches one
     ///   anywhere but at a pinch (a vertex shared by both, or visited twice by one ring, where
     ///   touching is allowed), crosses one at a pinch, or leaves a vertex along the direction of
-    ///   another edge there (within `1e-12` rad: a spike, or an overlap); checked exactly, with
+    ///   another edge there (within `1e-12` rad, or with the shorter edge's far end within
+    ///   `5e-16` of the other's great circle: a spike, or an overlap); checked exactly, with
     ///   Shewchuk's `orient3d`, on the pairs of edges whose bounding boxes meet;
     /// - [`GeomError::ZeroArea`] for a ring whose vertices lie on one great circle to within
     ///   rounding (its smaller side is below `1e-12` times its squared perimeter);
@@ -354,7 +355,10 @@ impl SphericalPolygon {
     /// from the boundary (empty or full). Accuracy: about `1e-15 * n` absolute for `n`
     /// vertices, and full relative precision for small polygons and their complements' small
     /// sides (the determinant is evaluated on edge differences), so a polygon of 1e-6 rad across
-    /// keeps about 1e-10 relative accuracy, which is what its unit-vector vertices determine.
+    /// keeps about 1e-10 relative accuracy, which is what its unit-vector vertices determine. An
+    /// edge between nearly antipodal vertices `a`, `b` has its great circle only to about
+    /// `1e-16 / |a + b|` rad, and the area loses that much times the edge's length (down to about
+    /// `1e-6` for `|a + b|` at [`ANTIPODAL_TOLERANCE`]).
     #[must_use]
     pub fn solid_angle(&self) -> f64 {
         const FOUR_PI: f64 = 4.0 * PI;
@@ -702,13 +706,19 @@ pub(crate) fn is_sliver(ring: &[DVec3]) -> bool {
 }
 
 /// Whether the ring folds back at `x` between its neighbours `p` and `q`: the two edges leave
-/// `x` in the same direction, exactly or within `1e-12` rad (a spike, or a notch of the same
-/// width). This is the test [`SphericalPolygon::new`] applies to edges sharing an endpoint: a
-/// wedge that narrow has no side any later operation can resolve.
+/// `x` in the same direction, exactly, within `1e-12` rad, or so nearly that the far end of the
+/// shorter one lies within `5e-16` (a few ulps of a unit vector: the rounding of the vertices)
+/// of the other's great circle (a spike, or a notch of the same width). This is the test [`SphericalPolygon::new`] applies to
+/// edges sharing an endpoint: a wedge that narrow has no side any later operation can resolve
+/// (the direction of an edge of length `l` is only known to about `1e-16 / l`).
 pub(crate) fn folds_back(p: DVec3, x: DVec3, q: DVec3) -> bool {
     let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
-    tp.dot(tq) > 0.0
-        && (orient(x, p, q) == 0 || tp.cross(tq).length() <= 1e-12 * tp.length() * tq.length())
+    if !(tp.dot(tq) > 0.0) {
+        return false;
+    }
+    let (lp, lq) = (tp.length(), tq.length());
+    let cross = tp.cross(tq).length();
+    orient(x, p, q) == 0 || cross <= 1e-12 * lp * lq || cross <= 5e-16 * lp.max(lq)
 }
 
 /// The result of an operation, built from rings that may hold what validation rejects (the
