@@ -621,3 +621,49 @@ fn fuzz_sphere_horizon_corner_tip_narrower_than_rounding() {
         assert!((up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() <= 1e-12);
     }
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: a clip whose result is two rings touching at
+/// a vertex `a` of both. A point of the small ring lies straight above `a` as seen from one edge
+/// of the big ring leaving `a`, so that edge's perpendicular foot rounded onto the arc by a
+/// hair and the edge alone decided the point was inside the big ring (it is outside: the big
+/// ring's wedge at `a` is elsewhere). The validation then rejected the clip's own result as
+/// inconsistently oriented.
+#[test]
+fn fuzz_sphere_horizon_point_straight_above_a_pinch_vertex() {
+    let a = v(-0.7106690545187014, -0.497468338163091, -0.497468338163091);
+    let big = vec![
+        a,
+        v(
+            -0.5773502691896258,
+            -0.5773502691896258,
+            -0.5773502691896258,
+        ),
+        v(
+            -0.6804138174397718,
+            -0.6804138174397716,
+            -0.2721655269759088,
+        ),
+    ];
+    let small = vec![
+        v(-0.1342653772197982, 0.6003866723196086, -0.7883582004273262),
+        v(-0.13426537541508882, 0.6003866708948511, -0.788358201819733),
+        a,
+    ];
+    let both = SphericalPolygon::new(vec![big.clone(), small.clone()]).unwrap();
+    both.validate().unwrap();
+    let (big, small) = (
+        SphericalPolygon::new(vec![big]).unwrap(),
+        SphericalPolygon::new(vec![small]).unwrap(),
+    );
+    assert!((both.solid_angle() - big.solid_angle() - small.solid_angle()).abs() <= 1e-15);
+    for (ring, other) in [(&big, &small), (&small, &big)] {
+        let r = other.rings().next().unwrap();
+        for k in 0..r.len() {
+            let (p, q) = (r[k], r[(k + 1) % r.len()]);
+            if p != a {
+                assert!(!ring.contains(p), "{p}");
+            }
+            assert!(!ring.contains((p + q).normalize()), "{p} {q}");
+        }
+    }
+}

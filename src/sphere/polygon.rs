@@ -1004,17 +1004,27 @@ pub(crate) fn nearest_feature<'a>(
             // a x (b - a) = a x b, without the cancellation that would leave a short edge's
             // normal with a relative error of 1e-16 over its length.
             let nrm = a.cross(b - a);
+            let len = nrm.length();
             // p's nearest point on the great circle lies inside the arc iff turning from a to p
-            // and from p to b both go the arc's way round.
-            if a.cross(p).dot(nrm) > 0.0 && p.cross(b).dot(nrm) > 0.0 {
+            // and from p to b both go the arc's way round. The turns are taken from differences
+            // (a x p = a x (p - a)), so their rounding is relative to |p - a| and |b - p|; a foot
+            // within that rounding of an end is left to the end's vertex, which is then as near
+            // and decides the side from all the edges there (an edge whose foot only rounds
+            // into the arc would decide it alone, and wrongly, when p lies straight above a
+            // vertex outside the edge's wedge).
+            let pa = p - a;
+            let bp = b - p;
+            if a.cross(pa).dot(nrm) > 1e-15 * pa.length() * len
+                && p.cross(bp).dot(nrm) > 1e-15 * bp.length() * len
+            {
                 // Sine of the distance to the circle (p - a is exact for close points).
-                let s = (p - a).dot(nrm) / nrm.length();
+                let s = pa.dot(nrm) / len;
                 let s2 = (s * s).min(1.0);
                 // Squared chord to the nearest point, 2 - 2 cos(d), without cancellation.
                 let d = 2.0 * s2 / (1.0 + crate::math::sqrt(1.0 - s2));
                 consider(d, Ok(s > 0.0));
             }
-            consider((p - a).length_squared(), Err(a));
+            consider(pa.length_squared(), Err(a));
         }
     }
     let (d, what) = best?;
