@@ -667,3 +667,48 @@ fn fuzz_sphere_horizon_point_straight_above_a_pinch_vertex() {
         }
     }
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: a ring running along the circle for most of
+/// it, a vertex a rounding above it and another below. Snapped, no ring crosses the circle, and
+/// whether the upper side is inside was taken at the circle point farthest from the boundary,
+/// which was within rounding of it: the clip returned the whole hemisphere for a sliver.
+#[test]
+fn fuzz_sphere_horizon_ring_along_the_circle_lies_below_it() {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    for h in [
+        0.0,
+        1e-16,
+        1e-15,
+        1.01171875e-14,
+        1e-13,
+        1e-12,
+        1e-11,
+        1e-10,
+    ] {
+        let p = SphericalPolygon::new(vec![vec![
+            v(h, -1.0, 0.0),
+            v(-0.68738482481996, 0.0, 0.726293399809769),
+            v(0.0, -0.9486832980505138, 0.31622776601683794),
+            v(0.0, 0.9985681322700889, -0.0534947213716119),
+        ]])
+        .unwrap();
+        let (up, down) = (
+            p.clip_to_hemisphere(DVec3::X),
+            p.clip_to_hemisphere(-DVec3::X),
+        );
+        up.validate().unwrap();
+        down.validate().unwrap();
+        // The upper side is a sliver under the edge to (h, -1, 0), about 37 h: that edge spans
+        // 177 degrees, so the vertex's height tilts it 20 times as much at its middle.
+        assert!(
+            up.solid_angle() <= 40.0 * h,
+            "h = {h:e}: {}",
+            up.solid_angle()
+        );
+        assert!(down.solid_angle() < two_pi);
+        assert!(
+            (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() <= 40.0 * h + 1e-14,
+            "h = {h:e}"
+        );
+    }
+}

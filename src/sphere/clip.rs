@@ -487,7 +487,17 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             poly.ring_count() > 0
                 && far_side_inside(poly.rings(), n)
                     .or_else(|| far_side_inside(poly.rings(), -n))
-                    .unwrap_or_else(|| circle_point_inside(poly, &frame()))
+                    .unwrap_or_else(|| {
+                        if out_verts.is_empty() {
+                            // No ring enters the open upper side: it is all inside or all
+                            // outside, and its pole is a quarter turn from every ring, even from
+                            // one that runs along the circle (where every circle point is within
+                            // rounding of it).
+                            rings_contain(poly.rings(), n)
+                        } else {
+                            circle_point_inside(poly, &frame())
+                        }
+                    })
         });
         if circle_inside {
             push_circle(&mut out_verts, &mut out_ends, &frame());
