@@ -712,3 +712,39 @@ fn fuzz_sphere_horizon_ring_along_the_circle_lies_below_it() {
         );
     }
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the outside of a triangle whose corner lies a
+/// rounding below the circle. Its two edges cross the circle a rounding apart, and the exit
+/// joins the entry a full turn round the circle: the ring touches itself there, but it did so
+/// at two rounded points 1 ulp apart, so it crossed itself.
+#[test]
+fn fuzz_sphere_horizon_crossings_a_rounding_apart_a_full_turn_round() {
+    let n = v(49.0, 51.0, 1.0).normalize();
+    let ring = [
+        v(-12.0, 49.0, -11.0).normalize(),
+        v(51.0, 55.0, 50.0).normalize(),
+        v(53.0, 52.0, 51.0).normalize(),
+    ];
+    let two_pi = 2.0 * std::f64::consts::PI;
+    for e in 0..=40 {
+        for sign in [1.0, -1.0] {
+            let h = sign * 1e-16 * 10f64.powf(e as f64 / 10.0);
+            // The corner moved along the great circle through n to height h: the ring then runs
+            // clockwise round the triangle.
+            let flat = (ring[0] - n * ring[0].dot(n)).normalize();
+            let mut r = ring.to_vec();
+            r[0] = flat * (1.0 - h * h).sqrt() + n * h;
+            let p = SphericalPolygon::new(vec![r]).unwrap();
+            let triangle = 2.0 * two_pi - p.solid_angle();
+            assert!(triangle < 0.01);
+            let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+            up.validate()
+                .unwrap_or_else(|err| panic!("h = {h:e}: {err}: {up:?}"));
+            down.validate()
+                .unwrap_or_else(|err| panic!("h = {h:e}: {err}: {down:?}"));
+            // The triangle lies above the circle but for its corner.
+            assert!((down.solid_angle() - two_pi).abs() <= 1e-12);
+            assert!((up.solid_angle() - (two_pi - triangle)).abs() <= 1e-12);
+        }
+    }
+}

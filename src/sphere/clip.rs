@@ -514,6 +514,9 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     } else {
         join_chains(&chains, &scratch, &frame)
     };
+    if delicate {
+        merge_inverted_crossings(&chains, &next, &frame, &mut scratch);
+    }
     let mut visited: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
     for first in 0..k {
         if visited[first] {
@@ -696,6 +699,42 @@ fn single_chain_gap(chain: &Chain, scratch: &[DVec3], frame: &Frame) -> (Joins, 
         }
     };
     (smallvec::smallvec![(0, gap, x.angle)], !clear)
+}
+
+/// Neighbouring crossings along the circle whose rounded points lie out of their exact order
+/// (or on one point) made one point, the first one's, in `scratch`; except an exit and the entry
+/// it joins by a short arc, an edge of the result, whose fold [`regularized`] cuts. Elsewhere two
+/// such points end up in different places of the result (an exit joined to an entry a full turn
+/// round, its neighbour a rounding behind it), and the ring, which should touch itself there at
+/// one vertex, would cross itself.
+fn merge_inverted_crossings(chains: &[Chain], next: &Joins, frame: &Frame, scratch: &mut [DVec3]) {
+    let at = |i: usize| {
+        let c = &chains[i / 2];
+        if i.is_multiple_of(2) {
+            c.start
+        } else {
+            c.end - 1
+        }
+    };
+    let order = sorted_crossings(chains, frame);
+    let m = order.len();
+    let original: SmallVec<[DVec3; 8]> = (0..m).map(|i| scratch[at(i)]).collect();
+    for w in 0..m {
+        let (a, b) = (order[w], order[(w + 1) % m]);
+        let (ca, cb) = (crossing(chains, a), crossing(chains, b));
+        // Within their rounding of each other (either way round: a rounded angle may lie across
+        // the polar angle 0 from its exact point), with b exactly at a or just ahead of it, not
+        // just behind it a full turn round (the wrapping pair of two crossings).
+        let d = (cb.angle - ca.angle).rem_euclid(2.0 * PI);
+        let close = (d <= ca.err + cb.err || d >= 2.0 * PI - ca.err - cb.err)
+            && frame.turn_sign(ca.feature, cb.feature) >= 0;
+        let joined = a % 2 == 1 && b % 2 == 0 && next[a / 2].0 == b / 2 && next[a / 2].1 < PI;
+        let (pa, pb) = (original[a], original[b]);
+        // b's rounded point not counter-clockwise of a's: out of the exact order, or equal.
+        if close && !joined && pa.cross(pb - pa).dot(frame.n) <= 0.0 {
+            scratch[at(b)] = scratch[at(a)];
+        }
+    }
 }
 
 /// `false` when a ring of the result is certainly not a sliver ([`is_sliver`]), by a bound that
