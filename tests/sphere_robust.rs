@@ -748,3 +748,67 @@ fn fuzz_sphere_horizon_crossings_a_rounding_apart_a_full_turn_round() {
         }
     }
 }
+
+/// A census case of the horizon family's near-antipodal mode: a ring whose vertices 1 and 2 are
+/// nearly antipodal (`|a + b|` about 1e-9), the edge between them crossing the circle a
+/// rounding-sized height from both ends. The lower part has two rings; one holds that edge,
+/// whose fan triangle from a vertex a quarter turn away has a Van Oosterom–Strackee denominator
+/// of 1e-17 (the angle near pi, set by the determinant). The rounding bound of the rings' sum
+/// divided by the denominator alone (1e3 sr), so the total was "within rounding of zero" and the
+/// far-point test made the lower part the full sphere, 4 pi: partition error 4 pi - 4.6.
+///
+/// Checked against the partition identity `clip(n) + clip(-n) = P` (to the 1e-16 / |a + b|
+/// precision of the near-antipodal edge), each part within its hemisphere, and the parts'
+/// containment against the polygon's and the hemisphere's on a Fibonacci lattice of directions
+/// away from every edge's great circle and from the horizon.
+#[test]
+fn census_horizon_near_antipodal_edge_across_the_circle_keeps_the_lower_part() {
+    let ring = vec![
+        v(-0.058722021951470346, 0.0, 0.9982743731749959),
+        v(
+            -0.08589757442436136,
+            -0.08589757442436136,
+            0.9925941836501071,
+        ),
+        v(
+            0.08589757368308437,
+            0.08589757368308437,
+            -0.9925941837784051,
+        ),
+        v(-1.0, 0.0, 0.0),
+    ];
+    let n = v(0.7018700783265118, 0.7018700783265118, 0.12147751355651165);
+    let p = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+    let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+    up.validate().unwrap();
+    down.validate().unwrap();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let (a_up, a_down) = (up.solid_angle(), down.solid_angle());
+    assert!(a_up <= two_pi && a_down <= two_pi, "{a_up} {a_down}");
+    assert!(
+        (a_up + a_down - p.solid_angle()).abs() < 1e-6,
+        "{a_up} + {a_down} != {}",
+        p.solid_angle()
+    );
+    let count = 20000;
+    let mut checked = 0;
+    for i in 0..count {
+        // Fibonacci lattice: z uniform, longitude by the golden angle.
+        let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
+        let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let r = (1.0 - z * z).sqrt();
+        let d = v(r * phi.cos(), r * phi.sin(), z);
+        let clear = (0..ring.len()).all(|k| {
+            let c = ring[k].cross(ring[(k + 1) % ring.len()]);
+            d.dot(c).abs() > 1e-6 * c.length()
+        });
+        if !clear || d.dot(n).abs() < 1e-6 {
+            continue;
+        }
+        checked += 1;
+        let inside = p.contains(d);
+        assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{d:?}");
+        assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{d:?}");
+    }
+    assert!(checked > count * 9 / 10);
+}

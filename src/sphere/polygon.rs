@@ -880,9 +880,17 @@ fn ring_small_area_with<const ERR: bool>(ring: &[DVec3]) -> (f64, f64) {
             let t = triangle_solid_angle(apex, b, c);
             sum += t;
             if ERR {
+                // t = 2 atan2(det, den) moves by 2 (|den| e_det + |det| e_den) / (det^2 + den^2)
+                // for errors e_det, e_den of its arguments: a few ulps of the edges' product
+                // (at most half the sum of their squares) and of the four unit terms of den.
+                // Over det^2 + den^2, not den^2: where den alone vanishes (b and c almost
+                // antipodal, the apex a quarter turn from both) the angle is near +-pi and
+                // conditioned by |det|.
+                let det = apex.dot((b - apex).cross(c - apex));
                 let den = 1.0 + apex.dot(b) + b.dot(c) + c.dot(apex);
                 let sides = 0.5 * ((b - apex).length_squared() + (c - apex).length_squared());
-                err += 32.0 * f64::EPSILON * (sides / den.abs() + t.abs() + sum.abs());
+                let spread = (sides * den.abs() + 4.0 * det.abs()) / (det * det + den * den);
+                err += 32.0 * f64::EPSILON * (spread + t.abs() + sum.abs());
             }
         }
     }
