@@ -4,9 +4,8 @@
 //! BENCHMARKS.md (section `shade`).
 
 use arealight::glam::DVec3;
-use arealight::shade::{
-    ConvexPolyhedron, DemoConfig, Light, Material, Method, Scene, Shape, TriangleMesh, demo_scene,
-};
+use arealight::internals::{DemoConfig, demo_scene};
+use arealight::shade::{Body, ConvexPolyhedron, Light, Material, Method, Scene, TriangleMesh};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 
@@ -84,7 +83,7 @@ fn interpenetrating(c: &mut Criterion) {
     let ico = ConvexPolyhedron::icosphere(DVec3::new(0.0, 0.0, 2.5), 0.6, 1).unwrap();
     let rod =
         ConvexPolyhedron::cuboid(DVec3::new(0.2, 0.05, 2.5), DVec3::new(0.12, 0.12, 1.0)).unwrap();
-    let cases: [(&str, Shape, Shape, DVec3); 2] = [
+    let cases: [(&str, Body, Body, DVec3); 2] = [
         (
             "quad light, straddling box",
             quad.into(),

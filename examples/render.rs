@@ -32,7 +32,8 @@
 //! measured on linear radiance over all pixels and channels.
 
 use arealight::glam::DVec3;
-use arealight::shade::{Demo, DemoConfig, Material, MonteCarlo, ReferenceBrdf, demo_scene};
+use arealight::internals::{Demo, DemoConfig, demo_scene};
+use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -2,12 +2,22 @@
 
 use core::fmt;
 
-/// Everything that can be wrong with the input of a public entry point.
+/// Everything that can go wrong in a public entry point.
 ///
 /// Every public function validates its input at the boundary and returns one of these instead of
-/// panicking or producing garbage. Locations are given as `(ring, vertex)` indices into the input as
-/// the caller passed it (a planar contour is a ring too), so the message points at the offending
-/// coordinate.
+/// panicking or producing garbage. There are two kinds, told apart by
+/// [`GeomError::is_undecidable`]:
+///
+/// - **Input faults** (every variant but [`GeomError::Undecidable`]): the input is invalid; skip
+///   it or fix it. Locations in vertex lists are `(ring, vertex)` indices into the input as the
+///   caller passed it (a planar contour is a ring too); a single argument that is not a vertex
+///   list (a shading point, a normal, a view direction, a primitive's center or axis) is named
+///   by [`GeomError::NonFiniteArgument`] or [`GeomError::ZeroLengthArgument`].
+/// - **Give-ups** ([`GeomError::Undecidable`]): the input is valid, but a configuration met on
+///   the way cannot be decided within rounding; a renderer falls back for this query.
+///
+/// More variants may be added (`#[non_exhaustive]`); match on the kind with
+/// [`GeomError::is_undecidable`] where only the kind matters.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum GeomError {
@@ -69,11 +79,36 @@ pub enum GeomError {
         /// Index of the second ring.
         other_ring: usize,
     },
+    /// An argument that is not part of a vertex list (a shading point, a normal or view
+    /// direction, a hemisphere's normal, a primitive's center, radii or axis) is NaN or
+    /// infinite.
+    NonFiniteArgument {
+        /// Which argument.
+        what: &'static str,
+    },
+    /// A direction argument (a normal, a view direction, an axis) has zero or subnormal length,
+    /// so it names no direction.
+    ZeroLengthArgument {
+        /// Which argument.
+        what: &'static str,
+    },
     /// A value lies outside the range the algorithm supports; the message names the range.
     OutOfRange {
         /// Which input is out of range.
         what: &'static str,
         /// The offending value.
+        value: f64,
+        /// The largest supported magnitude.
+        limit: f64,
+    },
+    /// A coordinate of a vertex lies outside the supported range; the message names the vertex
+    /// and the range.
+    CoordinateOutOfRange {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Index of the vertex within the ring.
+        vertex: usize,
+        /// The offending magnitude.
         value: f64,
         /// The largest supported magnitude.
         limit: f64,
@@ -91,8 +126,9 @@ pub enum GeomError {
     /// The directions are not contained in any open hemisphere, so no gnomonic projection maps them
     /// all to the plane.
     NotInOpenHemisphere,
-    /// The input is geometrically degenerate in a way the operation cannot resolve; the string
-    /// says how. This is a fault of the input: fix or drop it.
+    /// The input is geometrically degenerate in a way the operation cannot resolve (coplanar
+    /// points for a hull, collinear consecutive contour points, a singular map); the string says
+    /// how. This is a fault of the input: fix or drop it.
     Degenerate(&'static str),
     /// The input is valid, but the computation met a configuration it cannot decide exactly
     /// (near-degenerate within rounding) and declined to guess rather than return a possibly
@@ -124,6 +160,22 @@ pub enum GeomError {
         face: usize,
         /// Index of the vertex in front of it.
         vertex: usize,
+    },
+    /// (solid) A mesh that must bound a solid has two triangles that cross, overlap or touch
+    /// anywhere but along an edge or at a vertex they share as neighbours on the surface.
+    SelfIntersectingMesh {
+        /// Index of the first triangle.
+        triangle: usize,
+        /// Index of the second triangle.
+        other: usize,
+    },
+    /// (solid) A mesh that must bound a solid has a vertex whose triangles form more than one
+    /// fan (two parts of the surface touch at the vertex, as two cones tip to tip).
+    NonManifoldVertex {
+        /// Index of the vertex.
+        vertex: usize,
+        /// Index of a triangle of a second fan at that vertex.
+        triangle: usize,
     },
 }
 
@@ -172,9 +224,26 @@ impl fmt::Display for GeomError {
                 "rings {ring} and {other_ring} border the same face but disagree on which side is \
                  inside; reverse one of them (outer rings counter-clockwise, holes clockwise)"
             ),
+            GeomError::NonFiniteArgument { what } => {
+                write!(f, "the {what} is NaN or infinite; pass finite values")
+            }
+            GeomError::ZeroLengthArgument { what } => write!(
+                f,
+                "the {what} has zero (or subnormal) length and names no direction"
+            ),
             GeomError::OutOfRange { what, value, limit } => write!(
                 f,
                 "{what} is {value:e}, outside the supported range (magnitude at most {limit:e})"
+            ),
+            GeomError::CoordinateOutOfRange {
+                ring,
+                vertex,
+                value,
+                limit,
+            } => write!(
+                f,
+                "a coordinate of vertex {vertex} in ring {ring} has magnitude {value:e}, outside \
+                 the supported range (at most {limit:e}); scale the input down"
             ),
             GeomError::OpenChain { edge } => write!(
                 f,
@@ -205,7 +274,19 @@ impl fmt::Display for GeomError {
             GeomError::OpenMesh { triangle } => write!(
                 f,
                 "triangle {triangle} has an edge not shared by exactly one other triangle running \
-                 the opposite way; a convex polyhedron must be a closed, consistently oriented mesh"
+                 the opposite way; a convex polyhedron or a solid must be a closed, consistently \
+                 oriented mesh"
+            ),
+            GeomError::SelfIntersectingMesh { triangle, other } => write!(
+                f,
+                "triangles {triangle} and {other} cross or touch away from a shared edge or \
+                 vertex: the mesh does not bound a solid; fix the mesh or use it per triangle"
+            ),
+            GeomError::NonManifoldVertex { vertex, triangle } => write!(
+                f,
+                "vertex {vertex} joins separate fans of triangles (triangle {triangle} is in a \
+                 second one): the surface touches itself there; split the vertex or use the mesh \
+                 per triangle"
             ),
             GeomError::NotConvex { face, vertex } => write!(
                 f,
@@ -224,6 +305,19 @@ impl GeomError {
     #[must_use]
     pub fn is_undecidable(&self) -> bool {
         matches!(self, GeomError::Undecidable(_))
+    }
+}
+
+impl GeomError {
+    /// This error, met on an intermediate result the crate built itself from valid input, as a
+    /// give-up: an [`GeomError::Undecidable`] stays as it is, any other error (a spherical
+    /// polygon the rounding made invalid, a planar operation that did not settle) becomes
+    /// `Undecidable(context)`, since nothing the caller passed was wrong.
+    pub(crate) fn give_up(self, context: &'static str) -> GeomError {
+        match self {
+            GeomError::Undecidable(_) => self,
+            _ => GeomError::Undecidable(context),
+        }
     }
 }
 

@@ -2,10 +2,10 @@
 //! records the property that found it and what was wrong, and checks validity and the identities
 //! (plus the chain property where that is what failed).
 
-mod planar_support;
+mod support;
 
 use arealight::planar::{BoolOp, Shape, boolean};
-use planar_support::*;
+use support::planar::*;
 
 fn chain(light: &str, tris: &[&str]) {
     let light = shape(light);
@@ -81,10 +81,10 @@ fn vertex_at_edge_midpoint_union() {
 /// planar shapes that the sphere layer's union in
 /// `sphere_boolean::regression_union_with_vertex_copies_ulps_apart` builds without its own
 /// weld: A's rings 1 and 3 hold `(-0.29782521525192895, 0.115230665014275)` as two copies
-/// `6e-17` apart, and B's first vertex is as close to both. B used to be snapped to one copy
-/// only, so the union kept B and ring 3 as two contours whose shared edge overlapped within
-/// rounding (valid by `Shape::validate`, wrong as an operand). Now every operand vertex within
-/// the snapping distance of another is welded, and B merges with ring 3.
+/// `6e-17` apart, and B's first vertex is as close to both. Snapping B to one copy only would
+/// leave B and ring 3 as two contours whose shared edge overlaps within rounding (valid by
+/// `Shape::validate`, wrong as an operand); every operand vertex within the snapping distance of
+/// another is welded instead, so B must merge with ring 3.
 #[test]
 fn union_with_vertex_copies_ulps_apart_within_one_operand() {
     let a = shape(
@@ -114,9 +114,9 @@ fn union_with_vertex_copies_ulps_apart_within_one_operand() {
 /// projection (before its weld). A's edge from vertex 4 to 5 and B's edge from 0 to 1 are the
 /// same edge up to `1.5e-15`, just over the snapping distance `1.3e-15`, so the vertices stay
 /// distinct; each is inserted into the other operand's edge, and B's closing edge, passing within
-/// the distance of A's vertex 4 near its end, gets that vertex too. B's split ring then ran
-/// `A4, B0, A4`: a spike through two copies of one point, whose node had an incoming result edge
-/// and no outgoing one. Spikes in the split rings are now cut back.
+/// the distance of A's vertex 4 near its end, gets that vertex too. B's split ring then runs
+/// `A4, B0, A4`: a spike through two copies of one point, whose node has an incoming result edge
+/// and no outgoing one unless spikes in the split rings are cut back, as they must be.
 #[test]
 fn difference_with_nearly_shared_edge() {
     let a = shape(

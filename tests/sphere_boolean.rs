@@ -1,16 +1,17 @@
 //! Spherical set operations: solid-angle identities on random and degenerate operands, Monte
 //! Carlo checks for regions larger than a hemisphere, and the seed's per-triangle workflow.
 
-mod common;
+mod support;
 
 use arealight::glam::DVec3;
 use arealight::planar::BoolOp;
 use arealight::sphere::{SphericalPolygon, order_directed_edges};
-use common::{
-    Rng, assert_mc_agrees, boundary_edges, crossed_cells, icosphere, mc_solid_angle, star_ring,
-};
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{
+    assert_mc_agrees, boundary_edges, crossed_cells, icosphere, mc_solid_angle, star_ring,
+};
 
 /// Identity tolerance: 1e-11 of the sphere, below the 1e-10 * 4 pi.
 const TOL: f64 = 1e-11 * 4.0 * PI;
@@ -117,7 +118,7 @@ fn check_identities(a: &SphericalPolygon, b: &SphericalPolygon) -> Result<(), Te
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     #[test]
     fn identities_hold(seed in any::<u64>()) {
@@ -379,8 +380,8 @@ fn near_antipodal_operands() {
 #[test]
 fn fuzz_regression_union_touching_at_a_vertex_inside_an_edge() {
     // B touches the boundary circle of the hemisphere A at one of B's vertices, which lies
-    // inside an edge of A. The planar union returned the touching point as a T-junction, which
-    // is not a valid spherical ring set; it is now inserted into the touched edge.
+    // inside an edge of A. The planar union returns the touching point as a T-junction, which is
+    // not a valid spherical ring set, so it must be inserted into the touched edge.
     let a = SphericalPolygon::new(vec![vec![
         DVec3::new(48.0, 48.0, 37.0),
         DVec3::new(-1.0, -1.0, -1.0),
@@ -430,8 +431,8 @@ fn fuzz_regression_pinch_vertex_containment() {
 #[test]
 fn fuzz_regression_touching_a_boundary_that_lies_on_a_cut() {
     // B is the hemisphere bounded by the great circle y = 0, one of the octant cuts; A touches
-    // it at one of its vertices. After the cut edges cancelled, A's vertex lay inside one of B's
-    // surviving circle edges; the circle is now split there.
+    // it at one of its vertices. After the cut edges cancel, A's vertex lies inside one of B's
+    // surviving circle edges, which must be split there.
     let a = SphericalPolygon::new(vec![vec![
         DVec3::new(0.0, -1.0, 1.0),
         DVec3::new(0.0, -1.0, 64.0),
@@ -490,8 +491,8 @@ fn fuzz_regression_pinch_on_the_cut_circle() {
 fn regression_union_with_vertex_copies_ulps_apart() {
     // Union of the front faces of a two-box light (tests/shade_geometry.rs, point 20): the
     // accumulated region holds two copies of one mesh vertex 6e-17 apart (rings 1 and 3), from
-    // different earlier projections. The planar union welded the next triangle to one copy and
-    // kept an edge overlapping the other; operands are now welded within 1e-12 first.
+    // different earlier projections. Welding the next triangle to one copy only would keep an
+    // edge overlapping the other, so operands are welded within 1e-12 first.
     let v = DVec3::new;
     let a = SphericalPolygon::new(vec![
         vec![

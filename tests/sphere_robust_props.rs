@@ -9,19 +9,20 @@
 //! reports how often anything fails (`cargo test --test sphere_robust_props census --
 //! --nocapture`; `SPHERE_CENSUS=N` cases per family, default 2000).
 
-mod common;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::sphere::{Gnomonic, HORIZON_TOLERANCE, SphericalPolygon};
-use common::{Rng, polar, star_ring};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{polar, star_ring};
 
 /// `p` validated both ways: the shared invariant checker, and `new` on its rings (which must
 /// agree, and give the same region back).
@@ -332,7 +333,7 @@ fn check_horizon(case: &HorizonCase) -> Result<(), String> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     /// Horizon family: continuity of the clipped solid angle and of its clamped-cosine integral
     /// as a vertex crosses the horizon (values at +-eps and at 0 within a bound proportional to
@@ -644,7 +645,7 @@ fn contains_mismatch(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     /// Tiny family: set operations on tiny polygons, their complements and near-antipodal tiny
     /// pairs agree with the reference (i_overlay in the gnomonic plane, or disjointness) at the
@@ -962,7 +963,7 @@ fn check_sliver(case: &SliverCase) -> Result<bool, Finding> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     /// Sliver family: a polygon and its copy with one vertex moved by 1e-15..1e-9 of its size
     /// (sizes 1e-6..1.4 rad, complements): valid results, identities, and A xor B within the

@@ -11,10 +11,10 @@ use alloc::vec::Vec;
 
 use glam::DVec3;
 
-use super::brdf::Material;
-use super::mesh::{ConvexPolyhedron, TriangleMesh};
-use super::scene::{Light, Scene, Shape};
+use super::material::Material;
+use super::scene::{Light, Scene};
 use crate::GeomError;
+use crate::solid::{Body, ConvexPolyhedron, TriangleMesh};
 
 /// Which lights and occluders of the test scene to include.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,14 +86,14 @@ pub fn demo_scene(cfg: DemoConfig) -> Result<Demo, GeomError> {
         8,
         19,
     )?;
-    let all_occ: Vec<Shape> = vec![cube.into(), ico.into(), ell.into()];
+    let all_occ: Vec<Body> = vec![cube.into(), ico.into(), ell.into()];
     let mats = [
         Material::new(DVec3::new(0.7, 0.25, 0.2), DVec3::splat(0.04), 0.5)?,
         Material::new(DVec3::new(0.25, 0.6, 0.3), DVec3::splat(0.04), 0.35)?,
         Material::new(DVec3::new(0.3, 0.35, 0.7), DVec3::splat(0.04), 0.6)?,
     ];
     let lights = all_lights.into_iter().take(cfg.lights.min(3)).collect();
-    let occluders: Vec<Shape> = all_occ.into_iter().take(cfg.occluders.min(3)).collect();
+    let occluders: Vec<Body> = all_occ.into_iter().take(cfg.occluders.min(3)).collect();
     let occluder_materials = mats[..occluders.len()].to_vec();
     Ok(Demo {
         scene: Scene::new(lights, occluders)?,

@@ -1,22 +1,18 @@
 //! Shading with area lights and analytic soft shadows: scenes of lights and occluders, and the
 //! radiance they give a shading point (seed paper 000, Alg. 1-3; thesis 003, section 4.2).
 //!
-//! - [`mesh`]: [`TriangleMesh`] (any mesh, the per-triangle method) and [`ConvexPolyhedron`]
-//!   (validated, or built as a convex hull), with the primitives of the seed paper's test scene.
-//! - [`silhouette`]: the spherical polygon of a convex polyhedron seen from a point (its
-//!   silhouette, oriented by front faces) and of single triangles, in the [`ShadingFrame`].
-//! - [`cull`]: discarding occluders that cannot lie between the point and a light (`GetBetween`).
-//! - [`brdf`]: [`Material`] (Lambert + GGX with Schlick's Fresnel).
-//! - [`demo`]: the test scene of seed 000 (Fig. 4), shared by the render example, tests and benches.
-//! - [`scene`]: [`Scene::shade`], the analytic radiance at a shading point, with the exact
-//!   visibility rule of [`Scene::visible_region`]: a blocker hides a light face only with its
-//!   part on the point's side of the face's plane. Blockers whose convex hull is disjoint from
-//!   the light's are decided by a separating plane computed once per scene (a private module,
-//!   `separation`), so the silhouette path stays as fast as plain subtraction; blockers that
-//!   interpenetrate a light are cut by its face planes.
-//! - [`reference`](mod@reference): a Monte Carlo estimator of the same radiance (solid-angle sampling of the
-//!   lights' triangles, exact ray-triangle visibility), with its standard error, for tests and
+//! - [`Scene`]: lights ([`Light`]) and occluders, and [`Scene::shade`], the analytic radiance at
+//!   a shading point. Which part of each light the point sees comes from the visibility layer
+//!   ([`crate::visibility::ClipVisibility`], the exact rule of [`Scene::visible_region`]).
+//! - [`Scene::shade_per_light`]: every light's share, split into diffuse and specular lobes,
+//!   with its unshadowed value ([`LightShading`]), for denoising and ratio estimators.
+//! - [`Material`]: Lambert + GGX with Schlick's Fresnel.
+//! - [`MonteCarlo`]: an estimator of the same radiance (solid-angle sampling of the lights'
+//!   triangles, exact ray-triangle visibility), with its standard error, for tests and
 //!   comparisons.
+//!
+//! The geometry types of the scene live in [`crate::solid`] and are re-exported here
+//! ([`TriangleMesh`], [`ConvexPolyhedron`], [`Body`], [`ShadingFrame`]).
 //!
 //! # Limitations
 //!
@@ -30,7 +26,7 @@
 //!   face-by-face path and the Monte Carlo reference nothing (no front face is seen).
 //! - The per-triangle path (meshes, and [`Method::PerTriangle`]) chains many spherical booleans
 //!   of edge-sharing triangles; on a few near-degenerate configurations the `sphere` layer may
-//!   report [`crate::GeomError::Degenerate`] (none in the current tests). The silhouette path
+//!   give up with [`crate::GeomError::Undecidable`] (none in the current tests). The silhouette path
 //!   of convex shapes has not been seen to fail.
 //!
 //! # Examples
@@ -61,19 +57,15 @@
 //! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
-pub mod brdf;
-pub mod cull;
-pub mod demo;
-pub mod mesh;
-pub mod reference;
-pub mod scene;
-mod separation;
-pub mod silhouette;
+pub(crate) mod demo;
+mod material;
+mod query;
+pub(crate) mod reference;
+mod scene;
 
-pub use brdf::Material;
-pub use cull::{BoundingSphere, may_occlude};
-pub use demo::{Demo, DemoConfig, demo_scene};
-pub use mesh::{ConvexPolyhedron, TriangleMesh};
-pub use reference::{Estimate, MonteCarlo, Pcg32, ReferenceBrdf};
-pub use scene::{Light, Method, Scene, Shape};
-pub use silhouette::{ShadingFrame, TriangleRole, convex_silhouette, triangle_polygon};
+pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
+pub use crate::visibility::{Blocker, Method};
+pub use material::Material;
+pub use query::LightShading;
+pub use reference::{Estimate, MonteCarlo, ReferenceBrdf};
+pub use scene::{Light, Scene};

@@ -19,18 +19,18 @@ use alloc::vec::Vec;
 
 use glam::{DVec2, DVec3};
 
-use super::brdf::Material;
-use super::scene::{Scene, Shape};
-use super::silhouette::ShadingFrame;
+use super::material::Material;
+use super::scene::Scene;
 use crate::GeomError;
 use crate::ltc::{Ltc, lookup};
 use crate::math::sqrt;
+use crate::solid::{Body, BoundingSphere, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalTriangle;
 
 /// PCG32 (O'Neill 2014, `XSH RR` output): a small, fast, deterministic generator, so that the
 /// crate needs no RNG dependency and every estimate is reproducible from its seed.
 #[derive(Debug, Clone)]
-pub struct Pcg32 {
+pub(crate) struct Pcg32 {
     state: u64,
     inc: u64,
 }
@@ -38,7 +38,7 @@ pub struct Pcg32 {
 impl Pcg32 {
     /// A generator for `seed` on stream `stream` (different streams are independent sequences).
     #[must_use]
-    pub fn new(seed: u64, stream: u64) -> Self {
+    pub(crate) fn new(seed: u64, stream: u64) -> Self {
         let mut r = Pcg32 {
             state: 0,
             inc: (stream << 1) | 1,
@@ -50,7 +50,7 @@ impl Pcg32 {
     }
 
     /// The next 32 random bits.
-    pub fn next_u32(&mut self) -> u32 {
+    pub(crate) fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old
             .wrapping_mul(6_364_136_223_846_793_005)
@@ -61,20 +61,21 @@ impl Pcg32 {
     }
 
     /// Uniform in `[0, 1)` with 53 random bits.
-    pub fn next_f64(&mut self) -> f64 {
+    pub(crate) fn next_f64(&mut self) -> f64 {
         let hi = u64::from(self.next_u32()) << 21;
         let lo = u64::from(self.next_u32()) >> 11;
         ((hi | lo) as f64) * (1.0 / (1u64 << 53) as f64)
     }
 
     /// Two uniform numbers in `[0, 1)`.
-    pub fn next_2d(&mut self) -> DVec2 {
+    pub(crate) fn next_2d(&mut self) -> DVec2 {
         DVec2::new(self.next_f64(), self.next_f64())
     }
 }
 
 /// Which BRDF the Monte Carlo estimator integrates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ReferenceBrdf {
     /// The BRDF as the analytic path models it: Lambert plus the LTC distribution scaled by the
     /// table's Fresnel-weighted norm. The estimate then differs from [`Scene::shade`] only by
@@ -204,7 +205,7 @@ impl MonteCarlo {
         // skipped as a blocker of itself; its own mesh is checked separately when it is not
         // convex).
         let no = scene.occluders().len();
-        let blockers: Vec<(&super::mesh::TriangleMesh, (DVec3, f64))> = scene
+        let blockers: Vec<(&TriangleMesh, BoundingSphere)> = scene
             .occluders()
             .iter()
             .chain(scene.lights().iter().map(|l| l.shape()))
@@ -234,7 +235,7 @@ impl MonteCarlo {
             if tris.is_empty() {
                 continue;
             }
-            let self_occluding = matches!(light.shape(), Shape::Mesh(_));
+            let self_occluding = matches!(light.shape(), Body::Mesh(_));
             let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
             for _ in 0..n {
                 let pick = rng.next_f64() * total;
@@ -259,7 +260,7 @@ impl MonteCarlo {
                 };
                 let t_max = t_light * (1.0 - RAY_EPS);
                 let t_min = t_light * RAY_EPS;
-                let blocked_by = |m: &super::mesh::TriangleMesh, skip: Option<usize>| {
+                let blocked_by = |m: &TriangleMesh, skip: Option<usize>| {
                     (0..m.triangle_count()).any(|j| {
                         Some(j) != skip
                             && ray_triangle(x, w, m.triangle(j))
@@ -268,9 +269,9 @@ impl MonteCarlo {
                 };
                 let mut blocked = self_occluding && blocked_by(mesh, Some(ti));
                 if !blocked {
-                    for (j, &(m, (c, r))) in blockers.iter().enumerate() {
+                    for (j, &(m, bound)) in blockers.iter().enumerate() {
                         if j != no + li
-                            && ray_meets_sphere(x, w, c, r, t_max)
+                            && ray_meets_sphere(x, w, bound.center, bound.radius, t_max)
                             && blocked_by(m, None)
                         {
                             blocked = true;

@@ -66,11 +66,12 @@ impl SphericalPolygon {
     ///
     /// # Errors
     ///
-    /// Only [`GeomError::Undecidable`], when `f64` cannot resolve the operands' contacts
-    /// consistently (the planar operation does not settle, or no projection gives a valid
-    /// result); valid operands in exactly degenerate positions (shared vertices and edges) are
-    /// supported. In the crate's tests this happens for about one difference in ten thousand
-    /// of a chain over a mesh whose vertex copies are jittered by `1e-11`.
+    /// Only [`GeomError::Undecidable`] (both operands are valid polygons, so nothing else can be
+    /// wrong with the input), when `f64` cannot resolve the operands' contacts consistently (the
+    /// planar operation does not settle, or no projection gives a valid result); valid operands
+    /// in exactly degenerate positions (shared vertices and edges) are supported. In the crate's
+    /// tests this happens for about one difference in ten thousand of a chain over a mesh whose
+    /// vertex copies are jittered by `1e-11`.
     pub fn boolean(
         &self,
         other: &SphericalPolygon,
@@ -105,13 +106,16 @@ impl SphericalPolygon {
         // The operands are valid: what fails from here on is a numerical give-up.
         match split(self, other, op) {
             Ok(r) if r.validate().is_ok() => Ok(r),
-            _ => Err(GeomError::Undecidable(
-                "spherical boolean: the operands are closer to a degenerate contact than f64 \
-                 resolves (no projection and no octant split gave a valid result)",
-            )),
+            Ok(_) => Err(GeomError::Undecidable(BOOLEAN_FAILED)),
+            Err(e) => Err(e.give_up(BOOLEAN_FAILED)),
         }
     }
 }
+
+/// What [`SphericalPolygon::boolean`] reports when neither a projection nor the octant split
+/// gives a valid result and the failure is not already an [`GeomError::Undecidable`].
+const BOOLEAN_FAILED: &str = "spherical boolean: the operands are closer to a degenerate contact \
+     than f64 resolves (no projection and no octant split gave a valid result)";
 
 /// Results that need no geometry: an empty or full operand.
 fn trivial(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<SphericalPolygon> {
@@ -213,7 +217,7 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
     for ring in q.rings() {
         let mut c = Vec::with_capacity(ring.len());
         for &v in ring {
-            c.push(g.project(v).ok_or(GeomError::Degenerate(
+            c.push(g.project(v).ok_or(GeomError::Undecidable(
                 "a vertex left the projection hemisphere",
             ))?);
         }
@@ -680,8 +684,8 @@ fn cancel_cut_edges(edges: Vec<(DVec3, DVec3)>) -> Result<Vec<(DVec3, DVec3)>, G
                     1 => out.push((p0, p)),
                     -1 => out.push((p, p0)),
                     _ => {
-                        return Err(GeomError::Degenerate(
-                            "octant pieces overlap along a cut; the operands are not valid",
+                        return Err(GeomError::Undecidable(
+                            "octant pieces overlap along a cut; the octant solutions disagree within rounding",
                         ));
                     }
                 }

@@ -93,12 +93,14 @@ impl SphericalPolygon {
     ///
     /// # Errors
     ///
-    /// [`GeomError::NonFinite`] or [`GeomError::ZeroVector`] (ring 0, vertex 0) for the normal.
+    /// [`GeomError::NonFiniteArgument`] or [`GeomError::ZeroLengthArgument`] (`what` is
+    /// `"hemisphere normal"`) for the normal.
     pub fn try_clip_to_hemisphere(&self, normal: DVec3) -> Result<SphericalPolygon, GeomError> {
+        const WHAT: &str = "hemisphere normal";
         if !normal.is_finite() {
-            return Err(GeomError::NonFinite { ring: 0, vertex: 0 });
+            return Err(GeomError::NonFiniteArgument { what: WHAT });
         }
-        let n = normalize_any(normal).ok_or(GeomError::ZeroVector { ring: 0, vertex: 0 })?;
+        let n = normalize_any(normal).ok_or(GeomError::ZeroLengthArgument { what: WHAT })?;
         Ok(clip_polygon(self, n))
     }
 }

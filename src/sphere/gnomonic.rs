@@ -41,12 +41,14 @@ impl Gnomonic {
     ///
     /// # Errors
     ///
-    /// [`GeomError::NonFinite`] or [`GeomError::ZeroVector`] when `center` names no direction.
+    /// [`GeomError::NonFiniteArgument`] or [`GeomError::ZeroLengthArgument`] (`what` is
+    /// `"projection center"`) when `center` names no direction.
     pub fn new(center: DVec3) -> Result<Self, GeomError> {
+        const WHAT: &str = "projection center";
         if !center.is_finite() {
-            return Err(GeomError::NonFinite { ring: 0, vertex: 0 });
+            return Err(GeomError::NonFiniteArgument { what: WHAT });
         }
-        let c = normalize_any(center).ok_or(GeomError::ZeroVector { ring: 0, vertex: 0 })?;
+        let c = normalize_any(center).ok_or(GeomError::ZeroLengthArgument { what: WHAT })?;
         let (u, v) = tangent_frame(c);
         Ok(Gnomonic { center: c, u, v })
     }
@@ -207,9 +209,19 @@ mod tests {
 
     #[test]
     fn invalid_centers_are_errors() {
-        assert!(Gnomonic::new(DVec3::ZERO).is_err());
-        assert!(Gnomonic::new(DVec3::new(f64::INFINITY, 0.0, 0.0)).is_err());
-        assert!(enclosing_cap(&[]).is_err());
+        assert!(matches!(
+            Gnomonic::new(DVec3::ZERO),
+            Err(GeomError::ZeroLengthArgument {
+                what: "projection center"
+            })
+        ));
+        assert!(matches!(
+            Gnomonic::new(DVec3::new(f64::INFINITY, 0.0, 0.0)),
+            Err(GeomError::NonFiniteArgument {
+                what: "projection center"
+            })
+        ));
+        assert!(matches!(enclosing_cap(&[]), Err(GeomError::Degenerate(_))));
         let g = Gnomonic::new(DVec3::new(0.0, 0.0, 1e300)).unwrap();
         assert_eq!(g.center(), DVec3::Z);
         assert!(g.unproject(DVec2::new(f64::NAN, 0.0)).is_nan());

@@ -8,7 +8,8 @@
 //! valid inputs, not that arbitrary bytes are valid.
 
 use arealight::glam::DVec2;
-use arealight::planar::{BoolOp, Shape, boolean, boolean_fast, boolean_robust};
+use arealight::internals::{boolean_fast, boolean_robust};
+use arealight::planar::{BoolOp, Shape, boolean};
 use libfuzzer_sys::arbitrary::{self, Arbitrary};
 
 /// One fuzz case. `Debug` prints the rings so a crash pastes into a regression test.

@@ -332,7 +332,7 @@ fn edge_status(
 /// FHP vertex classes for the vertices of `r`, given its edge statuses.
 ///
 /// Tracing needs only the edge statuses, so this runs only for diagnostics and tests
-/// ([`crate::planar::contact_classes`]), which check the classes against FHP's definitions on known
+/// ([`crate::internals::contact_classes`]), which check the classes against FHP's definitions on known
 /// configurations.
 pub(crate) fn classify(
     r_nxt: &[u32],

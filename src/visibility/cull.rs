@@ -10,15 +10,7 @@
 use glam::DVec3;
 
 use crate::math::{acos, asin};
-
-/// A sphere holding an object, for culling.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BoundingSphere {
-    /// Center.
-    pub center: DVec3,
-    /// Radius (non-negative).
-    pub radius: f64,
-}
+use crate::solid::BoundingSphere;
 
 /// Angular margin (radians) added to every cone test, far above the rounding of the angles, so
 /// that an occluder grazing the light's cone is kept rather than lost.
@@ -36,7 +28,8 @@ const MARGIN: f64 = 1e-9;
 ///
 /// ```
 /// use arealight::glam::DVec3;
-/// use arealight::shade::{BoundingSphere, may_occlude};
+/// use arealight::internals::may_occlude;
+/// use arealight::solid::BoundingSphere;
 /// let light = BoundingSphere { center: DVec3::new(0.0, 0.0, 5.0), radius: 1.0 };
 /// let between = BoundingSphere { center: DVec3::new(0.0, 0.0, 2.0), radius: 0.5 };
 /// let aside = BoundingSphere { center: DVec3::new(4.0, 0.0, 2.0), radius: 0.5 };

@@ -1,5 +1,5 @@
 //! Separating planes between a light and a blocker (an occluder or another light), computed once
-//! per scene: the fast path of the exact visibility rule in [`crate::shade::scene`].
+//! per scene: the fast path of the exact visibility rule of [`crate::visibility::ClipVisibility`].
 //!
 //! If a plane has the blocker on one closed side and the light on the other, every ray from a
 //! shading point `x` crosses the plane at most once, so along every ray that meets both, the
@@ -7,7 +7,7 @@
 //! it hides of the light in projection (subtract its whole silhouette, seed 000 Alg. 1 lines
 //! 7-12), and a blocker on the other side hides nothing. For disjoint convex hulls such a plane
 //! always exists, and per shading point the decision is one dot product; the per-face handling of
-//! [`crate::shade::Scene::visible_region`] is left for blockers that interpenetrate a light.
+//! [`crate::visibility::ClipVisibility`] is left for blockers that interpenetrate a light.
 //!
 //! Why not the simpler per-point test "every blocker vertex on the point's side of every front
 //! face plane": a light's nearly edge-on front faces have planes passing close to the point, and
@@ -26,7 +26,7 @@
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::mesh::TriangleMesh;
+use super::mesh::{BoundingSphere, TriangleMesh};
 
 /// Overlap, relative to the pair's scale, up to which a plane still counts as separating: hulls
 /// that touch (a face on a face) are separated by a plane only up to rounding. A sliver of this
@@ -64,8 +64,14 @@ impl Separation {
 /// A plane separating the convex hulls of `light`'s and `blocker`'s vertices, or `None` when they
 /// overlap (or touch in a way no candidate plane verifies, e.g. edge on edge).
 pub(crate) fn separating_plane(light: &TriangleMesh, blocker: &TriangleMesh) -> Option<Separation> {
-    let (ca, ra) = light.bounding_sphere();
-    let (cb, rb) = blocker.bounding_sphere();
+    let BoundingSphere {
+        center: ca,
+        radius: ra,
+    } = light.bounding_sphere();
+    let BoundingSphere {
+        center: cb,
+        radius: rb,
+    } = blocker.bounding_sphere();
     let scale = ra + rb + (ca - cb).length();
     let tol = OVERLAP_TOLERANCE * scale;
     // Relative to the light's center, so every dot product below rounds at the pair's own scale
@@ -152,7 +158,7 @@ fn min_norm_difference(a: &[DVec3], b: &[DVec3], scale: f64) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shade::mesh::ConvexPolyhedron;
+    use crate::solid::ConvexPolyhedron;
 
     fn cube(c: DVec3, h: f64) -> TriangleMesh {
         ConvexPolyhedron::cuboid(c, DVec3::splat(h))

@@ -20,7 +20,10 @@ use crate::ltc::{GGX_MIN_ALPHA, ggx_brdf_cos};
 /// use arealight::shade::Material;
 /// let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4)?;
 /// assert!((m.alpha() - 0.16).abs() < 1e-15);
-/// assert!(Material::new(DVec3::splat(-0.1), DVec3::ZERO, 0.5).is_err());
+/// assert!(matches!(
+///     Material::new(DVec3::splat(-0.1), DVec3::ZERO, 0.5),
+///     Err(arealight::GeomError::OutOfRange { what: "material albedo", .. })
+/// ));
 /// # Ok::<(), arealight::GeomError>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,0 +1,453 @@
+//! Validated triangle meshes with edge adjacency, and the bounding spheres the culling uses.
+
+use alloc::vec::Vec;
+
+use glam::DVec3;
+
+use super::facing::FACE_TOLERANCE;
+use crate::GeomError;
+use crate::math::sqrt;
+
+/// Largest coordinate magnitude accepted by the mesh constructors.
+///
+/// Squared distances and cross products of coordinates must stay finite and keep relative
+/// precision; `1e100` leaves a wide margin below `sqrt(f64::MAX) ~ 1.3e154`. (The planar layer's
+/// limit, [`crate::planar::MAX_COORD`], is higher: its predicates square coordinates only once.)
+pub const MAX_MESH_COORD: f64 = 1e100;
+
+/// A triangle is degenerate when twice its area is at most this fraction of the square of its
+/// longest edge (its smallest angle is then below about `1e-12` rad).
+///
+/// Below that, the face normal is dominated by rounding (a cross product of `f64` edge vectors
+/// carries a relative error of a few `1e-16` of the squared edge length), so front/back facing
+/// would be a coin toss.
+pub const DEGENERATE_TRIANGLE: f64 = 1e-12;
+
+/// A sphere holding an object: what the culling tests and the scale-relative tolerances use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundingSphere {
+    /// Center.
+    pub center: DVec3,
+    /// Radius (non-negative).
+    pub radius: f64,
+}
+
+/// Checks a vertex list: finite and within [`MAX_MESH_COORD`]. `ring` in the error is 0.
+pub(crate) fn check_vertices(vertices: &[DVec3]) -> Result<(), GeomError> {
+    for (i, v) in vertices.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(GeomError::NonFinite { ring: 0, vertex: i });
+        }
+        let m = v.abs().max_element();
+        if m > MAX_MESH_COORD {
+            return Err(GeomError::OutOfRange {
+                what: "mesh vertex coordinate",
+                value: m,
+                limit: MAX_MESH_COORD,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Center of the axis-aligned bounding box and the largest distance from it to a vertex: a
+/// bounding sphere (not the smallest one, but within a factor `sqrt 3` of it), used for culling.
+fn bounding_sphere(vertices: &[DVec3]) -> BoundingSphere {
+    let Some(&first) = vertices.first() else {
+        return BoundingSphere {
+            center: DVec3::ZERO,
+            radius: 0.0,
+        };
+    };
+    let (lo, hi) = vertices
+        .iter()
+        .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let c = 0.5 * (lo + hi);
+    let r2 = vertices
+        .iter()
+        .map(|&v| (v - c).length_squared())
+        .fold(0.0, f64::max);
+    // Pad by a relative ulp margin so that the sphere truly contains every vertex after rounding.
+    BoundingSphere {
+        center: c,
+        radius: sqrt(r2) * (1.0 + 1e-12),
+    }
+}
+
+/// An edge of a triangle mesh with the triangles on either side. It runs `a -> b`
+/// counter-clockwise around triangle `f0` (seen from the side its normal points to), hence
+/// `b -> a` around `f1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct MeshEdge {
+    /// First vertex (index into [`TriangleMesh::vertices`]).
+    pub a: u32,
+    /// Second vertex.
+    pub b: u32,
+    /// The triangle around which `a -> b` is counter-clockwise.
+    pub f0: u32,
+    /// The triangle running `b -> a` along the same edge, or [`MeshEdge::BORDER`] on a border (the
+    /// edge belongs to `f0` alone) and on a non-manifold or inconsistently oriented edge (more
+    /// than two triangles, or two running the same way: each of them is then listed as an edge of
+    /// its own). A plain index rather than an `Option`, so that the silhouette loop over a convex
+    /// polyhedron's edges (all paired) tests nothing.
+    pub f1: u32,
+}
+
+impl MeshEdge {
+    /// The value of [`MeshEdge::f1`] for an edge with one triangle.
+    pub const BORDER: u32 = u32::MAX;
+
+    /// The second triangle, `None` for a border or non-manifold edge.
+    #[must_use]
+    pub fn twin(&self) -> Option<u32> {
+        (self.f1 != MeshEdge::BORDER).then_some(self.f1)
+    }
+}
+
+/// A triangle mesh: vertices and index triples. Triangles are counter-clockwise seen from the
+/// side their normal points to (outside, for a closed mesh); that side is the emitting side of a
+/// light.
+///
+/// The mesh need not be closed, convex or manifold: lights and occluders built from it use the
+/// per-triangle method (seed paper 000, section 4.4). Values are valid: coordinates are finite
+/// and at most [`MAX_MESH_COORD`] in magnitude, indices are in range and no triangle is
+/// degenerate ([`DEGENERATE_TRIANGLE`]). Construction also records each triangle's unit normal,
+/// its plane's offset for the facing predicate ([`crate::solid::face_side`]) and the edge
+/// adjacency ([`TriangleMesh::edges`]).
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::solid::TriangleMesh;
+/// // A unit square in the plane z = 2, facing down (-z).
+/// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+/// assert_eq!(quad.triangle_count(), 2);
+/// assert!(quad.triangle_normal(0).z < 0.0);
+/// // The diagonal is shared; the four sides are borders.
+/// assert_eq!(quad.edges().iter().filter(|e| e.twin().is_some()).count(), 1);
+/// assert_eq!(quad.edges().len(), 5);
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleMesh {
+    vertices: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+    /// Unit normal of each triangle.
+    normals: Vec<DVec3>,
+    /// Per triangle `f`: `normals[f] . (a_f - bounds.center)`, `a_f` its first corner, so that
+    /// the signed distance of `x` from its plane is `normals[f] . (x - center) - offsets[f]`.
+    offsets: Vec<f64>,
+    edges: Vec<MeshEdge>,
+    bounds: BoundingSphere,
+    /// All triangles in one plane, facing the same way.
+    planar: bool,
+    /// Every directed edge has exactly one reversed twin (a closed, consistently oriented
+    /// surface).
+    closed: bool,
+}
+
+impl TriangleMesh {
+    /// Builds and validates a mesh.
+    ///
+    /// # Errors
+    ///
+    /// - [`GeomError::NonFinite`] / [`GeomError::OutOfRange`] for a bad coordinate (`vertex` is the
+    ///   vertex index);
+    /// - [`GeomError::InvalidIndex`] for an index past the vertex list;
+    /// - [`GeomError::DegenerateTriangle`] for a triangle with (nearly) zero area or a repeated
+    ///   index;
+    /// - [`GeomError::TooFewVertices`] for a mesh without triangles.
+    pub fn new(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Result<Self, GeomError> {
+        check_vertices(&vertices)?;
+        if triangles.is_empty() {
+            return Err(GeomError::TooFewVertices { ring: 0, count: 0 });
+        }
+        let mut normals = Vec::with_capacity(triangles.len());
+        for (t, tri) in triangles.iter().enumerate() {
+            for &i in tri {
+                if i as usize >= vertices.len() {
+                    return Err(GeomError::InvalidIndex {
+                        triangle: t,
+                        index: i as usize,
+                    });
+                }
+            }
+            let [a, b, c] = tri.map(|i| vertices[i as usize]);
+            normals.push(
+                triangle_normal(a, b, c).ok_or(GeomError::DegenerateTriangle { triangle: t })?,
+            );
+        }
+        let bounds = bounding_sphere(&vertices);
+        let offsets = triangles
+            .iter()
+            .zip(&normals)
+            .map(|(t, n)| n.dot(vertices[t[0] as usize] - bounds.center))
+            .collect();
+        let n0 = normals[0];
+        let p0 = vertices[triangles[0][0] as usize];
+        let planar = normals.iter().all(|n| (*n - n0).length() <= 1e-12)
+            && vertices
+                .iter()
+                .all(|v| n0.dot(*v - p0).abs() <= FACE_TOLERANCE * bounds.radius);
+        let (edges, closed) = edge_adjacency(&triangles);
+        Ok(TriangleMesh {
+            vertices,
+            triangles,
+            normals,
+            offsets,
+            edges,
+            bounds,
+            planar,
+            closed,
+        })
+    }
+
+    /// The vertices.
+    #[must_use]
+    pub fn vertices(&self) -> &[DVec3] {
+        &self.vertices
+    }
+
+    /// The triangles, as indices into [`TriangleMesh::vertices`].
+    #[must_use]
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Number of triangles.
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// The three corners of triangle `i` (panics if `i` is out of range, like slice indexing).
+    #[must_use]
+    pub fn triangle(&self, i: usize) -> [DVec3; 3] {
+        self.triangles[i].map(|k| self.vertices[k as usize])
+    }
+
+    /// The unit normal of triangle `i` (the side it faces).
+    #[must_use]
+    pub fn triangle_normal(&self, i: usize) -> DVec3 {
+        self.normals[i]
+    }
+
+    /// The unit normals of all triangles, in triangle order.
+    pub(crate) fn normals(&self) -> &[DVec3] {
+        &self.normals
+    }
+
+    /// The plane offsets of all triangles relative to the bounding center (see the field).
+    pub(crate) fn offsets(&self) -> &[f64] {
+        &self.offsets
+    }
+
+    /// A sphere holding every vertex.
+    #[must_use]
+    pub fn bounding_sphere(&self) -> BoundingSphere {
+        self.bounds
+    }
+
+    /// The edges with the triangles on either side, each undirected edge once (sorted by vertex
+    /// indices). On a closed mesh every edge has two triangles.
+    #[must_use]
+    pub fn edges(&self) -> &[MeshEdge] {
+        &self.edges
+    }
+
+    /// Whether every vertex lies in one plane and every triangle faces the same way (a flat
+    /// light such as a quad). The triangles of a planar mesh are assumed not to overlap, so their
+    /// projections from any point are disjoint.
+    #[must_use]
+    pub fn is_planar(&self) -> bool {
+        self.planar
+    }
+
+    /// Whether the mesh is a closed, consistently oriented surface: every directed edge `a -> b`
+    /// of a triangle has exactly one reversed twin `b -> a` in another triangle (by vertex index).
+    ///
+    /// Seen from outside a closed mesh, every ray that meets the mesh meets a front face first
+    /// (it has to enter), which is why the union of the front faces is the region a closed light
+    /// covers; an open mesh (sheets) can show a back face first, which then hides what lies
+    /// behind it.
+    #[must_use]
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// The mesh of all triangles of `self` and `other` (no vertices are merged).
+    ///
+    /// # Errors
+    ///
+    /// Never for valid inputs; the `Result` guards the index range (more than `u32::MAX`
+    /// vertices is [`GeomError::OutOfRange`]).
+    pub fn merged(&self, other: &TriangleMesh) -> Result<Self, GeomError> {
+        let n = self.vertices.len();
+        if n + other.vertices.len() > u32::MAX as usize {
+            return Err(GeomError::OutOfRange {
+                what: "vertex count",
+                value: (n + other.vertices.len()) as f64,
+                limit: u32::MAX as f64,
+            });
+        }
+        let mut vertices = self.vertices.clone();
+        vertices.extend_from_slice(&other.vertices);
+        let mut triangles = self.triangles.clone();
+        triangles.extend(other.triangles.iter().map(|t| t.map(|i| i + n as u32)));
+        TriangleMesh::new(vertices, triangles)
+    }
+}
+
+/// The undirected edges of `triangles` with the triangles on either side, and whether the mesh
+/// is closed (every directed edge has exactly one reversed twin and none repeats, i.e. every
+/// edge pairs exactly two triangles running opposite ways).
+///
+/// The directed edges are sorted by `(min, max, triangle, direction)`, so the copies of one
+/// undirected edge are neighbours; a pair of opposite copies becomes one edge, anything else
+/// (a border, more than two triangles, two running the same way) one edge per copy.
+fn edge_adjacency(triangles: &[[u32; 3]]) -> (Vec<MeshEdge>, bool) {
+    let mut half: Vec<(u32, u32, u32, u32)> = Vec::with_capacity(3 * triangles.len());
+    for (f, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            half.push((a.min(b), a.max(b), f as u32, u32::from(a > b)));
+        }
+    }
+    half.sort_unstable();
+    let mut edges = Vec::with_capacity(half.len() / 2 + 1);
+    let mut closed = true;
+    let mut i = 0;
+    while i < half.len() {
+        let (lo, hi, f, dir) = half[i];
+        let mut end = i + 1;
+        while end < half.len() && half[end].0 == lo && half[end].1 == hi {
+            end += 1;
+        }
+        if end == i + 2 && half[i + 1].3 != dir {
+            let g = half[i + 1].2;
+            // dir == 0 means triangle f runs lo -> hi.
+            let (f0, f1) = if dir == 0 { (f, g) } else { (g, f) };
+            edges.push(MeshEdge {
+                a: lo,
+                b: hi,
+                f0,
+                f1,
+            });
+        } else {
+            closed = false;
+            for &(lo, hi, f, dir) in &half[i..end] {
+                let (a, b) = if dir == 0 { (lo, hi) } else { (hi, lo) };
+                edges.push(MeshEdge {
+                    a,
+                    b,
+                    f0: f,
+                    f1: MeshEdge::BORDER,
+                });
+            }
+        }
+        i = end;
+    }
+    (edges, closed)
+}
+
+/// Unit normal of the triangle `(a, b, c)` (counter-clockwise seen from the side it points to),
+/// or `None` when the triangle is degenerate in the sense of [`DEGENERATE_TRIANGLE`].
+fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
+    let (e0, e1, e2) = (b - a, c - b, a - c);
+    let longest2 = e0
+        .length_squared()
+        .max(e1.length_squared())
+        .max(e2.length_squared());
+    // The cross product of the two edges adjacent to the largest angle is the best conditioned.
+    let n = e0.cross(-e2);
+    let len = n.length();
+    if len.is_nan() || len <= DEGENERATE_TRIANGLE * longest2 || !len.is_finite() {
+        return None;
+    }
+    Some(n / len)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solid::ConvexPolyhedron;
+    use alloc::vec;
+
+    #[test]
+    fn closedness() {
+        let cube = ConvexPolyhedron::cuboid(DVec3::ZERO, DVec3::ONE).unwrap();
+        assert!(cube.mesh().is_closed());
+        let quad = TriangleMesh::quad(DVec3::ZERO, DVec3::X, DVec3::Y).unwrap();
+        assert!(!quad.is_closed());
+        // Two closed parts are closed; a closed part plus a sheet is not.
+        assert!(cube.mesh().merged(cube.mesh()).unwrap().is_closed());
+        assert!(!cube.mesh().merged(&quad).unwrap().is_closed());
+        // A triangle and its reverse form a closed (two-sided) surface; a repeated triangle does
+        // not.
+        let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        assert!(
+            TriangleMesh::new(v.clone(), vec![[0, 1, 2], [0, 2, 1]])
+                .unwrap()
+                .is_closed()
+        );
+        assert!(
+            !TriangleMesh::new(v, vec![[0, 1, 2], [0, 1, 2], [0, 2, 1]])
+                .unwrap()
+                .is_closed()
+        );
+    }
+
+    #[test]
+    fn edges_pair_opposite_triangles() {
+        // Every edge of a closed mesh has two triangles, and runs a -> b in f0 and b -> a in f1;
+        // each triangle has three edges; borders and non-manifold edges have one triangle each.
+        let runs = |m: &TriangleMesh, f: u32, a: u32, b: u32| {
+            let t = m.triangles()[f as usize];
+            (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)
+        };
+        let ico = ConvexPolyhedron::icosphere(DVec3::ZERO, 1.0, 1).unwrap();
+        let m = ico.mesh();
+        assert_eq!(m.edges().len(), 3 * m.triangle_count() / 2);
+        let mut per_triangle = vec![0; m.triangle_count()];
+        for e in m.edges() {
+            let f1 = e.twin().unwrap();
+            assert!(runs(m, e.f0, e.a, e.b) && runs(m, f1, e.b, e.a), "{e:?}");
+            per_triangle[e.f0 as usize] += 1;
+            per_triangle[f1 as usize] += 1;
+        }
+        assert!(per_triangle.iter().all(|&c| c == 3));
+        // A fan of three triangles on one edge: three copies, none paired.
+        let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, -DVec3::Y];
+        let fan = TriangleMesh::new(v, vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]]).unwrap();
+        let on_01: Vec<_> = fan
+            .edges()
+            .iter()
+            .filter(|e| e.a.min(e.b) == 0 && e.a.max(e.b) == 1)
+            .collect();
+        assert_eq!(on_01.len(), 3);
+        assert!(
+            on_01
+                .iter()
+                .all(|e| e.twin().is_none() && runs(&fan, e.f0, e.a, e.b))
+        );
+        assert!(!fan.is_closed());
+    }
+
+    #[test]
+    fn invalid_meshes_are_errors() {
+        let v = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        assert!(matches!(
+            TriangleMesh::new(v.clone(), vec![[0, 1, 3]]),
+            Err(GeomError::InvalidIndex { .. })
+        ));
+        assert!(matches!(
+            TriangleMesh::new(v.clone(), vec![[0, 1, 1]]),
+            Err(GeomError::DegenerateTriangle { .. })
+        ));
+        assert!(matches!(
+            TriangleMesh::new(vec![DVec3::ZERO, DVec3::X, DVec3::NAN], vec![[0, 1, 2]]),
+            Err(GeomError::NonFinite { .. })
+        ));
+    }
+}

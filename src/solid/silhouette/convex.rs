@@ -1,0 +1,149 @@
+//! The silhouette of a convex polyhedron seen from a point (seed 000 Alg. 2, section 3.3; thesis
+//! 003 section 4.2).
+
+use alloc::vec::Vec;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use crate::GeomError;
+use crate::solid::facing::Side;
+use crate::solid::{ConvexPolyhedron, ShadingFrame};
+use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, order_directed_edges};
+
+/// The region a convex polyhedron covers, seen from the frame's origin, in the local frame.
+///
+/// Contour edges are the edges between a front-facing and a non-front-facing face (thesis 003
+/// eq. 4.1/4.2); for a convex polyhedron every contour edge is a silhouette edge (003 section 4.2).
+/// Each is oriented by its front face: a front face runs counter-clockwise seen from the point,
+/// which puts its interior on the right on the unit sphere (seen from outside the sphere), so the
+/// edge is taken in the reverse of its counter-clockwise direction around the front face. The
+/// directed edges are then chained by vertex index (exact and combinatorial: each silhouette
+/// vertex has one outgoing contour edge), which replaces the planar nearest-endpoint search of
+/// seed 000 Alg. 2; configurations that are not one simple loop (near-degenerate views) go through
+/// [`order_directed_edges`] instead, which merges endpoints by tolerance and validates.
+///
+/// Front faces are decided by the facing predicate ([`face_side`](crate::solid::face_side)): a
+/// face whose plane passes within its tolerance of the point is seen edge-on and counts as
+/// back-facing. A point inside the polyhedron (behind every face) sees the full sphere; a point on
+/// its surface (no face strictly in front, some within the tolerance) is covered by the
+/// intersection of the half-spaces behind the faces it lies on: a hemisphere for a point on a
+/// face, a lune on an edge.
+///
+/// # Errors
+///
+/// [`GeomError::Undecidable`] when the projected silhouette is degenerate within rounding (the
+/// point within rounding distance of an edge's line, so that [`order_directed_edges`] cannot
+/// close its loops).
+pub fn convex_silhouette(
+    poly: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+) -> Result<SphericalPolygon, GeomError> {
+    let mut s = Vec::new();
+    let tol = poly.facing(frame.origin(), &mut s);
+    let front = |d: f64| Side::of(d, tol) == Side::Front;
+    if !s.iter().any(|&d| front(d)) {
+        // No front face: the point is inside or on the surface. The polyhedron then covers, seen
+        // from the point, the intersection of the closed half-spaces behind the faces the point
+        // lies on: the full sphere inside, a hemisphere on a face (a cube standing on the
+        // ground covers the ground point's whole upper hemisphere), a lune on an edge.
+        let mut region = SphericalPolygon::full();
+        for (f, &d) in s.iter().enumerate() {
+            if Side::of(d, tol) == Side::On {
+                let n = frame.dir_to_local(poly.mesh().triangle_normal(f));
+                region = region.clip_to_hemisphere(-n);
+            }
+        }
+        return Ok(region);
+    }
+    // Contour edges as directed pairs of vertex indices.
+    let mut contour: SmallVec<[(u32, u32); 24]> = SmallVec::new();
+    for e in poly.edges() {
+        // Every edge of a convex polyhedron has both faces (checked by `from_mesh`).
+        match (front(s[e.f0 as usize]), front(s[e.f1 as usize])) {
+            (true, false) => contour.push((e.b, e.a)),
+            (false, true) => contour.push((e.a, e.b)),
+            _ => {}
+        }
+    }
+    let verts = poly.vertices();
+    if let Some(ring) = chain_by_index(&contour, verts.len()) {
+        // The silhouette of a convex polyhedron seen from outside is one simple loop through
+        // distinct vertices, which are at least about FACE_TOLERANCE apart in direction (they
+        // span front faces, whose planes miss the point by more than the tolerance). So when the
+        // combinatorial walk closes one loop, only consecutive-vertex spacing needs checking,
+        // not the quadratic simplicity test of `SphericalPolygon::new`.
+        let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(ring.len());
+        for &i in &ring {
+            let Some(u) = frame.to_local(verts[i as usize]).try_normalize() else {
+                return order_edges_of(&contour, verts, frame);
+            };
+            out.push(u);
+        }
+        let n = out.len();
+        let spaced = n >= 3
+            && (0..n).all(|k| {
+                let (a, b) = (out[k], out[(k + 1) % n]);
+                (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+            });
+        if spaced {
+            let ends: SmallVec<[u32; 2]> = smallvec::smallvec![n as u32];
+            return Ok(SphericalPolygon::from_parts(out, ends));
+        }
+    }
+    order_edges_of(&contour, verts, frame)
+}
+
+/// The general path: the contour's directed edges ordered with [`order_directed_edges`], which
+/// merges endpoints by tolerance, allows pinches and validates the result.
+fn order_edges_of(
+    contour: &[(u32, u32)],
+    verts: &[DVec3],
+    frame: &ShadingFrame,
+) -> Result<SphericalPolygon, GeomError> {
+    let edges: Vec<(DVec3, DVec3)> = contour
+        .iter()
+        .map(|&(a, b)| {
+            (
+                frame.to_local(verts[a as usize]),
+                frame.to_local(verts[b as usize]),
+            )
+        })
+        .collect();
+    // The polyhedron and the point are valid, so edges that do not close into loops are a
+    // rounding give-up, not an input fault.
+    order_directed_edges(&edges).map_err(|e| {
+        e.give_up("silhouette edges do not close into loops within rounding (the point is within rounding distance of an edge's line)")
+    })
+}
+
+/// Walks directed edges (vertex index pairs) as one loop: `Some(vertex indices)` when every
+/// vertex used has exactly one outgoing edge and the walk from the first edge uses all of them,
+/// `None` otherwise (several loops or pinches: left to the general path).
+pub(crate) fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<SmallVec<[u32; 24]>> {
+    const NONE: u32 = u32::MAX;
+    if edges.len() < 3 {
+        return None;
+    }
+    let mut next = alloc::vec![NONE; nverts];
+    for &(a, b) in edges {
+        if next[a as usize] != NONE {
+            return None;
+        }
+        next[a as usize] = b;
+    }
+    let mut ring = SmallVec::new();
+    let start = edges[0].0;
+    let mut at = start;
+    for _ in 0..edges.len() {
+        ring.push(at);
+        at = next[at as usize];
+        if at == NONE {
+            return None;
+        }
+        if at == start {
+            break;
+        }
+    }
+    (at == start && ring.len() == edges.len()).then_some(ring)
+}
