@@ -48,7 +48,6 @@ fn quad_light_down() -> TriangleMesh {
 /// Reproducer 6: a sliver triangle occluder in front of a box light blacked the light out (0
 /// against 0.0044).
 #[test]
-#[ignore = "needs the sphere layer's horizon clip fix (issue 24): Undecidable today"]
 fn reproducer_6_sliver_occluder_does_not_black_out_a_light() {
     let light = ConvexPolyhedron::cuboid(
         v(0.34662662372029085, 0.3801404514925406, 2.6289028376302745),
@@ -82,7 +81,6 @@ fn reproducer_6_sliver_occluder_does_not_black_out_a_light() {
 /// Reproducer 7: `Method::PerTriangle` gave 0 where `Method::Silhouette` gave the right value,
 /// at a point near a small icosphere occluder next to a box light.
 #[test]
-#[ignore = "needs the sphere layer's horizon clip fix (issue 24): PerTriangle is Undecidable today"]
 fn reproducer_7_per_triangle_agrees_with_silhouette() {
     let light = ConvexPolyhedron::cuboid(
         v(0.15342134478867786, -0.4333232720532363, 2.627123700298531),
