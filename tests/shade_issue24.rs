@@ -296,3 +296,23 @@ fn reproducer_9_icosphere_radius_must_be_positive() {
         Err(GeomError::NonFiniteArgument { .. })
     ));
 }
+
+/// Reproducer 8e: a point very far from a quad light with an occluder in front of it gets a tiny
+/// value, not an error. From far below, the 0.2 x 0.2 box hides the light's corner
+/// `[0, 0.1]^2` of its `[0, 0.5]^2` in the parallel-projection limit: the ratio to the
+/// unoccluded value tends to `1 - 0.01 / 0.25 = 0.96`, within about `size / distance`.
+#[test]
+fn reproducer_8_far_point_with_an_occluder_gets_a_tiny_value() {
+    let light = Light::new(quad_light_down(), DVec3::ONE).unwrap();
+    let cube = ConvexPolyhedron::cuboid(v(0.0, 0.0, 1.0), DVec3::splat(0.1)).unwrap();
+    let scene = Scene::new(vec![light.clone()], vec![cube.into()]).unwrap();
+    let alone = Scene::new(vec![light], vec![]).unwrap();
+    let m = diffuse();
+    for d in [1e7, 1e9, 1e12] {
+        let x = v(0.25, 0.25, 1.0 - d);
+        let got = scene.shade(x, DVec3::Z, DVec3::Z, &m).unwrap();
+        let free = alone.shade(x, DVec3::Z, DVec3::Z, &m).unwrap();
+        assert!(free.x > 0.0, "{d}");
+        assert!((got.x / free.x - 0.96).abs() < 1e-6, "{d}: {} / {}", got.x, free.x);
+    }
+}
