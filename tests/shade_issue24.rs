@@ -313,6 +313,11 @@ fn reproducer_8_far_point_with_an_occluder_gets_a_tiny_value() {
         let got = scene.shade(x, DVec3::Z, DVec3::Z, &m).unwrap();
         let free = alone.shade(x, DVec3::Z, DVec3::Z, &m).unwrap();
         assert!(free.x > 0.0, "{d}");
-        assert!((got.x / free.x - 0.96).abs() < 1e-6, "{d}: {} / {}", got.x, free.x);
+        assert!(
+            (got.x / free.x - 0.96).abs() < 1e-6,
+            "{d}: {} / {}",
+            got.x,
+            free.x
+        );
     }
 }
