@@ -51,7 +51,7 @@ use crate::GeomError;
 use crate::planar::{FillRule, Shape};
 use crate::solid::facing::{FACE_TOLERANCE, Side};
 use crate::solid::silhouette::convex_silhouette;
-use crate::solid::{Body, BoundingSphere, Bvh, ClosedMesh, ShadingFrame, TriangleMesh};
+use crate::solid::{Body, BoundingSphere, Bvh, ShadingFrame, TriangleMesh};
 use crate::sphere::{COINCIDENT_TOLERANCE, Gnomonic, SphericalPolygon, enclosing_cap};
 
 /// Smallest cosine between the chart's centre and a direction of the light (about 78 degrees):
@@ -90,107 +90,89 @@ pub(crate) enum LightRegion<'a> {
 }
 
 /// What is precomputed once per scene for a body that may block: a bounding-volume hierarchy
-/// over its triangles when it has many, and whether front faces alone cover what it hides.
+/// over its triangles when it has many, and, for a closed mesh, its connected components and
+/// their boxes, which let back faces be left out (see [`Closed`]).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BlockerAccel {
     /// The hierarchy, for bodies of at least [`super::BVH_MIN_TRIANGLES`] triangles.
     pub bvh: Option<Bvh>,
-    /// For a mesh that bounds solids with outward normals, none inside another: its bounding
-    /// box. From a point outside that box every ray that meets the mesh enters a solid through
-    /// a front face before it meets anything else, so the front faces' projections cover all
-    /// that the mesh hides and the back faces can be left out.
-    pub front_only_outside: Option<(DVec3, DVec3)>,
+    /// For a closed mesh ([`TriangleMesh::is_closed`]): its components.
+    pub closed: Option<Closed>,
+}
+
+/// The connected components (through shared edges) of a closed mesh and their bounding boxes.
+///
+/// Each component is a closed oriented surface (its triangles pair up along every edge), so
+/// the winding number of the component about a point changes by one across each of its faces,
+/// up when a ray crosses a face from its front to its back, and is 0 far away. For a point
+/// outside a component's box (winding 0 there), a ray that meets the component starts and ends
+/// at winding 0, so it crosses the component both ways: at least once front to back, through a
+/// face that faces the point. So from such a point the component's front faces cover every
+/// direction it covers, whatever its orientation (inside-out, cavities) and even where it meets
+/// itself or other components; its back faces can be left out.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Closed {
+    /// Component of each triangle.
+    component: Vec<u32>,
+    /// Bounding box of each component.
+    boxes: Vec<(DVec3, DVec3)>,
 }
 
 impl BlockerAccel {
-    /// The precomputation for `body` (for a closed mesh, [`ClosedMesh::new`]'s validation,
-    /// about `n log n`, and one pass over its triangles).
+    /// The precomputation for `body` (one pass over a closed mesh's edges and triangles, and
+    /// the hierarchy's build, about `n log n`).
     pub(crate) fn new(body: &Body, bvh_min: usize) -> Self {
         let mesh = body.mesh();
         let bvh = (mesh.triangle_count() >= bvh_min).then(|| Bvh::build(mesh));
-        let front_only_outside = (matches!(body, Body::Mesh(_))
-            && mesh.is_closed()
-            && ClosedMesh::new(mesh.clone()).is_ok()
-            && outward_and_apart(mesh))
-        .then(|| {
-            let v = mesh.vertices();
-            v.iter()
-                .fold((v[0], v[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
-        });
-        BlockerAccel {
-            bvh,
-            front_only_outside,
-        }
+        let closed = (matches!(body, Body::Mesh(_)) && mesh.is_closed()).then(|| Closed::new(mesh));
+        BlockerAccel { bvh, closed }
     }
 }
 
-/// Whether every connected component of a closed mesh (one that bounds solids) encloses a
-/// positive volume (its normals point outwards) and the components' bounding boxes are
-/// pairwise disjoint (so none lies inside another, where a cavity's inward normals would be
-/// right): then the region the mesh bounds has winding number 1 and everything else 0.
-fn outward_and_apart(mesh: &TriangleMesh) -> bool {
-    // Components by union-find over the edges' triangle pairs.
-    let n = mesh.triangle_count();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
-    }
-    for e in mesh.edges() {
-        if let Some(f1) = e.twin() {
-            let (a, b) = (root(&mut parent, e.f0), root(&mut parent, f1));
-            parent[a.max(b) as usize] = a.min(b);
-        }
-    }
-    // Per component: six times its signed volume (about its first corner, for precision) and
-    // its bounding box.
-    struct Comp {
-        origin: DVec3,
-        volume6: f64,
-        lo: DVec3,
-        hi: DVec3,
-    }
-    let mut comps: Vec<Comp> = Vec::new();
-    let mut comp_of_root = vec![u32::MAX; n];
-    for t in 0..n {
-        let r = root(&mut parent, t as u32);
-        let [a, b, c] = mesh.triangle(t);
-        let k = match comp_of_root[r as usize] {
-            u32::MAX => {
-                if comps.len() >= MAX_COMPONENTS {
-                    return false;
-                }
-                comp_of_root[r as usize] = comps.len() as u32;
-                comps.push(Comp {
-                    origin: a,
-                    volume6: 0.0,
-                    lo: a,
-                    hi: a,
-                });
-                comps.len() - 1
+impl Closed {
+    fn new(mesh: &TriangleMesh) -> Self {
+        let n = mesh.triangle_count();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn root(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                parent[i as usize] = parent[parent[i as usize] as usize];
+                i = parent[i as usize];
             }
-            k => k as usize,
-        };
-        let c0 = &mut comps[k];
-        let o = c0.origin;
-        c0.volume6 += (a - o).dot((b - o).cross(c - o));
-        c0.lo = c0.lo.min(a.min(b).min(c));
-        c0.hi = c0.hi.max(a.max(b).max(c));
+            i
+        }
+        for e in mesh.edges() {
+            if let Some(f1) = e.twin() {
+                let (a, b) = (root(&mut parent, e.f0), root(&mut parent, f1));
+                parent[a.max(b) as usize] = a.min(b);
+            }
+        }
+        let mut id = vec![u32::MAX; n];
+        let mut component = Vec::with_capacity(n);
+        let mut boxes: Vec<(DVec3, DVec3)> = Vec::new();
+        for t in 0..n {
+            let r = root(&mut parent, t as u32) as usize;
+            let [a, b, c] = mesh.triangle(t);
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            if id[r] == u32::MAX {
+                id[r] = boxes.len() as u32;
+                boxes.push((lo, hi));
+            }
+            let k = id[r];
+            let bx = &mut boxes[k as usize];
+            *bx = (bx.0.min(lo), bx.1.max(hi));
+            component.push(k);
+        }
+        Closed { component, boxes }
     }
-    let apart = |i: usize, j: usize| {
-        let (p, q) = (&comps[i], &comps[j]);
-        p.hi.cmplt(q.lo).any() || q.hi.cmplt(p.lo).any()
-    };
-    comps.iter().all(|c| c.volume6 > 0.0)
-        && (0..comps.len()).all(|i| (i + 1..comps.len()).all(|j| apart(i, j)))
-}
 
-/// Most components [`outward_and_apart`] compares pairwise (beyond it the mesh keeps its back
-/// faces, which is only slower).
-const MAX_COMPONENTS: usize = 256;
+    /// Whether `x` lies outside the box of triangle `t`'s component (beyond rounding, relative
+    /// `1e-9` of the box's size and position).
+    fn outside(&self, t: usize, x: DVec3) -> bool {
+        let (lo, hi) = self.boxes[self.component[t] as usize];
+        let m = 1e-9 * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element());
+        x.cmplt(lo - DVec3::splat(m)).any() || x.cmpgt(hi + DVec3::splat(m)).any()
+    }
+}
 
 /// A blocker: its geometry and what is precomputed for it.
 pub(crate) type BlockerGeometry<'a> = (&'a Body, &'a BlockerAccel);
@@ -283,14 +265,7 @@ pub(crate) fn one_pass(
                 polygon_rings(&sil, &chart, &mut soup);
             }
             _ => {
-                let front_only = accel
-                    .front_only_outside
-                    .is_some_and(|(lo, hi)| outside_box(x, lo, hi));
-                let role = if front_only {
-                    Role::FrontBlocker
-                } else {
-                    Role::Blocker
-                };
+                let role = Role::Blocker(accel.closed.as_ref());
                 let bvh = accel.bvh.as_ref();
                 mesh_rings(
                     body.mesh(),
@@ -320,13 +295,6 @@ pub(crate) fn one_pass(
     let visible =
         Shape::with_fill_rule(soup, FillRule::Positive).map_err(|e| e.give_up(PASS_FAILED))?;
     Ok(Some(unproject(&visible, &chart.g)))
-}
-
-/// Whether `x` lies outside the box `[lo, hi]` by more than rounding (relative `1e-9` of the
-/// box's size and position).
-fn outside_box(x: DVec3, lo: DVec3, hi: DVec3) -> bool {
-    let m = 1e-9 * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element());
-    x.cmplt(lo - DVec3::splat(m)).any() || x.cmpgt(hi + DVec3::splat(m)).any()
 }
 
 /// The empty slot of [`Work::table`] (no edge has it: its two vertices would be equal).
@@ -445,14 +413,13 @@ fn box_planes(g: &Gnomonic, lo: DVec2, hi: DVec2) -> [DVec3; 4] {
 }
 
 /// How a mesh enters the soup.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Role {
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Role<'a> {
     /// Front faces only (they emit), winding `+1`, clipped to the horizon too.
     Light,
-    /// Every face not seen edge-on (both sides block), winding `-1`.
-    Blocker,
-    /// Front faces only, winding `-1` (see [`BlockerAccel::front_only_outside`]).
-    FrontBlocker,
+    /// Every face not seen edge-on (both sides block), winding `-1`; for a closed mesh, the
+    /// back faces of components the point lies outside of are left out ([`Closed`]).
+    Blocker(Option<&'a Closed>),
 }
 
 /// Appends to `soup` the rings of the triangles of `mesh` inside the shaft (see the module
@@ -464,7 +431,7 @@ fn mesh_rings(
     bvh: Option<&Bvh>,
     chart: &Chart,
     frame: &ShadingFrame,
-    role: Role,
+    role: Role<'_>,
     shaft: &Shaft,
     work: &mut Work,
     soup: &mut Vec<Vec<DVec2>>,
@@ -491,9 +458,10 @@ fn mesh_rings(
         // Seen from the front a triangle's corners run clockwise in the chart (its axes are
         // right-handed seen from outside the sphere): winding -1 as given, +1 reversed.
         let keep_order = match (side, role) {
-            (Side::On, _) | (Side::Behind, Role::Light | Role::FrontBlocker) => return,
-            (Side::Front, Role::Blocker | Role::FrontBlocker) => true,
-            (Side::Behind, Role::Blocker) | (Side::Front, Role::Light) => false,
+            (Side::On, _) | (Side::Behind, Role::Light) => return,
+            (Side::Behind, Role::Blocker(Some(c))) if c.outside(t, x) => return,
+            (Side::Front, Role::Blocker(_)) => true,
+            (Side::Behind, Role::Blocker(_)) | (Side::Front, Role::Light) => false,
         };
         let idx = if keep_order {
             idx
