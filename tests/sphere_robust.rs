@@ -812,3 +812,76 @@ fn census_horizon_near_antipodal_edge_across_the_circle_keeps_the_lower_part() {
     }
     assert!(checked > count * 9 / 10);
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: a ring of integer directions one vertex of
+/// which, `v0 = (-1, -1, -100)`, lies exactly on the great circle of the edge from
+/// `(-1, 0, 3)` to `(0, -1, -103)` in integers, 0.01 rad beyond the crossing of that edge with
+/// the circle; normalized, it is within 1e-17 of the edge, on the side away from its two
+/// neighbours.
+///
+/// Two ulp-sized moves put it on the wrong side, and the lower clip crossed itself there: `new`
+/// normalized the given unit vectors once more (an ulp each), so the stored polygon itself
+/// failed `validate`; and the clip's shortened edge (its far end the rounded crossing) turns by
+/// the crossing's rounding. Now unit vertices are stored as given, and a vertex the shortened
+/// edge passes on the wrong side (its exact side of the input's edge is known) is put on it: the
+/// lower part touches itself at `v0`.
+///
+/// Checked: the stored polygon is the given rings bit for bit and validates; both clips
+/// validate, partition the polygon to rounding, and agree in containment with the polygon and
+/// the hemisphere on a Fibonacci lattice away from every edge's great circle and the horizon.
+#[test]
+fn fuzz_sphere_horizon_vertex_on_another_edges_circle_beyond_its_crossing() {
+    let ints = [
+        (-1, -1, -100),
+        (-7, -1, -1),
+        (-1, -103, 31),
+        (-1, 0, 3),
+        (0, -1, -103),
+        (0, 3, 99),
+        (0, 0, 34),
+        (0, -35, 0),
+    ];
+    let base: Vec<DVec3> = ints
+        .iter()
+        .map(|&(x, y, z)| v(x as f64, y as f64, z as f64).normalize())
+        .collect();
+    let n = v(34.0, -1.0, 0.0).normalize();
+    // The fuzz case moved vertex 5 to these heights along the great circle through n.
+    for h in [1e-9f64, -1e-9, 0.0, 1e-12, -1e-14] {
+        let mut ring = base.clone();
+        let flat = (ring[5] - n * ring[5].dot(n)).normalize();
+        ring[5] = flat * (1.0f64 - h * h).sqrt() + n * h;
+        let p = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+        assert_eq!(p.rings().next().unwrap(), &ring[..], "h = {h:e}");
+        p.validate().unwrap();
+        let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+        up.validate()
+            .unwrap_or_else(|e| panic!("h = {h:e}: {e}: {up:?}"));
+        down.validate()
+            .unwrap_or_else(|e| panic!("h = {h:e}: {e}: {down:?}"));
+        assert!(
+            (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < 1e-13,
+            "h = {h:e}"
+        );
+        let count = 20000;
+        let mut checked = 0;
+        for i in 0..count {
+            let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
+            let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+            let r = (1.0 - z * z).sqrt();
+            let d = v(r * phi.cos(), r * phi.sin(), z);
+            let clear = (0..ring.len()).all(|k| {
+                let c = ring[k].cross(ring[(k + 1) % ring.len()]);
+                d.dot(c).abs() > 1e-6 * c.length()
+            });
+            if !clear || d.dot(n).abs() < 1e-6 {
+                continue;
+            }
+            checked += 1;
+            let inside = p.contains(d);
+            assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{d:?}");
+            assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{d:?}");
+        }
+        assert!(checked > count * 9 / 10);
+    }
+}
