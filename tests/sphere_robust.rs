@@ -885,3 +885,78 @@ fn fuzz_sphere_horizon_vertex_on_another_edges_circle_beyond_its_crossing() {
         assert!(checked > count * 9 / 10);
     }
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the complement of a ring that runs along the
+/// circle for half a turn: from a vertex on it, along a 135-degree edge to a vertex `1.6e-12`
+/// off it (snapped: that edge lies along the circle), then along a 45-degree edge to a vertex
+/// `1.6e-14` off it (just beyond the vertex tolerance, and that edge is not flat by its far end).
+/// The lower clip kept the last vertex, so its edge left the snapped one at `2e-14` rad, and the
+/// circle arc joined there ran back over it: a fold validation rejects. A vertex within the flat
+/// slope of its chord to a snapped neighbour is now snapped too.
+///
+/// Checked: both clips validate, partition the polygon (to the documented snapping, far below
+/// 1e-11 here), and agree in containment with the polygon and the hemisphere on a Fibonacci
+/// lattice away from every edge's great circle and the horizon.
+#[test]
+fn fuzz_sphere_horizon_vertex_beside_a_snapped_vertex_along_the_circle() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(0.0, 1.0, -113.0),
+        unit(-113.0, 38.0, -113.0),
+        unit(0.0, 0.0, 1.0),
+        unit(-53.0, 0.0, -53.0),
+    ];
+    let n = unit(1.0, -53.0, 0.0);
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..4)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 4]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 4.0;
+    for neighbour in [-1e-12, -0.5e-12, 1e-12] {
+        for h in [1e-14, -1e-14, 0.0, 1e-13, -1e-13, 1e-15, -1e-15] {
+            let mut ring = base.to_vec();
+            ring[1] = at_height(ring[1], neighbour * size);
+            ring[0] = at_height(ring[0], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring.clone()]) else {
+                continue;
+            };
+            let p = p.complement();
+            let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            up.validate()
+                .unwrap_or_else(|e| panic!("{what}: {e}: {up:?}"));
+            down.validate()
+                .unwrap_or_else(|e| panic!("{what}: {e}: {down:?}"));
+            assert!(
+                (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < 1e-11,
+                "{what}"
+            );
+            let count = 20000;
+            let mut checked = 0;
+            for i in 0..count {
+                let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
+                let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+                let r = (1.0 - z * z).sqrt();
+                let d = v(r * phi.cos(), r * phi.sin(), z);
+                let clear = (0..4).all(|k| {
+                    let c = ring[k].cross(ring[(k + 1) % 4]);
+                    d.dot(c).abs() > 1e-6 * c.length()
+                });
+                if !clear || d.dot(n).abs() < 1e-6 {
+                    continue;
+                }
+                checked += 1;
+                let inside = p.contains(d);
+                assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{what}: {d:?}");
+                assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{what}: {d:?}");
+            }
+            assert!(checked > count * 9 / 10);
+        }
+    }
+}

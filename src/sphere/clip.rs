@@ -391,9 +391,14 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             ring
         };
         let m = ring.len();
+        let sides: SmallVec<[Side; 12]> = if near {
+            classify_ring(ring, &s)
+        } else {
+            SmallVec::new()
+        };
         let side = |i: usize| {
             if near {
-                classify(ring, &s, i)
+                sides[i]
             } else if s[i] > 0.0 {
                 Side::Above
             } else {
@@ -877,6 +882,34 @@ fn may_be_sliver(ring: &[DVec3], n: DVec3) -> bool {
 /// [`HORIZON_TOLERANCE`] or at the end of a flat edge ([`FLAT_SLOPE`]). Vertices this close to
 /// the circle have short edges ([`SNAP_CHORD2`]; the caller splits longer ones).
 #[inline]
+/// [`classify`] for every vertex of a ring, closed under snapping: a vertex within
+/// [`FLAT_SLOPE`] of its chord to a neighbour that is snapped is snapped too. The edge between
+/// them lies along the circle once the neighbour is on it; kept, the vertex would leave the
+/// snapped point at an angle below validation's `1e-12` rad resolution, where the circle arc
+/// joined there can run back over the edge (a fold). Each such vertex is within `FLAT_SLOPE`
+/// times an edge of the circle, as for a flat edge.
+fn classify_ring(ring: &[DVec3], s: &[f64]) -> SmallVec<[Side; 12]> {
+    let m = ring.len();
+    let mut sides: SmallVec<[Side; 12]> = (0..m).map(|i| classify(ring, s, i)).collect();
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for i in 0..m {
+            if sides[i] == Side::On || s[i].abs() > 2.0 * FLAT_SLOPE {
+                continue;
+            }
+            let flat_to = |j: usize| {
+                sides[j] == Side::On && s[i].abs() <= FLAT_SLOPE * (ring[j] - ring[i]).length()
+            };
+            if flat_to((i + m - 1) % m) || flat_to((i + 1) % m) {
+                sides[i] = Side::On;
+                changed = true;
+            }
+        }
+    }
+    sides
+}
+
 fn classify(ring: &[DVec3], s: &[f64], i: usize) -> Side {
     let x = s[i];
     // Chords are at most 2, so beyond this no edge can be flat: the common case.
