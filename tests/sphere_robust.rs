@@ -10,6 +10,47 @@ fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
 
+/// Both clips of `p` at `n` validate, partition `p` to `tol`, and agree in containment with `p`
+/// and the hemisphere on a 20000-point Fibonacci lattice, at the directions farther than 1e-6
+/// rad from every edge's great circle and from the horizon (an independent check of the
+/// region: `p`'s own containment and the sign of `d . n`).
+fn assert_clips_partition(p: &SphericalPolygon, n: DVec3, tol: f64, what: &str) {
+    let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+    up.validate()
+        .unwrap_or_else(|e| panic!("{what}: {e}: {up:?}"));
+    down.validate()
+        .unwrap_or_else(|e| panic!("{what}: {e}: {down:?}"));
+    assert!(
+        (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < tol,
+        "{what}: {} + {} vs {}",
+        up.solid_angle(),
+        down.solid_angle(),
+        p.solid_angle()
+    );
+    let count = 20000;
+    let mut checked = 0;
+    for i in 0..count {
+        let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
+        let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let r = (1.0 - z * z).sqrt();
+        let d = v(r * phi.cos(), r * phi.sin(), z);
+        let clear = p.rings().all(|ring| {
+            (0..ring.len()).all(|k| {
+                let c = ring[k].cross(ring[(k + 1) % ring.len()]);
+                d.dot(c).abs() > 1e-6 * c.length()
+            })
+        });
+        if !clear || d.dot(n).abs() < 1e-6 {
+            continue;
+        }
+        checked += 1;
+        let inside = p.contains(d);
+        assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{what}: {d:?}");
+        assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{what}: {d:?}");
+    }
+    assert!(checked > count * 8 / 10, "{what}: {checked}");
+}
+
 /// Issue 24, reproducer 1: a triangle with one vertex `h = 1e-13` above the horizon and two
 /// below. The part above is the tiny triangle cut off near the apex; in the gnomonic plane about
 /// `+x` (great circles are lines, the horizon is the line `t = 0`) it has the apex `(0, h)` and
@@ -854,35 +895,7 @@ fn fuzz_sphere_horizon_vertex_on_another_edges_circle_beyond_its_crossing() {
         let p = SphericalPolygon::new(vec![ring.clone()]).unwrap();
         assert_eq!(p.rings().next().unwrap(), &ring[..], "h = {h:e}");
         p.validate().unwrap();
-        let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
-        up.validate()
-            .unwrap_or_else(|e| panic!("h = {h:e}: {e}: {up:?}"));
-        down.validate()
-            .unwrap_or_else(|e| panic!("h = {h:e}: {e}: {down:?}"));
-        assert!(
-            (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < 1e-13,
-            "h = {h:e}"
-        );
-        let count = 20000;
-        let mut checked = 0;
-        for i in 0..count {
-            let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
-            let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
-            let r = (1.0 - z * z).sqrt();
-            let d = v(r * phi.cos(), r * phi.sin(), z);
-            let clear = (0..ring.len()).all(|k| {
-                let c = ring[k].cross(ring[(k + 1) % ring.len()]);
-                d.dot(c).abs() > 1e-6 * c.length()
-            });
-            if !clear || d.dot(n).abs() < 1e-6 {
-                continue;
-            }
-            checked += 1;
-            let inside = p.contains(d);
-            assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{d:?}");
-            assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{d:?}");
-        }
-        assert!(checked > count * 9 / 10);
+        assert_clips_partition(&p, n, 1e-13, &format!("h = {h:e}"));
     }
 }
 
@@ -927,36 +940,54 @@ fn fuzz_sphere_horizon_vertex_beside_a_snapped_vertex_along_the_circle() {
                 continue;
             };
             let p = p.complement();
-            let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
             let what = format!("neighbour {neighbour:e}, h {h:e}");
-            up.validate()
-                .unwrap_or_else(|e| panic!("{what}: {e}: {up:?}"));
-            down.validate()
-                .unwrap_or_else(|e| panic!("{what}: {e}: {down:?}"));
-            assert!(
-                (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < 1e-11,
-                "{what}"
-            );
-            let count = 20000;
-            let mut checked = 0;
-            for i in 0..count {
-                let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
-                let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
-                let r = (1.0 - z * z).sqrt();
-                let d = v(r * phi.cos(), r * phi.sin(), z);
-                let clear = (0..4).all(|k| {
-                    let c = ring[k].cross(ring[(k + 1) % 4]);
-                    d.dot(c).abs() > 1e-6 * c.length()
-                });
-                if !clear || d.dot(n).abs() < 1e-6 {
-                    continue;
-                }
-                checked += 1;
-                let inside = p.contains(d);
-                assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{what}: {d:?}");
-                assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{what}: {d:?}");
-            }
-            assert!(checked > count * 9 / 10);
+            assert_clips_partition(&p, n, 1e-11, &what);
         }
     }
+}
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the complement of a ring with two vertices
+/// `1.3e-14` apart, `1.3e-14` and `2.5e-14` above the circle, the second of them the end of a
+/// long edge from far below, the ring folding back there at an angle validation accepts. The
+/// upper clip replaced that long edge by the `2.5e-14` piece from its rounded crossing, whose
+/// direction is known only to `1e-16 / 2.5e-14`: the fold became one validation rejects.
+/// Results whose first or last kept vertex of a chain folds back are now regularized (the
+/// spike, `1e-30` sr, is cut).
+#[test]
+fn fuzz_sphere_horizon_fold_at_the_end_of_a_short_cut_edge() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(-1.0, -1.0, -1.0),
+        unit(34.0, -3.0, -1.0),
+        unit(-128.0, 33.0, 0.0),
+        unit(99.0, 0.0, 0.0),
+    ];
+    let n = unit(-113.0, -1.0, -1.0);
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..4)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 4]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 4.0;
+    let mut tried = 0;
+    for neighbour in [1e-14, 2e-14, 0.5e-14] {
+        for h in [1.137e-14, -1.137e-14, 0.0, 3e-14, 1e-15] {
+            let mut ring = base.to_vec();
+            ring[0] = at_height(ring[0], neighbour * size);
+            ring[3] = at_height(ring[3], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring]) else {
+                continue;
+            };
+            tried += 1;
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            assert_clips_partition(&p.complement(), n, 1e-12, &what);
+            assert_clips_partition(&p, n, 1e-12, &what);
+        }
+    }
+    assert!(tried >= 10, "{tried}");
 }

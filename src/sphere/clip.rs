@@ -8,8 +8,8 @@ use smallvec::SmallVec;
 
 use super::exact;
 use super::polygon::{
-    COINCIDENT_TOLERANCE, SphericalPolygon, Verts, close_ring, far_side_inside, is_sliver,
-    nearest_feature, regularized, ring_left_area, rings_contain,
+    COINCIDENT_TOLERANCE, SphericalPolygon, Verts, close_ring, far_side_inside, folds_back,
+    is_sliver, nearest_feature, regularized, ring_left_area, rings_contain,
 };
 use super::predicates::{arcs_intersect, normalize_any, orient};
 use crate::GeomError;
@@ -532,6 +532,14 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
         merge_inverted_crossings(&chains, &next, &frame, &mut scratch);
     }
     let flipped = flipped_vertices(&chains, &scratch, &out_verts);
+    // A chain's first or last edge ends at a rounded point: its direction is known only to the
+    // point's rounding over the edge's length, and a spike of the input at the kept end (an
+    // angle validation accepts, just) can become one it rejects. Such results are regularized.
+    let folded = chains.iter().any(|ch| {
+        let (s, e) = (ch.start, ch.end);
+        folds_back(scratch[s], scratch[s + 1], scratch[s + 2])
+            || folds_back(scratch[e - 3], scratch[e - 2], scratch[e - 1])
+    });
     let mut visited: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
     for first in 0..k {
         if visited[first] {
@@ -591,7 +599,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             out_ends.pop();
         }
     }
-    if delicate || !flipped.is_empty() {
+    if delicate || folded || !flipped.is_empty() {
         // Crossings a rounding apart can leave a spike of that width (the tip of a sharp
         // corner just above the circle) or its rounded points out of the exact order: the folds
         // validation rejects are cut, and the points they leave merged.
