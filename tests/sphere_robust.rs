@@ -991,3 +991,56 @@ fn fuzz_sphere_horizon_fold_at_the_end_of_a_short_cut_edge() {
     }
     assert!(tried >= 10, "{tried}");
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the complement of a ring with a 135-degree
+/// edge `1.2e-13` above the circle at its end `v1` (snapped: the edge lies along the circle),
+/// then a steep `1.1e-13` edge straight down to a vertex `v2` `1.5e-14` above the circle (just
+/// beyond the vertex tolerance), then far below. Snapping `v1` moves the long edge onto the
+/// circle, across `v2` and the crossing after it; the clip kept `v2` and returned the triangle
+/// under it (5e-29 sr) for the upper part instead of the hemisphere minus a sliver (partition
+/// error 2 pi). A vertex next to a snapped one, no higher and within four times its height of
+/// it, is now snapped too.
+#[test]
+fn fuzz_sphere_horizon_vertex_under_a_snapped_flat_edge() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(-42.0, -1.0, 61.0),
+        unit(61.0, 61.0, 61.0),
+        unit(61.0, 61.0, 37.0),
+        unit(-1.0, 0.0, 0.0),
+    ];
+    let n = -DVec3::Z;
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..4)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 4]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 4.0;
+    let eps = 1e-14 * (1.0 + 61.0 / 256.0);
+    for neighbour in [1e-13, 3e-13, 1e-12] {
+        let mut ups = Vec::new();
+        for h in [eps, -eps, 0.0, 2.0 * eps, 0.5 * eps] {
+            let mut ring = base.to_vec();
+            ring[2] = at_height(ring[2], neighbour * size);
+            ring[1] = at_height(ring[1], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring]) else {
+                continue;
+            };
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            assert_clips_partition(&p, n, 1e-11, &what);
+            let c = p.complement();
+            assert_clips_partition(&c, n, 1e-11, &what);
+            ups.push(c.clip_to_hemisphere(n).solid_angle());
+        }
+        // The upper part of the complement is the hemisphere but for slivers along the circle.
+        assert!(ups.len() >= 4);
+        for u in ups {
+            assert!((u - 2.0 * std::f64::consts::PI).abs() < 1e-11, "{u}");
+        }
+    }
+}

@@ -890,12 +890,14 @@ fn may_be_sliver(ring: &[DVec3], n: DVec3) -> bool {
 /// [`HORIZON_TOLERANCE`] or at the end of a flat edge ([`FLAT_SLOPE`]). Vertices this close to
 /// the circle have short edges ([`SNAP_CHORD2`]; the caller splits longer ones).
 #[inline]
-/// [`classify`] for every vertex of a ring, closed under snapping: a vertex within
-/// [`FLAT_SLOPE`] of its chord to a neighbour that is snapped is snapped too. The edge between
-/// them lies along the circle once the neighbour is on it; kept, the vertex would leave the
-/// snapped point at an angle below validation's `1e-12` rad resolution, where the circle arc
-/// joined there can run back over the edge (a fold). Each such vertex is within `FLAT_SLOPE`
-/// times an edge of the circle, as for a flat edge.
+/// [`classify`] for every vertex of a ring, closed under snapping: a vertex next to a snapped
+/// one is snapped too when it lies within [`FLAT_SLOPE`] of their chord from the circle (the edge
+/// lies along the circle once the neighbour is on it; kept, the vertex would leave the snapped
+/// point at an angle below validation's `1e-12` rad resolution, where the circle arc joined
+/// there can run back over the edge: a fold), or when it is no higher than the neighbour and
+/// within four times the neighbour's height of it (in the band the neighbour's snap sweeps: the
+/// neighbour's other edges, moved onto the circle, would pass over it). Each such vertex is
+/// within `FLAT_SLOPE` times an edge, or a snapped neighbour's height, of the circle.
 fn classify_ring(ring: &[DVec3], s: &[f64]) -> SmallVec<[Side; 12]> {
     let m = ring.len();
     let mut sides: SmallVec<[Side; 12]> = (0..m).map(|i| classify(ring, s, i)).collect();
@@ -907,7 +909,10 @@ fn classify_ring(ring: &[DVec3], s: &[f64]) -> SmallVec<[Side; 12]> {
                 continue;
             }
             let flat_to = |j: usize| {
-                sides[j] == Side::On && s[i].abs() <= FLAT_SLOPE * (ring[j] - ring[i]).length()
+                let d = (ring[j] - ring[i]).length();
+                sides[j] == Side::On
+                    && (s[i].abs() <= FLAT_SLOPE * d
+                        || (s[i].abs() <= s[j].abs() && d <= 4.0 * s[j].abs()))
             };
             if flat_to((i + m - 1) % m) || flat_to((i + 1) % m) {
                 sides[i] = Side::On;
