@@ -60,12 +60,18 @@ use super::convex::chain_by_index;
 use super::nonconvex::{
     Arc, ORDER_ERROR, Outline, collinear, evaluate_rings, outline, outline_with,
 };
+use super::triangulated::{
+    CellCorners, OnFace, SNAP_REL, TriangleSource, certified_triangulation, evaluate_stored,
+    fan_or_list, raw_stored,
+};
 use super::{convex_silhouette, nonconvex_silhouette};
 use crate::GeomError;
 use crate::solid::facing::{FACE_TOLERANCE, Side, face_distances};
 use crate::solid::{ClosedMesh, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 use crate::sphere::predicates::c3;
-use crate::sphere::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon};
+use crate::sphere::{
+    ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, SphericalTriangle,
+};
 
 /// The default box of a BSP is the mesh's bounding sphere's center plus or minus this many
 /// bounding radii along each axis. Shading points farther out are answered by the direct
@@ -152,7 +158,12 @@ pub struct SilhouetteBsp {
     hi: DVec3,
     leaves: u32,
     direct_leaves: u32,
+    /// Whether leaves with rings carry a triangulation section (built with triangulations).
+    triangulated: bool,
 }
+
+/// The rings of a leaf as arcs and ring ends, read from the leaf data.
+type Rings = (SmallVec<[Arc; 24]>, SmallVec<[u32; 4]>);
 
 impl SilhouetteBsp {
     /// Precomputed silhouettes of a closed mesh in its default box
@@ -182,6 +193,69 @@ impl SilhouetteBsp {
         let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi);
         b.build_nonconvex();
         b.finish(Source::Solid(solid.clone()), lo, hi)
+    }
+
+    /// As [`SilhouetteBsp::build`], also storing per leaf a triangulation of its silhouette
+    /// that is certified valid everywhere in the leaf's cell (thesis 003 section 6.2.3; the
+    /// certificate and its argument are in the documentation of [`SilhouetteSampler`]'s
+    /// module, `solid/silhouette/triangulated.rs`), for [`SilhouetteBsp::query_triangles`].
+    /// Convex polyhedra need none (the fan of a convex silhouette is valid from every point
+    /// outside): for them this is [`SilhouetteBsp::build`].
+    ///
+    /// [`SilhouetteSampler`]: crate::solid::SilhouetteSampler
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::build_in`].
+    pub fn build_triangulated(solid: &ClosedMesh) -> Result<Self, GeomError> {
+        let (lo, hi) = default_region(solid.mesh());
+        SilhouetteBsp::build_triangulated_in(solid, lo, hi)
+    }
+
+    /// As [`SilhouetteBsp::build_triangulated`], in the box `[lo, hi]`.
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::build_in`].
+    pub fn build_triangulated_in(
+        solid: &ClosedMesh,
+        lo: DVec3,
+        hi: DVec3,
+    ) -> Result<Self, GeomError> {
+        Ok(SilhouetteBsp::build_triangulated_recording(solid, lo, hi, false)?.0)
+    }
+
+    /// As [`SilhouetteBsp::build_triangulated`], also returning the vertices of the cell of
+    /// every leaf that stores a triangulation (the convex cell its certificate covers), for
+    /// tests that sample points per cell.
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::build_in`].
+    #[doc(hidden)]
+    pub fn build_triangulated_with_cells(
+        solid: &ClosedMesh,
+    ) -> Result<(Self, Vec<Vec<DVec3>>), GeomError> {
+        let (lo, hi) = default_region(solid.mesh());
+        SilhouetteBsp::build_triangulated_recording(solid, lo, hi, true)
+    }
+
+    fn build_triangulated_recording(
+        solid: &ClosedMesh,
+        lo: DVec3,
+        hi: DVec3,
+        record: bool,
+    ) -> Result<(Self, Vec<Vec<DVec3>>), GeomError> {
+        if let Ok(p) = ConvexPolyhedron::from_mesh(solid.mesh()) {
+            return Ok((SilhouetteBsp::build_convex_in(&p, lo, hi)?, Vec::new()));
+        }
+        check_region(lo, hi)?;
+        let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi);
+        b.triangulate = Some(OnFace::new(solid.mesh()));
+        b.cells = record.then(Vec::new);
+        b.build_nonconvex();
+        let cells = b.cells.take().unwrap_or_default();
+        Ok((b.finish(Source::Solid(solid.clone()), lo, hi)?, cells))
     }
 
     /// Precomputed silhouettes of a convex polyhedron in its default box (thesis 003 section
@@ -230,33 +304,13 @@ impl SilhouetteBsp {
         };
         let mut at = leaf as usize;
         match &self.source {
-            Source::Convex(poly) => {
-                let len = self.read(at) as usize;
-                if len == 0 {
-                    return convex_silhouette(poly, frame);
+            Source::Convex(poly) => match self.convex_loop(poly, at, frame) {
+                Some(out) => {
+                    let len = out.len() as u32;
+                    Ok(SphericalPolygon::from_parts(out, smallvec::smallvec![len]))
                 }
-                let verts = poly.vertices();
-                let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(len);
-                for k in 0..len {
-                    let v = verts[self.read(at + 1 + k) as usize];
-                    match frame.to_local(v).try_normalize() {
-                        Some(u) => out.push(u),
-                        None => return convex_silhouette(poly, frame),
-                    }
-                }
-                // The spacing test of `convex_silhouette`, which then takes its general path.
-                let spaced = (0..len).all(|k| {
-                    let (a, b) = (out[k], out[(k + 1) % len]);
-                    (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
-                });
-                if !spaced {
-                    return convex_silhouette(poly, frame);
-                }
-                Ok(SphericalPolygon::from_parts(
-                    out,
-                    smallvec::smallvec![len as u32],
-                ))
-            }
+                None => convex_silhouette(poly, frame),
+            },
             Source::Solid(solid) => {
                 let header = self.read(at);
                 at += 1;
@@ -265,22 +319,7 @@ impl SilhouetteBsp {
                     FULL => Ok(SphericalPolygon::full()),
                     DIRECT => nonconvex_silhouette(solid, frame),
                     _ => {
-                        let mut arcs: SmallVec<[Arc; 24]> = SmallVec::new();
-                        let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
-                        for _ in 0..header - RINGS {
-                            let len = self.read(at) as usize;
-                            at += 1;
-                            for _ in 0..len {
-                                let w = self.read(at);
-                                at += 1;
-                                arcs.push(Arc {
-                                    edge: w >> 2,
-                                    forward: w & 2 != 0,
-                                    from_crossing: w & 1 != 0,
-                                });
-                            }
-                            ends.push(arcs.len() as u32);
-                        }
+                        let (arcs, ends) = self.read_rings(header, &mut at);
                         let rings = evaluate_rings(solid.mesh(), &arcs, &ends, frame)?;
                         let mut verts: SmallVec<[DVec3; 12]> = SmallVec::new();
                         let mut ring_ends: SmallVec<[u32; 2]> = SmallVec::new();
@@ -303,6 +342,155 @@ impl SilhouetteBsp {
                 }
             }
         }
+    }
+
+    /// A triangulation of the silhouette seen from the frame's point (local frame), written to
+    /// `out`: positively oriented spherical triangles with disjoint interiors whose union is
+    /// the region of [`SilhouetteBsp::query`] (up to the rounding of its vertices). Where the
+    /// tree stores a certified triangulation for the point's cell
+    /// ([`SilhouetteBsp::build_triangulated`]), or for a convex polyhedron (the fan of its
+    /// silhouette loop), it is evaluated at the point and checked there (each triangle's
+    /// orientation exactly, their solid angles below `4 pi`); otherwise, or when that check
+    /// fails, the queried silhouette is triangulated at the point
+    /// ([`SphericalPolygon::triangulate`]). The result says which.
+    ///
+    /// # Errors
+    ///
+    /// Those of [`SilhouetteBsp::query`] and [`SphericalPolygon::triangulate`].
+    pub fn query_triangles(
+        &self,
+        frame: &ShadingFrame,
+        out: &mut Vec<SphericalTriangle>,
+    ) -> Result<TriangleSource, GeomError> {
+        out.clear();
+        if self.stored_into(frame, out) {
+            return Ok(TriangleSource::Stored);
+        }
+        *out = self.query(frame)?.triangulate()?;
+        Ok(TriangleSource::Computed)
+    }
+
+    /// The stored triangulation (or convex fan) evaluated and checked at the point; `false`
+    /// where there is none or the check fails.
+    fn stored_into(&self, frame: &ShadingFrame, out: &mut Vec<SphericalTriangle>) -> bool {
+        let x = frame.origin();
+        if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
+            return false;
+        }
+        let Some(leaf) = self.leaf_of(x) else {
+            return false;
+        };
+        let mut at = leaf as usize;
+        match &self.source {
+            Source::Convex(poly) => match self.convex_loop(poly, at, frame) {
+                Some(dirs) => {
+                    let n = dirs.len() as u32;
+                    fan_or_list(&dirs, (1..n - 1).map(|k| [0, k, k + 1]), out)
+                }
+                None => false,
+            },
+            Source::Solid(solid) => {
+                let header = self.read(at);
+                at += 1;
+                if !self.triangulated || header < RINGS {
+                    return false;
+                }
+                let (arcs, ends) = self.read_rings(header, &mut at);
+                let tris = self.read_triangles(at);
+                !tris.is_empty() && evaluate_stored(solid.mesh(), &arcs, &ends, &tris, frame, out)
+            }
+        }
+    }
+
+    /// The stored triangulation of the point's cell evaluated at the point (local frame) with
+    /// no check: `None` where there is none. For tests of the build-time certificate.
+    #[doc(hidden)]
+    #[must_use]
+    pub fn stored_triangulation(&self, frame: &ShadingFrame) -> Option<Vec<[DVec3; 3]>> {
+        let x = frame.origin();
+        if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
+            return None;
+        }
+        let mut at = self.leaf_of(x)? as usize;
+        match &self.source {
+            Source::Convex(poly) => {
+                let d = self.convex_loop(poly, at, frame)?;
+                Some((1..d.len() - 1).map(|k| [d[0], d[k], d[k + 1]]).collect())
+            }
+            Source::Solid(solid) => {
+                let header = self.read(at);
+                at += 1;
+                if !self.triangulated || header < RINGS {
+                    return None;
+                }
+                let (arcs, ends) = self.read_rings(header, &mut at);
+                let tris = self.read_triangles(at);
+                if tris.is_empty() {
+                    return None;
+                }
+                raw_stored(solid.mesh(), &arcs, &ends, &tris, frame)
+            }
+        }
+    }
+
+    /// The silhouette loop of a convex polyhedron's leaf as unit directions, or `None` where
+    /// [`convex_silhouette`] answers (no loop stored, or vertices too close to chain).
+    fn convex_loop(
+        &self,
+        poly: &ConvexPolyhedron,
+        at: usize,
+        frame: &ShadingFrame,
+    ) -> Option<SmallVec<[DVec3; 12]>> {
+        let len = self.read(at) as usize;
+        if len == 0 {
+            return None;
+        }
+        let verts = poly.vertices();
+        let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(len);
+        for k in 0..len {
+            let v = verts[self.read(at + 1 + k) as usize];
+            out.push(frame.to_local(v).try_normalize()?);
+        }
+        // The spacing test of `convex_silhouette`, which then takes its general path.
+        let spaced = (0..len).all(|k| {
+            let (a, b) = (out[k], out[(k + 1) % len]);
+            (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+        });
+        spaced.then_some(out)
+    }
+
+    /// The rings of a leaf with `header` (at least [`RINGS`]), read from `*at` on; `*at` ends
+    /// after them.
+    fn read_rings(&self, header: u32, at: &mut usize) -> Rings {
+        let mut arcs: SmallVec<[Arc; 24]> = SmallVec::new();
+        let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
+        for _ in 0..header - RINGS {
+            let len = self.read(*at) as usize;
+            *at += 1;
+            for _ in 0..len {
+                let w = self.read(*at);
+                *at += 1;
+                arcs.push(Arc {
+                    edge: w >> 2,
+                    forward: w & 2 != 0,
+                    from_crossing: w & 1 != 0,
+                });
+            }
+            ends.push(arcs.len() as u32);
+        }
+        (arcs, ends)
+    }
+
+    /// The triangle section of a leaf at `at` (after its rings): index triples into the
+    /// corners, empty where the leaf stores none.
+    fn read_triangles(&self, at: usize) -> SmallVec<[[u32; 3]; 16]> {
+        let n = self.read(at) as usize;
+        (0..n)
+            .map(|k| {
+                let b = at + 1 + 3 * k;
+                [self.read(b), self.read(b + 1), self.read(b + 2)]
+            })
+            .collect()
     }
 
     /// The direct algorithm for the polyhedron.
@@ -423,6 +611,53 @@ impl SilhouetteBsp {
             }
         }
         n
+    }
+
+    /// Number of leaves that store a certified triangulation
+    /// ([`SilhouetteBsp::build_triangulated`]), and number of leaves with silhouette rings (the
+    /// leaves that could store one; the others are empty, full, or answered directly).
+    #[must_use]
+    pub fn triangulated_leaf_count(&self) -> (usize, usize) {
+        let (mut stored, mut rings) = (0, 0);
+        self.for_each_triangulation(|t| {
+            rings += 1;
+            stored += usize::from(t > 0);
+        });
+        (stored, rings)
+    }
+
+    /// Number of stored triangles, over all leaves.
+    #[must_use]
+    pub fn stored_triangle_count(&self) -> usize {
+        let mut n = 0;
+        self.for_each_triangulation(|t| n += t);
+        n
+    }
+
+    /// Calls `f` with the stored triangle count of every leaf with rings of a non-convex solid.
+    fn for_each_triangulation(&self, mut f: impl FnMut(usize)) {
+        if !matches!(self.source, Source::Solid(_)) {
+            return;
+        }
+        for &w in &self.nodes {
+            if w & LEAF == 0 {
+                continue;
+            }
+            let mut at = (w & !LEAF) as usize;
+            let h = self.read(at);
+            at += 1;
+            if h < RINGS {
+                continue;
+            }
+            for _ in 0..h - RINGS {
+                at += 1 + self.read(at) as usize;
+            }
+            f(if self.triangulated {
+                self.read(at) as usize
+            } else {
+                0
+            });
+        }
     }
 
     /// Bytes of the precomputed data: nodes, leaf data and splitting planes (the mesh itself,
@@ -751,6 +986,11 @@ struct Builder<'a> {
     stamp: Vec<u32>,
     memo: Vec<Option<bool>>,
     now: u32,
+    /// Whether leaves with rings get a triangulation section, with the exact coplanarity of
+    /// vertices and face planes for the certificate.
+    triangulate: Option<OnFace>,
+    /// When recording: the cell vertices of each leaf that stores a triangulation.
+    cells: Option<Vec<Vec<DVec3>>>,
 }
 
 impl<'a> Builder<'a> {
@@ -773,6 +1013,8 @@ impl<'a> Builder<'a> {
             stamp: Vec::new(),
             memo: Vec::new(),
             now: 0,
+            triangulate: None,
+            cells: None,
         }
     }
 
@@ -1146,11 +1388,11 @@ impl<'a> Builder<'a> {
         let mut found = None;
         for t in tries {
             if let Ok(o) = outline_with(solid, t, Some(&mut crossed)) {
-                found = Some(o);
+                found = Some((o, t));
                 break;
             }
         }
-        let Some(first) = found else {
+        let Some((first, at)) = found else {
             self.direct_leaves += 1;
             self.leaf_word(&[DIRECT]);
             return;
@@ -1167,8 +1409,14 @@ impl<'a> Builder<'a> {
                 }
             }
         }
+        let corners = self
+            .triangulate
+            .is_some()
+            .then(|| self.snapped_vertices(cell));
         if varying.is_empty() {
-            let payload = encode_outline(&first);
+            // Further points to triangulate at: vertices pulled half-way to the centroid.
+            let samples: Vec<DVec3> = cell.p.iter().take(4).map(|&p| c + (p - c) * 0.5).collect();
+            let payload = self.outline_payload(&first, at, corners.as_ref(), &samples);
             self.leaf_word(&payload);
             return;
         }
@@ -1202,7 +1450,30 @@ impl<'a> Builder<'a> {
             }
             samples.push((p, bits));
         }
-        self.triple_tree(solid, &varying, 0, samples);
+        self.triple_tree(solid, &varying, 0, samples, corners.as_ref());
+    }
+
+    /// A leaf's data for the outline `o` found at the point `at`: [`encode_outline`], and when
+    /// building triangulations (`cell` given) and `o` has rings, its triangle section, with a
+    /// triangulation certified over `cell` (tried at `at`, then at `samples`) or none.
+    fn outline_payload(
+        &mut self,
+        o: &Outline,
+        at: DVec3,
+        cell: Option<&CellCorners>,
+        samples: &[DVec3],
+    ) -> Vec<u32> {
+        let mut payload = encode_outline(o);
+        if let (Some(on_face), Some(cell), Outline::Rings { arcs, ends }) =
+            (&self.triangulate, cell, o)
+        {
+            let tris = certified_triangulation(self.mesh, arcs, ends, at, cell, on_face, samples);
+            push_triangles(&mut payload, tris.as_deref().unwrap_or(&[]));
+            if let (Some(cells), Some(_)) = (&mut self.cells, &tris) {
+                cells.push(cell.p.clone());
+            }
+        }
+        payload
     }
 
     /// The decision subtree over the signs of `varying[k..]` for the `samples` (points with
@@ -1213,6 +1484,7 @@ impl<'a> Builder<'a> {
         varying: &[[u32; 3]],
         k: usize,
         mut samples: Vec<(DVec3, u32)>,
+        cell: Option<&CellCorners>,
     ) {
         if samples.is_empty() {
             self.direct_leaves += 1;
@@ -1220,9 +1492,13 @@ impl<'a> Builder<'a> {
             return;
         }
         if k == varying.len() {
-            for &(p, _) in &samples {
+            for (i, &(p, _)) in samples.iter().enumerate() {
                 if let Ok(o) = outline(solid, p) {
-                    let payload = encode_outline(&o);
+                    // The triangulation is certified over the whole cell (condition 1 of the
+                    // certificate holds on any part of it); condition 3 is the query's own
+                    // check, since the part with these signs may be disconnected.
+                    let others: Vec<DVec3> = samples[i + 1..].iter().take(4).map(|s| s.0).collect();
+                    let payload = self.outline_payload(&o, p, cell, &others);
                     self.leaf_word(&payload);
                     return;
                 }
@@ -1243,10 +1519,70 @@ impl<'a> Builder<'a> {
             plane: id,
             right: 0,
         });
-        self.triple_tree(solid, varying, k + 1, samples);
+        self.triple_tree(solid, varying, k + 1, samples, cell);
         let right = self.nodes.len() as u32;
         self.nodes[node] = BuildNode::Inner { plane: id, right };
-        self.triple_tree(solid, varying, k + 1, pos);
+        self.triple_tree(solid, varying, k + 1, pos, cell);
+    }
+
+    /// The cell's vertices, each snapped to a mesh vertex `m` where it is the intersection of
+    /// planes that all contain `m` exactly (three of them with independent normals, so that
+    /// their intersection is `m`) and lies within [`SNAP_REL`] of the box's size of it: such
+    /// corners (cells touching the solid) are where the triangulation certificate evaluates
+    /// affine functions that vanish at `m`, whose sign at the rounded vertex would be noise.
+    fn snapped_vertices(&self, cell: &Cell) -> CellCorners {
+        let verts = self.mesh.vertices();
+        let tris = self.mesh.triangles();
+        let points = |plane: u32| -> Option<[u32; 3]> {
+            match self.planes[plane as usize] {
+                SplitPlane::Face(f) => Some(tris[f as usize]),
+                SplitPlane::Through(s) => Some(s),
+                SplitPlane::Triple(_) => None,
+            }
+        };
+        let reach = SNAP_REL * (self.hi - self.lo).max_element();
+        let mut out = CellCorners {
+            p: Vec::with_capacity(cell.p.len()),
+            faces: Vec::with_capacity(cell.p.len()),
+        };
+        for (p, tags) in cell.p.iter().zip(&cell.tag) {
+            let planes: SmallVec<[[u32; 3]; 6]> = tags
+                .iter()
+                .filter(|&&t| t >= 6)
+                .filter_map(|&t| points(t - 6))
+                .collect();
+            let mut snapped = *p;
+            if planes.len() >= 3 {
+                let found = planes.iter().flatten().copied().find(|&m| {
+                    let q = verts[m as usize];
+                    (q - *p).length() <= reach
+                        && planes.iter().all(|s| {
+                            s.contains(&m)
+                                || orient3d(
+                                    c3(verts[s[0] as usize]),
+                                    c3(verts[s[1] as usize]),
+                                    c3(verts[s[2] as usize]),
+                                    c3(q),
+                                ) == 0.0
+                        })
+                        && independent(verts, &planes)
+                });
+                if let Some(m) = found {
+                    snapped = verts[m as usize];
+                }
+            }
+            out.p.push(snapped);
+            out.faces.push(
+                tags.iter()
+                    .filter(|&&t| t >= 6)
+                    .filter_map(|&t| match self.planes[(t - 6) as usize] {
+                        SplitPlane::Face(f) => Some(f),
+                        _ => None,
+                    })
+                    .collect(),
+            );
+        }
+        out
     }
 
     fn finish(self, source: Source, lo: DVec3, hi: DVec3) -> Result<SilhouetteBsp, GeomError> {
@@ -1291,8 +1627,32 @@ impl<'a> Builder<'a> {
             hi,
             leaves: self.leaves,
             direct_leaves: self.direct_leaves,
+            triangulated: self.triangulate.is_some(),
         })
     }
+}
+
+/// Whether three of the planes through the given vertex triples have clearly independent normals
+/// (the determinant of their unit normals beyond `1e-6`), so that they meet in one point.
+fn independent(verts: &[DVec3], planes: &[[u32; 3]]) -> bool {
+    let normals: SmallVec<[DVec3; 6]> = planes
+        .iter()
+        .filter_map(|s| {
+            let [a, b, c] = s.map(|i| verts[i as usize]);
+            (b - a).cross(c - a).try_normalize()
+        })
+        .collect();
+    let n = normals.len();
+    for i in 0..n {
+        for j in i + 1..n {
+            for k in j + 1..n {
+                if normals[i].dot(normals[j].cross(normals[k])).abs() > 1e-6 {
+                    return true;
+                }
+            }
+        }
+    }
+    false
 }
 
 /// Leaf data of a convex polyhedron seen from `x`: `[len, vertex indices]` of the silhouette
@@ -1322,6 +1682,14 @@ fn convex_ring(mesh: &TriangleMesh, x: DVec3, dist: &mut Vec<f64>) -> Vec<u32> {
             out
         }
         None => vec![0],
+    }
+}
+
+/// Appends a leaf's triangle section: the count, then the index triples.
+fn push_triangles(payload: &mut Vec<u32>, tris: &[[u32; 3]]) {
+    payload.push(tris.len() as u32);
+    for t in tris {
+        payload.extend_from_slice(t);
     }
 }
 
