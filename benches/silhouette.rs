@@ -12,6 +12,9 @@
 //!   in [-3, 3]^2, views 17 to 80 degrees off the normal, GGX alpha 0.3); times are per 32 points.
 //! - `silhouette/build/<polyhedron>` (table 7.4): `SilhouetteBsp::build`. Node counts, stored
 //!   silhouette elements and bytes are printed once (they do not depend on timing).
+//! - `silhouette/build triangulated/<polyhedron>` (table 7.4, "triangulated silhouettes"), for
+//!   the non-convex ones: `SilhouetteBsp::build_triangulated`, with the leaves that store a
+//!   certified triangulation, the stored triangles and bytes printed once.
 //!
 //! Fixed inputs; results in BENCHMARKS.md (section `silhouette`). Run with
 //! `cargo bench --bench silhouette`.
@@ -152,6 +155,25 @@ fn build(c: &mut Criterion) {
         );
         g.bench_with_input(BenchmarkId::from_parameter(name), &solid, |b, s| {
             b.iter(|| SilhouetteBsp::build(black_box(s)).unwrap())
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("silhouette/build triangulated");
+    g.sample_size(10);
+    g.measurement_time(Duration::from_secs(3));
+    for (name, mesh) in thesis_polyhedra().unwrap().into_iter().skip(5) {
+        let solid = ClosedMesh::new(mesh).unwrap();
+        let bsp = SilhouetteBsp::build_triangulated(&solid).unwrap();
+        let (stored, rings) = bsp.triangulated_leaf_count();
+        eprintln!(
+            "{name} triangulated: {} nodes, {stored} of {rings} leaves with rings store a \
+             triangulation, {} triangles, {} bytes",
+            bsp.node_count(),
+            bsp.stored_triangle_count(),
+            bsp.byte_size()
+        );
+        g.bench_with_input(BenchmarkId::from_parameter(name), &solid, |b, s| {
+            b.iter(|| SilhouetteBsp::build_triangulated(black_box(s)).unwrap())
         });
     }
     g.finish();

@@ -16,10 +16,11 @@ use arealight::glam::{DMat3, DQuat, DVec3};
 use arealight::internals::{
     bumpy_sphere, convex_silhouette, extruded_star, thesis_polyhedra, torus,
 };
+use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::solid::{
-    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, TriangleMesh, TriangleSource,
-    nonconvex_silhouette,
+    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, SilhouetteSampler, TriangleMesh,
+    TriangleSource, nonconvex_silhouette,
 };
 use arealight::sphere::{SphericalPolygon, SphericalTriangle};
 use robust::orient3d;
@@ -413,6 +414,11 @@ fn check_stored_triangulations(
             let Ok(poly) = bsp.query(&frame) else {
                 continue;
             };
+            // The leaf data with triangle sections still decode to the silhouette.
+            if let Ok(d) = nonconvex_silhouette(solid, &frame) {
+                let (a, b) = (poly.solid_angle(), d.solid_angle());
+                assert!((a - b).abs() <= 1e-9 * a.max(1e-3), "{name} x {x}: {a} vs {b}");
+            }
             let Some(tris) = bsp.stored_triangulation(&frame) else {
                 // Within rounding of the cell's boundary, in a neighbour without one, or
                 // answered directly (near a face plane).
@@ -475,5 +481,109 @@ fn stored_triangulations_are_valid_everywhere_in_their_cells() {
             max_cells,
         );
         assert!(checked >= 250, "solid {k}: only {checked} points checked");
+    }
+}
+
+/// Hoeffding's bound for the mean of `n` independent values in an interval of width `range`:
+/// exceeded with probability below 1e-9.
+fn hoeffding(n: usize, range: f64) -> f64 {
+    range * ((2e9f64).ln() / (2.0 * n as f64)).sqrt()
+}
+
+#[test]
+fn silhouette_sampler_is_uniform_over_the_silhouette() {
+    // At points whose cell stores a triangulation (and a few where it is computed), 40 000
+    // directions from `SilhouetteSampler` must all lie in the queried silhouette, and estimate
+    // (i) the clamped-cosine integral (`ltc::clamped_cosine_integral` of the silhouette) and
+    // (ii) the silhouette's share in a hemisphere through its middle (the solid angle of its
+    // hemisphere clip over its own), each within Hoeffding's bound at 1e-9 (values in [0, 1];
+    // 48 checks, so a false alarm has probability below 5e-8).
+    let mut rng = Rng::new(0x5a3);
+    let n = 40_000;
+    let solids = thesis_polyhedra().unwrap();
+    let mut stored = 0;
+    for (name, m) in solids.into_iter().skip(5) {
+        let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(m).unwrap()).unwrap();
+        let mesh_center = DVec3::ZERO;
+        let mut cases = 0;
+        while cases < 6 {
+            let x = mesh_center + rng.dir() * rng.range(1.5, 6.0);
+            let frame = ShadingFrame::new(x, DVec3::Z, DVec3::X).unwrap();
+            let (Ok(poly), Ok(sampler)) = (bsp.query(&frame), SilhouetteSampler::new(&bsp, &frame))
+            else {
+                continue;
+            };
+            cases += 1;
+            stored += usize::from(sampler.source() == TriangleSource::Stored);
+            let omega = poly.solid_angle();
+            assert!(
+                (sampler.solid_angle() - omega).abs() <= 1e-9 * omega,
+                "{name} x {x}"
+            );
+            // A hemisphere whose circle passes through the silhouette's middle.
+            let mid = sampler
+                .triangles()
+                .iter()
+                .map(|t| t.vertices().iter().sum::<DVec3>() * t.solid_angle())
+                .sum::<DVec3>()
+                .normalize();
+            let normal = mid.cross(rng.dir()).normalize();
+            let share = poly.clip_to_hemisphere(normal).solid_angle() / omega;
+            let cosine = clamped_cosine_integral(&poly) / omega;
+            let (mut in_half, mut cos_sum) = (0usize, 0.0);
+            for _ in 0..n {
+                let d = sampler.sample(rng.point2());
+                assert!(
+                    poly.contains(d) || boundary_distance(&poly, d) < 1e-9,
+                    "{name} x {x}: sample {d} outside the silhouette"
+                );
+                assert_eq!(sampler.pdf(d), 1.0 / sampler.solid_angle(), "{name} x {x}");
+                in_half += usize::from(d.dot(normal) > 0.0);
+                cos_sum += d.z.max(0.0) / std::f64::consts::PI;
+            }
+            let bound = hoeffding(n, 1.0);
+            let est = in_half as f64 / n as f64;
+            assert!(
+                (est - share).abs() <= bound,
+                "{name} x {x}: hemisphere share {est} sampled, {share} exact (bound {bound})"
+            );
+            let est = cos_sum / n as f64;
+            assert!(
+                (est - cosine).abs() <= hoeffding(n, 1.0 / std::f64::consts::PI),
+                "{name} x {x}: clamped cosine {est} sampled, {cosine} exact"
+            );
+        }
+    }
+    assert!(
+        stored >= 12,
+        "only {stored} of 24 cases used stored triangulations"
+    );
+}
+
+#[test]
+fn convex_fans_are_valid_triangulations() {
+    // A convex polyhedron's silhouette seen from outside is strictly convex inside every cell
+    // of its face planes (three silhouette vertices seen on one great circle would put the
+    // point on a supporting plane through three vertices: a face plane), so the fan of its
+    // stored loop is a triangulation: checked as the stored ones are, at points in the box,
+    // near the solid and near the face planes.
+    let mut rng = Rng::new(0xfa4);
+    for (name, m) in thesis_polyhedra().unwrap().into_iter().take(5) {
+        let mesh = m.clone();
+        let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(m).unwrap()).unwrap();
+        let mut checked = 0;
+        for _ in 0..400 {
+            let x = sample(&bsp, &mesh, &mut rng);
+            let frame = ShadingFrame::new(x, DVec3::Z, DVec3::Y).unwrap();
+            let (Ok(poly), Some(tris)) = (bsp.query(&frame), bsp.stored_triangulation(&frame))
+            else {
+                continue;
+            };
+            if let Err(msg) = check_triangulation(&tris, &poly, &mut rng) {
+                panic!("{name} x {x}: fan invalid: {msg}");
+            }
+            checked += 1;
+        }
+        assert!(checked >= 200, "{name}: {checked}");
     }
 }

@@ -47,6 +47,10 @@
 //! its right child (the left child follows it); a leaf holds the offset of its data. Leaf data
 //! are small integers stored with the narrowest width (1, 2 or 4 bytes) that holds all of them:
 //! vertex indices for convex polyhedra, `edge << 2 | direction | from-crossing` for arcs.
+//! Built with triangulations ([`SilhouetteBsp::build_triangulated`]), each leaf with rings
+//! ends with its triangle count and its triangles as index triples into its `n` corners (the
+//! arcs' starts), one element `i + n (j + n k)` each where `n^3` fits the width (the width of
+//! everything else decides), else three.
 
 use alloc::collections::BTreeMap;
 use alloc::vec;
@@ -199,8 +203,11 @@ impl SilhouetteBsp {
     /// that is certified valid everywhere in the leaf's cell (thesis 003 section 6.2.3; the
     /// certificate and its argument are in the documentation of [`SilhouetteSampler`]'s
     /// module, `solid/silhouette/triangulated.rs`), for [`SilhouetteBsp::query_triangles`].
-    /// Convex polyhedra need none (the fan of a convex silhouette is valid from every point
-    /// outside): for them this is [`SilhouetteBsp::build`].
+    /// Convex polyhedra need none: seen from a point of a cell of the face planes (off them by
+    /// more than the facing predicate's tolerance), the silhouette is strictly convex, since
+    /// three of its vertices seen on one great circle would put the point on a supporting
+    /// plane through three vertices, a face plane; so the fan of the stored loop from its
+    /// first vertex is a triangulation, and for them this is [`SilhouetteBsp::build`].
     ///
     /// [`SilhouetteSampler`]: crate::solid::SilhouetteSampler
     ///
@@ -299,7 +306,7 @@ impl SilhouetteBsp {
         if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
             return self.direct(frame);
         }
-        let Some(leaf) = self.leaf_of(x) else {
+        let Some(leaf) = self.leaf_of(x, matches!(self.source, Source::Solid(_))) else {
             return self.direct(frame);
         };
         let mut at = leaf as usize;
@@ -354,6 +361,22 @@ impl SilhouetteBsp {
     /// fails, the queried silhouette is triangulated at the point
     /// ([`SphericalPolygon::triangulate`]). The result says which.
     ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::solid::{ClosedMesh, ShadingFrame, SilhouetteBsp, TriangleSource};
+    /// use arealight::internals::thesis_polyhedra;
+    /// let (_, bowl) = thesis_polyhedra()?.pop().unwrap();
+    /// let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(bowl)?)?;
+    /// let frame = ShadingFrame::new(DVec3::new(0.3, -0.2, 3.0), DVec3::Z, DVec3::Z)?;
+    /// let mut tris = Vec::new();
+    /// assert_eq!(bsp.query_triangles(&frame, &mut tris)?, TriangleSource::Stored);
+    /// let area: f64 = tris.iter().map(|t| t.solid_angle()).sum();
+    /// assert!((area - bsp.query(&frame)?.solid_angle()).abs() < 1e-12);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
     /// # Errors
     ///
     /// Those of [`SilhouetteBsp::query`] and [`SphericalPolygon::triangulate`].
@@ -377,7 +400,7 @@ impl SilhouetteBsp {
         if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
             return false;
         }
-        let Some(leaf) = self.leaf_of(x) else {
+        let Some(leaf) = self.leaf_of(x, true) else {
             return false;
         };
         let mut at = leaf as usize;
@@ -396,7 +419,7 @@ impl SilhouetteBsp {
                     return false;
                 }
                 let (arcs, ends) = self.read_rings(header, &mut at);
-                let tris = self.read_triangles(at);
+                let tris = self.read_triangles(at, arcs.len());
                 !tris.is_empty() && evaluate_stored(solid.mesh(), &arcs, &ends, &tris, frame, out)
             }
         }
@@ -411,7 +434,7 @@ impl SilhouetteBsp {
         if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
             return None;
         }
-        let mut at = self.leaf_of(x)? as usize;
+        let mut at = self.leaf_of(x, true)? as usize;
         match &self.source {
             Source::Convex(poly) => {
                 let d = self.convex_loop(poly, at, frame)?;
@@ -424,7 +447,7 @@ impl SilhouetteBsp {
                     return None;
                 }
                 let (arcs, ends) = self.read_rings(header, &mut at);
-                let tris = self.read_triangles(at);
+                let tris = self.read_triangles(at, arcs.len());
                 if tris.is_empty() {
                     return None;
                 }
@@ -481,16 +504,26 @@ impl SilhouetteBsp {
         (arcs, ends)
     }
 
-    /// The triangle section of a leaf at `at` (after its rings): index triples into the
-    /// corners, empty where the leaf stores none.
-    fn read_triangles(&self, at: usize) -> SmallVec<[[u32; 3]; 16]> {
-        let n = self.read(at) as usize;
-        (0..n)
-            .map(|k| {
-                let b = at + 1 + 3 * k;
-                [self.read(b), self.read(b + 1), self.read(b + 2)]
-            })
-            .collect()
+    /// The triangle section of a leaf with `corners` corners at `at` (after its rings): index
+    /// triples into the corners, empty where the leaf stores none.
+    fn read_triangles(&self, at: usize, corners: usize) -> SmallVec<[[u32; 3]; 16]> {
+        let t = self.read(at) as usize;
+        if packs(corners, self.width) {
+            let n = corners as u32;
+            (0..t)
+                .map(|k| {
+                    let w = self.read(at + 1 + k);
+                    [w % n, w / n % n, w / (n * n)]
+                })
+                .collect()
+        } else {
+            (0..t)
+                .map(|k| {
+                    let b = at + 1 + 3 * k;
+                    [self.read(b), self.read(b + 1), self.read(b + 2)]
+                })
+                .collect()
+        }
     }
 
     /// The direct algorithm for the polyhedron.
@@ -502,12 +535,14 @@ impl SilhouetteBsp {
     }
 
     /// The data offset of the leaf holding `x`; `None` when a triple test is within rounding,
-    /// or, for a non-convex solid, `x` lies within the facing predicate's tolerance of a face
-    /// plane on the path: there the face counts as edge-on while the exact tests of planes
-    /// through vertices of that face see `x` on one side, so `x` may belong to no stored cell
-    /// (the direct algorithm then decides, or gives up, itself).
-    fn leaf_of(&self, x: DVec3) -> Option<u32> {
-        let band = matches!(self.source, Source::Solid(_));
+    /// or, with `band`, when `x` lies within the facing predicate's tolerance of a face plane
+    /// on the path. A non-convex solid's query always sets it: there the face counts as
+    /// edge-on while the exact tests of planes through vertices of that face see `x` on one
+    /// side, so `x` may belong to no stored cell (the direct algorithm then decides, or gives
+    /// up, itself). The stored triangulations set it for convex polyhedra too: within the band
+    /// a face counted edge-on may in fact be seen from its front, and the loop is then convex
+    /// only up to the tolerance.
+    fn leaf_of(&self, x: DVec3, band: bool) -> Option<u32> {
         let mesh = self.source.mesh();
         let b = mesh.bounding_sphere();
         let rel = x - b.center;
@@ -1585,7 +1620,70 @@ impl<'a> Builder<'a> {
         out
     }
 
-    fn finish(self, source: Source, lo: DVec3, hi: DVec3) -> Result<SilhouetteBsp, GeomError> {
+    /// Packs the leaves' triangle sections (see [`packs`]) once the width of everything else
+    /// is known, moving the leaves' data offsets; returns that width.
+    fn pack_triangles(&mut self) -> u8 {
+        // The leaves' data in order (their offsets increase with the node order).
+        let leaves: Vec<usize> = self
+            .nodes
+            .iter()
+            .filter_map(|n| match n {
+                BuildNode::Leaf(off) => Some(*off as usize),
+                BuildNode::Inner { .. } => None,
+            })
+            .collect();
+        // Per leaf with rings: where its triangle count is, its corners and its triangles.
+        let parse = |at: usize| -> Option<(usize, usize, usize)> {
+            let h = self.data[at];
+            if h < RINGS {
+                return None;
+            }
+            let (mut p, mut n) = (at + 1, 0usize);
+            for _ in 0..h - RINGS {
+                let len = self.data[p] as usize;
+                n += len;
+                p += 1 + len;
+            }
+            Some((p, n, self.data[p] as usize))
+        };
+        let mut max = 0u32;
+        for &at in &leaves {
+            let end = parse(at).map_or(at + 1, |(p, _, _)| p + 1);
+            max = max.max(self.data[at..end].iter().copied().max().unwrap_or(0));
+        }
+        let width = width_of(max);
+        let mut out: Vec<u32> = Vec::with_capacity(self.data.len());
+        let mut moved: Vec<u32> = Vec::with_capacity(leaves.len());
+        for &at in &leaves {
+            moved.push(out.len() as u32);
+            match parse(at) {
+                None => out.push(self.data[at]),
+                Some((p, n, t)) => {
+                    out.extend_from_slice(&self.data[at..=p]);
+                    for k in 0..t {
+                        let tri = &self.data[p + 1 + 3 * k..p + 4 + 3 * k];
+                        if packs(n, width) {
+                            let n = n as u32;
+                            out.push(tri[0] + n * (tri[1] + n * tri[2]));
+                        } else {
+                            out.extend_from_slice(tri);
+                        }
+                    }
+                }
+            }
+        }
+        let mut k = 0;
+        for node in &mut self.nodes {
+            if let BuildNode::Leaf(off) = node {
+                *off = moved[k];
+                k += 1;
+            }
+        }
+        self.data = out;
+        width
+    }
+
+    fn finish(mut self, source: Source, lo: DVec3, hi: DVec3) -> Result<SilhouetteBsp, GeomError> {
         let n = self.nodes.len() as u64;
         let child_bits = (64 - n.max(2).leading_zeros()).max(1);
         let plane_bits = 64 - (self.planes.len() as u64).max(1).leading_zeros();
@@ -1596,6 +1694,7 @@ impl<'a> Builder<'a> {
                 limit: f64::from(LEAF),
             });
         }
+        let packed = self.triangulate.is_some().then(|| self.pack_triangles());
         let nodes: Vec<u32> = self
             .nodes
             .iter()
@@ -1604,14 +1703,8 @@ impl<'a> Builder<'a> {
                 BuildNode::Inner { plane, right } => (plane << child_bits) | right,
             })
             .collect();
-        let max = self.data.iter().copied().max().unwrap_or(0);
-        let width: u8 = if max < 1 << 8 {
-            1
-        } else if max < 1 << 16 {
-            2
-        } else {
-            4
-        };
+        let width =
+            packed.unwrap_or_else(|| width_of(self.data.iter().copied().max().unwrap_or(0)));
         let mut data = Vec::with_capacity(self.data.len() * width as usize);
         for &x in &self.data {
             data.extend_from_slice(&x.to_le_bytes()[..width as usize]);
@@ -1630,6 +1723,23 @@ impl<'a> Builder<'a> {
             triangulated: self.triangulate.is_some(),
         })
     }
+}
+
+/// The narrowest data width (bytes) that holds `max`.
+fn width_of(max: u32) -> u8 {
+    if max < 1 << 8 {
+        1
+    } else if max < 1 << 16 {
+        2
+    } else {
+        4
+    }
+}
+
+/// Whether a leaf with `n` corners stores each triangle as one word `i + n (j + n k)` at data
+/// width `width`: when `n^3` fits the width.
+fn packs(n: usize, width: u8) -> bool {
+    (n as u64).pow(3) <= 1u64 << (8 * u32::from(width))
 }
 
 /// Whether three of the planes through the given vertex triples have clearly independent normals

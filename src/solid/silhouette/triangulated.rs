@@ -105,7 +105,8 @@ pub(crate) const SNAP_REL: f64 = 1e-9;
 #[non_exhaustive]
 pub enum TriangleSource {
     /// The triangulation stored for the point's cell, evaluated at the point (for a convex
-    /// polyhedron: the fan of its silhouette loop, valid for any point outside it).
+    /// polyhedron: the fan of its stored silhouette loop, see
+    /// [`SilhouetteBsp::build_triangulated`]).
     Stored,
     /// [`SphericalPolygon::triangulate`] of the queried silhouette: the tree stores no
     /// triangulation for the point's cell (it was built without them, the cell has none, the
