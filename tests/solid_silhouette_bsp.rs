@@ -417,7 +417,10 @@ fn check_stored_triangulations(
             // The leaf data with triangle sections still decode to the silhouette.
             if let Ok(d) = nonconvex_silhouette(solid, &frame) {
                 let (a, b) = (poly.solid_angle(), d.solid_angle());
-                assert!((a - b).abs() <= 1e-9 * a.max(1e-3), "{name} x {x}: {a} vs {b}");
+                assert!(
+                    (a - b).abs() <= 1e-9 * a.max(1e-3),
+                    "{name} x {x}: {a} vs {b}"
+                );
             }
             let Some(tris) = bsp.stored_triangulation(&frame) else {
                 // Within rounding of the cell's boundary, in a neighbour without one, or

@@ -65,7 +65,7 @@ use super::nonconvex::{
     Arc, ORDER_ERROR, Outline, collinear, evaluate_rings, outline, outline_with,
 };
 use super::triangulated::{
-    CellCorners, OnFace, SNAP_REL, TriangleSource, certified_triangulation, evaluate_stored,
+    CellCorners, Extra, OnFace, SNAP_REL, TriangleSource, certified_triangulation, evaluate_stored,
     fan_or_list, raw_stored,
 };
 use super::{convex_silhouette, nonconvex_silhouette};
@@ -1026,6 +1026,9 @@ struct Builder<'a> {
     triangulate: Option<OnFace>,
     /// When recording: the cell vertices of each leaf that stores a triangulation.
     cells: Option<Vec<Vec<DVec3>>>,
+    /// The last triangulation certified per leaf structure (encoded outline), tried first in
+    /// the next cell with that structure (neighbouring cells often share it).
+    last_triangulation: BTreeMap<Vec<u32>, Vec<[u32; 3]>>,
 }
 
 impl<'a> Builder<'a> {
@@ -1050,6 +1053,7 @@ impl<'a> Builder<'a> {
             now: 0,
             triangulate: None,
             cells: None,
+            last_triangulation: BTreeMap::new(),
         }
     }
 
@@ -1502,7 +1506,12 @@ impl<'a> Builder<'a> {
         if let (Some(on_face), Some(cell), Outline::Rings { arcs, ends }) =
             (&self.triangulate, cell, o)
         {
-            let tris = certified_triangulation(self.mesh, arcs, ends, at, cell, on_face, samples);
+            let hint = self.last_triangulation.get(&payload).map(Vec::as_slice);
+            let extra = Extra { samples, hint };
+            let tris = certified_triangulation(self.mesh, arcs, ends, at, cell, on_face, extra);
+            if let Some(t) = &tris {
+                self.last_triangulation.insert(payload.clone(), t.clone());
+            }
             push_triangles(&mut payload, tris.as_deref().unwrap_or(&[]));
             if let (Some(cells), Some(_)) = (&mut self.cells, &tris) {
                 cells.push(cell.p.clone());

@@ -514,7 +514,7 @@ fn triangulate_at(
 ///
 /// `arcs` and `ends` are the leaf's rings, `rep` a point of the cell's interior where they are
 /// the silhouette's structure, `cell` the cell's vertices (mesh vertices among them snapped
-/// exactly) and `samples` further interior points at which to try `triangulate`.
+/// exactly), `on_face` the mesh's vertex-plane incidences and `extra` further candidates.
 pub(crate) fn certified_triangulation(
     mesh: &TriangleMesh,
     arcs: &[Arc],
@@ -522,8 +522,9 @@ pub(crate) fn certified_triangulation(
     rep: DVec3,
     cell: &CellCorners,
     on_face: &OnFace,
-    samples: &[DVec3],
+    extra: Extra<'_>,
 ) -> Option<Vec<[u32; 3]>> {
+    let Extra { samples, hint } = extra;
     let corners = corners(mesh, arcs, ends);
     let canon = canonical(&corners);
     let frame = ShadingFrame::new(rep, DVec3::Z, DVec3::Z).ok()?;
@@ -543,8 +544,14 @@ pub(crate) fn certified_triangulation(
             triangles: Memo::default(),
         },
     };
-    // The triangulation at the representative point first (one call when it passes), then
-    // every triangulation by diagonals (the dynamic program), then triangulations elsewhere.
+    // The hint (the triangulation of another cell with the same structure) first, the
+    // triangulation at the representative point next (one call when it passes), then every
+    // triangulation by diagonals (the dynamic program), then triangulations elsewhere.
+    if let Some(t) = hint
+        && leaf.accept(t)
+    {
+        return Some(t.to_vec());
+    }
     if let Some(t) = triangulate_at(mesh, arcs, ends, &canon, rep)
         && leaf.accept(&t)
     {
@@ -565,6 +572,14 @@ pub(crate) fn certified_triangulation(
         }
     }
     None
+}
+
+/// Further candidates for [`certified_triangulation`]: points of the cell at which to try
+/// `triangulate`, and a triangulation to try first.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Extra<'a> {
+    pub samples: &'a [DVec3],
+    pub hint: Option<&'a [[u32; 3]]>,
 }
 
 /// One leaf's certificate: its ring edges, the corners' directions at the representative
@@ -615,8 +630,9 @@ impl Leaf<'_> {
 
 /// The closed corner sequences (canonical ids) whose polygon triangulations are triangulations
 /// of the rings: the ring itself, or for two rings, each ring joined to the other by a bridge
-/// traversed both ways (the bridges' two directions cancel in condition 2), between the four
-/// pairs of corners nearest at the representative point (`dirs`).
+/// traversed both ways (the bridges' two directions cancel in condition 2), between the
+/// four pairs of corners nearest at the representative point (`dirs`; trying all pairs
+/// certified no further leaf of the thesis polyhedra).
 fn sequences(canon: &[u32], ends: &[u32], dirs: &[DVec3]) -> Vec<Vec<u32>> {
     match ends {
         [_] => alloc::vec![canon.to_vec()],
