@@ -44,12 +44,24 @@ pub(crate) enum Crossing {
 /// triangle's winding order.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Occluder {
-    pub(crate) verts: [DVec3; MAX_OCCLUDER_VERTICES],
-    pub(crate) len: u8,
-    pub(crate) crossing: Crossing,
+    verts: [DVec3; MAX_OCCLUDER_VERTICES],
+    len: u8,
+    crossing: Crossing,
 }
 
 impl Occluder {
+    /// The occluder with vertices `v` (3 to [`MAX_OCCLUDER_VERTICES`], in order) crossed by the
+    /// query lines as `crossing` says.
+    pub(crate) fn new(v: &[DVec3], crossing: Crossing) -> Occluder {
+        let mut verts = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
+        verts[..v.len()].copy_from_slice(v);
+        Occluder {
+            verts,
+            len: v.len() as u8,
+            crossing,
+        }
+    }
+
     /// The vertices.
     #[inline]
     pub(crate) fn vertices(&self) -> &[DVec3] {
@@ -369,8 +381,8 @@ impl Tree {
     /// line `o_k -> p`: as is for the tile (`reverse` false), reversed for the light.
     fn orientation(&self, o: u32, orienters: &[Orienter], reverse: bool) -> Sign {
         let (mut pos, mut neg) = (false, false);
-        for &b in self.occluders[o as usize].vertices() {
-            for or in orienters {
+        for or in orienters {
+            for &b in self.occluders[o as usize].vertices() {
                 let Some(s) = or.strict_sign(b) else {
                     return Sign::Zero;
                 };

@@ -461,7 +461,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             for poly in polys {
                 let local: Fragment = poly.iter().map(|&p| p - origin).collect();
                 if let Some(frag) = clip_above(&local, xl, n) {
-                    result = query(tree, xl, frag, *budget, &mut ws.frags, &mut ws.scratch);
+                    result = query(tree, xl, &frag, *budget, &mut ws.frags, &mut ws.scratch);
                     if result.is_err() {
                         break;
                     }
@@ -526,7 +526,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 && query(
                     &mut tree,
                     DVec3::ZERO,
-                    frag,
+                    &frag,
                     self.tree_cap,
                     &mut ws.frags,
                     &mut ws.scratch,

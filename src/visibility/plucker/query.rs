@@ -49,10 +49,13 @@ enum Class {
     Split,
 }
 
-/// Buffers a query reuses.
+/// Buffers a query reuses: fragments live in one pool of vertices (a fragment is a range of
+/// it), so that splits append instead of moving polygons around.
 #[derive(Debug, Default, Clone)]
 pub(crate) struct Scratch {
-    stack: Vec<(u32, Fragment)>,
+    /// Node, start in `pool`, vertex count.
+    stack: Vec<(u32, u32, u32)>,
+    pool: Vec<DVec3>,
 }
 
 fn classify(or: &Orienter, frag: &[DVec3], vals: &mut SmallVec<[(f64, Sign); 8]>) -> Class {
@@ -103,13 +106,7 @@ fn split(frag: &[DVec3], vals: &[(f64, Sign)]) -> (Option<Fragment>, Option<Frag
             (sa, sb),
             (Sign::Positive, Sign::Negative) | (Sign::Negative, Sign::Positive)
         ) {
-            let den = va - vb;
-            let t = if den != 0.0 && (va / den).is_finite() {
-                (va / den).clamp(0.0, 1.0)
-            } else {
-                0.5
-            };
-            let p = a + (b - a) * t;
+            let p = cut_point(a, b, va, vb);
             push_point(&mut pos, p);
             push_point(&mut neg, p);
         }
@@ -123,6 +120,62 @@ fn split(frag: &[DVec3], vals: &[(f64, Sign)]) -> (Option<Fragment>, Option<Frag
     (close(pos), close(neg))
 }
 
+/// Appends to `pool` the part of the fragment `pool[s..s + n]` on the positive (`positive`) or
+/// negative side, as [`split`] does, and returns its range, or `None` for fewer than three
+/// distinct points (the pool is then left as it was).
+fn split_part(
+    pool: &mut Vec<DVec3>,
+    s: usize,
+    n: usize,
+    vals: &[(f64, Sign)],
+    positive: bool,
+) -> Option<(u32, u32)> {
+    let start = pool.len();
+    let (keep, drop) = if positive {
+        (Sign::Positive, Sign::Negative)
+    } else {
+        (Sign::Negative, Sign::Positive)
+    };
+    let push = |pool: &mut Vec<DVec3>, p: DVec3| {
+        if pool.len() == start || pool[pool.len() - 1] != p {
+            pool.push(p);
+        }
+    };
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b) = (pool[s + i], pool[s + j]);
+        let ((va, sa), (vb, sb)) = (vals[i], vals[j]);
+        if sa != drop {
+            push(pool, a);
+        }
+        if (sa == keep && sb == drop) || (sa == drop && sb == keep) {
+            push(pool, cut_point(a, b, va, vb));
+        }
+    }
+    while pool.len() > start + 1 && pool[start] == pool[pool.len() - 1] {
+        pool.pop();
+    }
+    if pool.len() - start < 3 {
+        pool.truncate(start);
+        return None;
+    }
+    Some((start as u32, (pool.len() - start) as u32))
+}
+
+/// The point where the edge `a -> b` crosses a plane, from the plane's values `va`, `vb` at its
+/// ends (of opposite certified signs), clamped to the edge. Both parts of a split compute it
+/// the same way, so they share it bit for bit.
+#[inline]
+fn cut_point(a: DVec3, b: DVec3, va: f64, vb: f64) -> DVec3 {
+    let den = va - vb;
+    let t = if den != 0.0 && (va / den).is_finite() {
+        (va / den).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    a + (b - a) * t
+}
+
 /// Seed 002 Alg. 1 `BSP_query`: appends to `out` the fragments of `poly` (a convex polygon on
 /// the tree's light, in the tree's coordinates) that the point `x` sees, growing the tree where
 /// it is undefined. Stops with [`CapExceeded`] as soon as the tree's size passes `cap` bytes
@@ -130,15 +183,18 @@ fn split(frag: &[DVec3], vals: &[(f64, Sign)]) -> (Option<Fragment>, Option<Frag
 pub(crate) fn query(
     tree: &mut Tree,
     x: DVec3,
-    poly: Fragment,
+    poly: &[DVec3],
     cap: usize,
     out: &mut Vec<Fragment>,
     scratch: &mut Scratch,
 ) -> Result<(), CapExceeded> {
     let mut vals: SmallVec<[(f64, Sign); 8]> = SmallVec::new();
-    scratch.stack.clear();
-    scratch.stack.push((Tree::ROOT, poly));
-    while let Some((mut n, mut frag)) = scratch.stack.pop() {
+    let Scratch { stack, pool } = scratch;
+    stack.clear();
+    pool.clear();
+    pool.extend_from_slice(poly);
+    stack.push((Tree::ROOT, 0, poly.len() as u32));
+    while let Some((mut n, mut s, mut len)) = stack.pop() {
         loop {
             match *tree.node(n) {
                 Node::Inner {
@@ -150,18 +206,19 @@ pub(crate) fn query(
                 } => {
                     let (ha, hb) = tree.occluder(occ).edge(edge);
                     let or = Orienter::new(ha, hb, x);
-                    match classify(&or, &frag, &mut vals) {
+                    let frag = &pool[s as usize..(s + len) as usize];
+                    match classify(&or, frag, &mut vals) {
                         Class::Pos => n = pos,
                         Class::Neg => n = neg,
                         Class::Zero => n = if zero_pos { pos } else { neg },
                         Class::Split => {
-                            let (p, m) = split(&frag, &vals);
-                            if let Some(m) = m {
-                                scratch.stack.push((neg, m));
+                            let (su, lu) = (s as usize, len as usize);
+                            if let Some((ms, ml)) = split_part(pool, su, lu, &vals, false) {
+                                stack.push((neg, ms, ml));
                             }
-                            match p {
-                                Some(p) => {
-                                    frag = p;
+                            match split_part(pool, su, lu, &vals, true) {
+                                Some((ps, pl)) => {
+                                    (s, len) = (ps, pl);
                                     n = pos;
                                 }
                                 None => break,
@@ -170,7 +227,12 @@ pub(crate) fn query(
                     }
                 }
                 Node::Visible => {
-                    out.push(frag);
+                    out.push(
+                        pool[s as usize..(s + len) as usize]
+                            .iter()
+                            .copied()
+                            .collect(),
+                    );
                     break;
                 }
                 Node::Invisible => break,
@@ -314,7 +376,7 @@ pub(crate) fn clip_above(poly: &[DVec3], p0: DVec3, n: DVec3) -> Option<Fragment
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::visibility::plucker::bsp::{Crossing, MAX_OCCLUDER_VERTICES, Occluder};
+    use crate::visibility::plucker::bsp::{Crossing, Occluder};
 
     fn area(poly: &[DVec3]) -> f64 {
         let mut s = DVec3::ZERO;
@@ -325,13 +387,7 @@ mod tests {
     }
 
     fn occluder(v: &[DVec3], crossing: Crossing) -> Occluder {
-        let mut verts = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
-        verts[..v.len()].copy_from_slice(v);
-        Occluder {
-            verts,
-            len: v.len() as u8,
-            crossing,
-        }
+        Occluder::new(v, crossing)
     }
 
     /// The 3D area of what `x` sees of `light` past the occluder `occ`.
@@ -341,7 +397,7 @@ mod tests {
         query(
             &mut tree,
             x,
-            light.iter().copied().collect(),
+            light,
             usize::MAX,
             &mut out,
             &mut Scratch::default(),

@@ -391,13 +391,7 @@ pub(crate) fn build_group_tree<'m>(
             (true, true) => Crossing::Both,
             (false, false) => continue,
         };
-        let mut verts = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
-        verts[..cut.len()].copy_from_slice(&cut);
-        occluders.push(Occluder {
-            verts,
-            len: cut.len() as u8,
-            crossing,
-        });
+        occluders.push(Occluder::new(&cut, crossing));
         if near_somewhere {
             near.push((bt.owner, bt.tri));
         }
