@@ -710,3 +710,51 @@ fn invalid_arguments_are_errors() {
     other.visible_region_in(&mut ctx, 0, &f).unwrap();
     assert_eq!(ctx.stats().queries, 1);
 }
+
+#[test]
+fn a_point_a_hair_above_a_self_hiding_light_sees_what_the_clipping_backend_sees() {
+    // Found by fuzz/fuzz_targets/visibility_backends.rs: a two-sheet mesh light (a quad facing
+    // down over one facing up, 10.75 below), shaded from a corner of the upper sheet, 6e-8 above
+    // its plane and so behind it: the upper sheet hides all of the lower one. A context's
+    // shared tile tree (built at the tile's centre, about a normal that is not the sheet's)
+    // left a 9.3e-9 sr sliver of the lower sheet visible; the per-call tree and the clipping
+    // backend see nothing. Points that close to a blocker's plane now get a tree of their own.
+    // Offsets from 2^-14 to 2^-34 above the corner, every cell size of the fuzz target's range.
+    let c = DVec3::new(85.0, -86.0, 6.0) / 8.0;
+    let d = DVec3::new(0.0, 42.0, -86.0) / 8.0;
+    let h = 21.0 / 16.0;
+    let sheets = TriangleMesh::quad(c, DVec3::Y * h, DVec3::X * h)
+        .unwrap()
+        .merged(&TriangleMesh::quad(c + d, DVec3::X * h, DVec3::Y * h).unwrap())
+        .unwrap();
+    let scene = Scene::new(vec![light(sheets, DVec3::ONE)], vec![])
+        .unwrap()
+        .with_method(Method::PerTriangle);
+    let clip = scene.visibility();
+    let pl = PluckerVisibility::from_clip(clip.clone());
+    let corner = DVec3::new(11.9375, -12.0625, 0.75);
+    let n = DVec3::new(0.6707484193111499, 0.6707484193111499, 0.31653296192211566);
+    let v = DVec3::new(-0.1414213562373094, -0.9899494936611666, 0.0);
+    let sa = |p: Vec<SphericalPolygon>| p.iter().map(SphericalPolygon::solid_angle).sum::<f64>();
+    let mut checked = 0;
+    for k in 14..=34 {
+        let x = corner + DVec3::Z * (-f64::from(k)).exp2();
+        let f = ShadingFrame::new(x, n, v).unwrap();
+        let reference = sa(clip.visible_region(0, &f).unwrap());
+        let single = sa(pl.visible_region(0, &f).unwrap());
+        assert!(
+            (single - reference).abs() <= 1e-12,
+            "2^-{k}: per call {single}, clip {reference}"
+        );
+        for cell in [1.0 / 32.0, 0.25, 1.0, 2.0] {
+            let mut ctx = PluckerContext::new(cell).unwrap();
+            let shared = sa(pl.visible_region_in(&mut ctx, 0, &f).unwrap());
+            assert!(
+                (shared - reference).abs() <= 1e-12,
+                "2^-{k}, cell {cell}: context {shared}, clip {reference}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 84);
+}

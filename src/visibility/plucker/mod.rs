@@ -440,14 +440,11 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
         let Slot::Built(built) = &mut tile.slots[g] else {
             return Ok(Status::Done);
         };
-        let GroupTree { tree, near } = &mut **built;
-        if near
-            .iter()
-            .any(|&(b, t)| face_side(self.mesh_of(b), t as usize, x) == Side::On)
-        {
+        if built.excludes(x, &|b| self.mesh_of(b)) {
             stats.edge_on_fallbacks += 1;
             return Ok(Status::Fallback);
         }
+        let tree = &mut built.tree;
         if !*reuse {
             tree.reset();
         }
@@ -459,8 +456,8 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             ws.frags.clear();
             let mut result = Ok(());
             for poly in polys {
-                let local: Fragment = poly.iter().map(|&p| p - origin).collect();
-                if let Some(frag) = clip_above(&local, xl, n) {
+                let local: Fragment = poly.iter().map(|&p| p - x).collect();
+                if let Some(frag) = clip_above(&local, DVec3::ZERO, n) {
                     result = query(tree, xl, &frag, *budget, &mut ws.frags, &mut ws.scratch);
                     if result.is_err() {
                         break;
@@ -486,7 +483,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
         }
         stats.fragments += ws.frags.len() as u64;
         for frag in &ws.frags {
-            push_piece(out, frag, xl, frame)?;
+            push_piece(out, frag, DVec3::ZERO, frame)?;
         }
         Ok(Status::Done)
     }
@@ -701,8 +698,8 @@ pub struct PluckerStats {
     pub tree_resets: u64,
     /// Queries answered by the clipping backend: one query alone outgrew the budget.
     pub clip_fallbacks: u64,
-    /// Queries from a point that sees a blocker of its tile edge-on, answered by a tree of
-    /// their own.
+    /// Queries from a point that sees a blocker of its tile edge-on or lies within `1e-5` of
+    /// the coordinates' magnitude of its plane, answered by a tree of their own.
     pub edge_on_fallbacks: u64,
     /// Visible fragments returned.
     pub fragments: u64,
@@ -771,10 +768,11 @@ impl Tile {
 ///
 /// A receiver cell is a square of side `cell_size` in the plane through the shading point with
 /// the frame's normal, on a grid fixed by that normal; queries share a cell when their normals
-/// are bitwise equal (points of one flat receiver) and their offsets along it agree to
-/// `1e-12` of their scale. Smaller cells cull more occluders per tree, larger ones let more
-/// queries reuse one tree. A context follows one backend at a time (it clears itself when used
-/// with another).
+/// are bitwise equal (points of one flat receiver) and their offsets along it agree to `1e-14`
+/// of their coordinates' magnitude plus the cell size. Smaller cells cull more occluders per
+/// tree, larger ones let more queries reuse one tree. Points within `1e-5` of that magnitude
+/// of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`). A context follows
+/// one backend at a time (it clears itself when used with another).
 ///
 /// The budget bounds the bytes of all cached trees: least recently used tiles are dropped to
 /// stay within it, a tree that alone outgrows it is reset, and a query that alone outgrows it
@@ -873,7 +871,9 @@ impl PluckerContext {
         let (u, v) = (t.dot(x), b.dot(x));
         let cell = (floor(u / s) as i64, floor(v / s) as i64);
         let offset = n.dot(x);
-        let tol = 1e-12 * (x.abs().max_element() + s);
+        // Far below the near band of `tile.rs` (`NEAR_BAND`), whose error bound assumes it;
+        // far above the rounding of points computed on one receiver plane.
+        let tol = 1e-14 * (x.abs().max_element() + s);
         if let Some(i) = self.tiles.iter().position(|tl| {
             tl.light == light
                 && tl.cell == cell

@@ -165,20 +165,33 @@ fn split_part(
 /// The point where the edge `a -> b` crosses a plane, from the plane's values `va`, `vb` at its
 /// ends (of opposite certified signs), clamped to the edge. Both parts of a split compute it
 /// the same way, so they share it bit for bit.
+///
+/// It is interpolated from the end nearer the plane: its error is then the rounding of that
+/// end's offset, not of the whole edge's, which matters when the plane passes a hair from a
+/// vertex (a blocker cut by the tangent plane of a point `1e-6` from it: from the far end, the
+/// cut edge sat `1e-16` off the plane and left a `1e-10` rad horizon sliver unblocked).
 #[inline]
 fn cut_point(a: DVec3, b: DVec3, va: f64, vb: f64) -> DVec3 {
-    let den = va - vb;
-    let t = if den != 0.0 && (va / den).is_finite() {
-        (va / den).clamp(0.0, 1.0)
+    let (near, far, vn, vf) = if va.abs() <= vb.abs() {
+        (a, b, va, vb)
+    } else {
+        (b, a, vb, va)
+    };
+    let den = vn - vf;
+    let t = if den != 0.0 && (vn / den).is_finite() {
+        (vn / den).clamp(0.0, 1.0)
     } else {
         0.5
     };
-    a + (b - a) * t
+    near + (far - near) * t
 }
 
 /// Seed 002 Alg. 1 `BSP_query`: appends to `out` the fragments of `poly` (a convex polygon on
-/// the tree's light, in the tree's coordinates) that the point `x` sees, growing the tree where
-/// it is undefined. Stops with [`CapExceeded`] as soon as the tree's size passes `cap` bytes
+/// the tree's light, relative to the point: `p - x` in world coordinates) that the point `x`
+/// (in the tree's coordinates) sees, growing the tree where it is undefined. Fragments are
+/// relative to the point too, so they are the same numbers whatever the tree's origin: the
+/// point's tangent-plane cut and the directions of light points very close to it (a point
+/// within a few `1e-11` of a face plane) do not pick up the rounding of the tile's offset. Stops with [`CapExceeded`] as soon as the tree's size passes `cap` bytes
 /// (the tree is then valid but larger; the caller resets it).
 pub(crate) fn query(
     tree: &mut Tree,
@@ -205,7 +218,9 @@ pub(crate) fn query(
                     zero_pos,
                 } => {
                     let (ha, hb) = tree.occluder(occ).edge(edge);
-                    let or = Orienter::new(ha, hb, x);
+                    // The fragment is relative to the point: the node's line is moved there
+                    // instead, so that light points close to the point keep their precision.
+                    let or = Orienter::new(ha - x, hb - x, DVec3::ZERO);
                     let frag = &pool[s as usize..(s + len) as usize];
                     match classify(&or, frag, &mut vals) {
                         Class::Pos => n = pos,
@@ -394,10 +409,11 @@ mod tests {
     fn seen(x: DVec3, light: &[DVec3], occ: Occluder) -> f64 {
         let mut tree = Tree::new(&[x], light, alloc::vec![occ], 7);
         let mut out = Vec::new();
+        let relative: Vec<DVec3> = light.iter().map(|&p| p - x).collect();
         query(
             &mut tree,
             x,
-            light,
+            &relative,
             usize::MAX,
             &mut out,
             &mut Scratch::default(),

@@ -17,8 +17,9 @@
 //!
 //! A blocker triangle whose plane passes through the point within the facing tolerance is seen
 //! edge-on and hides nothing (as in the clipping backend). Triangles edge-on from every point of
-//! the tile are dropped; those edge-on from some points only are listed as `near`, and a query
-//! from a point that sees one of them edge-on does not use the shared tree.
+//! the tile are dropped; those edge-on from some points, or whose plane passes within
+//! [`NEAR_BAND`] of the tile, are listed as `near`, and a query from a point that sees one of
+//! them edge-on, or lies that close to its plane, does not use the shared tree.
 
 use alloc::vec::Vec;
 
@@ -280,11 +281,51 @@ pub(crate) struct TileGeometry {
     pub(crate) cell: SmallVec<[DVec3; 4]>,
 }
 
-/// A tree with the blocker triangles that some points of its tile see edge-on.
+/// Relative half-width of the band about a blocker's plane in which a point does not use its
+/// tile's shared tree: `1e-5` of the tile's coordinate magnitude plus its size.
+///
+/// A shared tree is exact for points on its tile plane, in coordinates centred on the tile.
+/// A point of the tile differs from that by the rounding of its world coordinates (about
+/// `1e-16` of their magnitude `|x|`) and by the offset the tile accepts between its plane and
+/// the point (`1e-14 (|x| + size)`, `PluckerContext`). Seen from a point at distance `d` from a
+/// blocker, a blocker cut or placed that much off moves its shadow's edge by that over `d`
+/// radians; outside the band (`d` above `1e-5 (|x| + size)`) that is below `1e-9`. Points in
+/// the band get a tree of their own, centred on them, which has no such term.
+pub(crate) const NEAR_BAND: f64 = 1e-5;
+
+/// A blocker triangle whose plane passes through, or within [`NEAR_BAND`] of, a tile.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Near {
+    pub(crate) owner: Blocker,
+    pub(crate) tri: u32,
+    /// The plane: unit normal and offset (`n . p = d` on it).
+    n: DVec3,
+    d: f64,
+}
+
+/// A tree with the blocker triangles whose planes pass through or close to its tile, and the
+/// half-width of that band.
 #[derive(Debug, Clone)]
 pub(crate) struct GroupTree {
     pub(crate) tree: Tree,
-    pub(crate) near: Vec<(Blocker, u32)>,
+    near: Vec<Near>,
+    band: f64,
+}
+
+impl GroupTree {
+    /// Whether the point `x` must not use the shared tree: it sees a blocker of the tile edge-on
+    /// (by the facing predicate, as the clipping backend), or lies within the band of one's
+    /// plane.
+    pub(crate) fn excludes<'m>(
+        &self,
+        x: DVec3,
+        mesh_of: &dyn Fn(Blocker) -> &'m TriangleMesh,
+    ) -> bool {
+        self.near.iter().any(|b| {
+            (b.n.dot(x) - b.d).abs() <= self.band
+                || face_side(mesh_of(b.owner), b.tri as usize, x) == Side::On
+        })
+    }
 }
 
 /// What a tree is built from besides the tile: the light's faces that share one plane (the
@@ -328,6 +369,17 @@ pub(crate) fn build_group_tree<'m>(
         return None;
     }
     let cell_local: SmallVec<[DVec3; 4]> = tile.cell.iter().map(|&c| c - o).collect();
+    let size = tile
+        .cell
+        .iter()
+        .flat_map(|&a| tile.cell.iter().map(move |&b| (a - b).length()))
+        .fold(0.0, f64::max);
+    let magnitude = tile
+        .cell
+        .iter()
+        .map(|c| c.abs().max_element())
+        .fold(0.0, f64::max);
+    let band = NEAR_BAND * (magnitude + size);
     let mut planes = Vec::new();
     shaft_planes(&cell_local, &light, &mut planes);
     for p in &mut planes {
@@ -360,7 +412,17 @@ pub(crate) fn build_group_tree<'m>(
         if !front && !behind {
             continue;
         }
-        let near_somewhere = on || (front && behind);
+        // The plane's distance is affine over the (convex) cell: its extremes are at corners.
+        let tn = owner_mesh.triangle_normal(bt.tri as usize);
+        let td = tn.dot(bt.v[0]);
+        let (lo, hi) = tile
+            .cell
+            .iter()
+            .map(|&c| tn.dot(c) - td)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                (l.min(v), h.max(v))
+            });
+        let near_somewhere = on || (front && behind) || (lo <= band && hi >= -band);
         let local = bt.v.map(|v| v - o);
         let vals: SmallVec<[(f64, Sign); 8]> = df.iter().map(|&d| (d, Sign::of(d))).collect();
         let Some(cut) = keep_positive(&local, &vals) else {
@@ -393,11 +455,17 @@ pub(crate) fn build_group_tree<'m>(
         };
         occluders.push(Occluder::new(&cut, crossing));
         if near_somewhere {
-            near.push((bt.owner, bt.tri));
+            near.push(Near {
+                owner: bt.owner,
+                tri: bt.tri,
+                n: tn,
+                d: td,
+            });
         }
     }
     Some(GroupTree {
         tree: Tree::new(&cell_local, &light, occluders, seed),
         near,
+        band,
     })
 }
