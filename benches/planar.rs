@@ -12,21 +12,32 @@
 //!   converts to its C++ core in every call);
 //! - `geo`: `BooleanOps` on `Polygon<f64>` (backed by i_overlay).
 //!
+//! Groups `planar/resolve/{star,valid}` turn raw rings into shapes under the non-zero rule, for
+//! 16 to 1024 vertices:
+//!
+//! - `star`: one self-intersecting star ring (`support::planar::self_intersecting_star`: every spike's edges cross
+//!   the neighbouring spikes', about two crossings per vertex); `arealight` is
+//!   `Shape::with_fill_rule`, `i_overlay` is `simplify_shape` (default i32 grid), `clipper2` is
+//!   the union of the ring as the only subject (`Paths<Fine>`, 2^-30 grid, built per call);
+//! - `valid`: the simple star of the boolean groups, which needs no resolving: `with_fill_rule`
+//!   against `Shape::new` (the strict constructor) and the same references.
+//!
 //! Run: `cargo bench --bench planar`; results are summarized in BENCHMARKS.md.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 // The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
-#[path = "../tests/planar_support/mod.rs"]
-mod planar_support;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use arealight::glam::DVec2;
-use arealight::planar::{BoolOp, Shape, boolean};
+use arealight::planar::{BoolOp, FillRule as Rule, Shape, boolean};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use geo::BooleanOps;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::float::simplify::SimplifyShape;
 use i_overlay::float::single::SingleFloatOverlay;
 
 fn bench(c: &mut Criterion) {
@@ -43,8 +54,8 @@ fn bench(c: &mut Criterion) {
                 .warm_up_time(Duration::from_millis(300))
                 .measurement_time(Duration::from_millis(1200));
             for n in [4usize, 8, 16, 64] {
-                let pa = planar_support::bench_polygon(n, DVec2::ZERO, 0.0, star);
-                let pb = planar_support::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+                let pa = support::planar::bench_polygon(n, DVec2::ZERO, 0.0, star);
+                let pb = support::planar::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
                 let sa = Shape::new(vec![pa.clone()]).unwrap();
                 let sb = Shape::new(vec![pb.clone()]).unwrap();
                 g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {
@@ -95,5 +106,49 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+fn bench_resolve(c: &mut Criterion) {
+    for star in [true, false] {
+        let mut g = c.benchmark_group(format!(
+            "planar/resolve/{}",
+            if star { "star" } else { "valid" }
+        ));
+        g.sample_size(20)
+            .warm_up_time(Duration::from_millis(300))
+            .measurement_time(Duration::from_millis(1500));
+        for n in [16usize, 64, 256, 1024] {
+            let ring = if star {
+                support::planar::self_intersecting_star(n)
+            } else {
+                support::planar::bench_polygon(n, DVec2::ZERO, 0.0, true)
+            };
+            g.bench_with_input(BenchmarkId::new("arealight", n), &n, |bch, _| {
+                bch.iter(|| {
+                    Shape::with_fill_rule(vec![black_box(&ring).clone()], Rule::NonZero).unwrap()
+                })
+            });
+            if !star {
+                g.bench_with_input(BenchmarkId::new("arealight-strict", n), &n, |bch, _| {
+                    bch.iter(|| Shape::new(vec![black_box(&ring).clone()]).unwrap())
+                });
+            }
+            let ir: Vec<[f64; 2]> = ring.iter().map(|p| [p.x, p.y]).collect();
+            g.bench_with_input(BenchmarkId::new("i_overlay", n), &n, |bch, _| {
+                bch.iter(|| black_box(&ir).simplify_shape(FillRule::NonZero))
+            });
+            let cr: Vec<(f64, f64)> = ring.iter().map(|p| (p.x, p.y)).collect();
+            g.bench_with_input(BenchmarkId::new("clipper2", n), &n, |bch, _| {
+                bch.iter(|| {
+                    let subject: clipper2::Paths<support::planar::Fine> =
+                        vec![black_box(&cr).clone()].into();
+                    let none: clipper2::Paths<support::planar::Fine> =
+                        Vec::<Vec<(f64, f64)>>::new().into();
+                    clipper2::union(subject, none, clipper2::FillRule::NonZero).unwrap()
+                })
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench, bench_resolve);
 criterion_main!(benches);

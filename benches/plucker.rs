@@ -29,13 +29,17 @@
 //! On a loaded machine, count instructions of one pass instead (see `one_pass`).
 
 use arealight::glam::DVec3;
-use arealight::internals::Pcg32;
 use arealight::shade::{Body, ConvexPolyhedron, Light, Scene, ShadingFrame, TriangleMesh};
 use arealight::visibility::Visibility;
 use arealight::visibility::plucker::{PluckerContext, PluckerVisibility};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use std::hint::black_box;
 use std::time::Duration;
+
+#[path = "../tests/support/mod.rs"]
+mod support;
+
+use support::Rng;
 
 /// Tiles per iteration and queries per tile.
 const TILES: usize = 4;
@@ -72,12 +76,12 @@ fn penumbra(pl: &PluckerVisibility<Light>, f: &ShadingFrame) -> bool {
 
 fn terrain(m: usize) -> Case {
     let (s, step) = (4.0, 8.0 / m as f64);
-    let mut rng = Pcg32::new(11, 2);
+    let mut rng = Rng::new(11);
     let mut z = vec![0.0; (m + 1) * (m + 1)];
     for (k, h) in z.iter_mut().enumerate() {
         let (i, j) = (k / (m + 1), k % (m + 1));
         let (x, y) = (-s + i as f64 * step, -s + j as f64 * step);
-        *h = height(x, y, 0.3 * step * (rng.next_f64() - 0.5));
+        *h = height(x, y, 0.3 * step * (rng.f64() - 0.5));
     }
     let p = |i: usize, j: usize| {
         DVec3::new(
@@ -122,10 +126,10 @@ fn terrain(m: usize) -> Case {
     .unwrap();
     let pl = PluckerVisibility::from_clip(scene.visibility().clone());
     let mut frames = Vec::new();
-    let mut rng = Pcg32::new(7, 1);
+    let mut rng = Rng::new(7);
     let mut tries = 0;
     while frames.len() < TILES * PER_TILE {
-        let (n, [a, b, c]) = tris[(rng.next_u32() as usize) % tris.len()];
+        let (n, [a, b, c]) = tris[rng.below(tris.len())];
         let centre = (a + b + c) / 3.0;
         let near = 1.5 + step;
         if centre.x.abs() > near || centre.y.abs() > near || (light_centre - a).dot(n) <= 0.0 {
@@ -136,7 +140,7 @@ fn terrain(m: usize) -> Case {
             continue;
         }
         for _ in 0..PER_TILE {
-            let (mut u, mut w) = (rng.next_f64(), rng.next_f64());
+            let (mut u, mut w) = (rng.f64(), rng.f64());
             if u + w > 1.0 {
                 (u, w) = (1.0 - u, 1.0 - w);
             }
@@ -153,7 +157,7 @@ fn terrain(m: usize) -> Case {
 
 fn boxes(g: usize) -> Case {
     let (s, cell) = (4.0, 8.0 / g as f64);
-    let mut rng = Pcg32::new(5, 3);
+    let mut rng = Rng::new(5);
     let mut bodies = Vec::new();
     let mut feet = Vec::new();
     for i in 0..g {
@@ -164,9 +168,9 @@ fn boxes(g: usize) -> Case {
                 0.0,
             );
             let h = DVec3::new(
-                cell * (0.1 + 0.25 * rng.next_f64()),
-                cell * (0.1 + 0.25 * rng.next_f64()),
-                (cell * (0.2 + 0.6 * rng.next_f64())).min(0.8),
+                cell * (0.1 + 0.25 * rng.f64()),
+                cell * (0.1 + 0.25 * rng.f64()),
+                (cell * (0.2 + 0.6 * rng.f64())).min(0.8),
             );
             let at = c + DVec3::new(0.0, 0.0, h.z);
             feet.push((at, h));
@@ -184,11 +188,11 @@ fn boxes(g: usize) -> Case {
     // in scanline order, none under a box.
     let t = 0.0625;
     let mut frames = Vec::new();
-    let mut rng = Pcg32::new(7, 1);
+    let mut rng = Rng::new(7);
     let side = (PER_TILE as f64).sqrt() as usize;
     let mut tries = 0;
     while frames.len() < TILES * PER_TILE {
-        let c = DVec3::new(rng.next_f64() * 7.0 - 3.5, rng.next_f64() * 7.0 - 3.5, 0.0);
+        let c = DVec3::new(rng.f64() * 7.0 - 3.5, rng.f64() * 7.0 - 3.5, 0.0);
         let c = (c / t).floor() * t;
         let tile: Vec<ShadingFrame> = (0..PER_TILE)
             .map(|k| {

@@ -1,8 +1,8 @@
 //! Spherical primitives: solid angle of an 8-gon, hemisphere clip of an 8-gon, ordering of 12
 //! silhouette edges. Fixed inputs; results in BENCHMARKS.md.
 
-#[path = "../tests/common/mod.rs"]
-mod common;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use arealight::glam::DVec3;
 use arealight::internals::convex_silhouette;
@@ -76,7 +76,7 @@ fn visibility(c: &mut Criterion) {
                 .unwrap()
         })
     });
-    let (v, faces) = common::icosphere(DVec3::new(0.3, 0.2, 1.5), 0.4);
+    let (v, faces) = support::sphere::icosphere(DVec3::new(0.3, 0.2, 1.5), 0.4);
     let tris: Vec<SphericalPolygon> = faces
         .iter()
         .map(|f| {

@@ -7,8 +7,8 @@
 //! `star`. Inputs are those of `benches/planar.rs`.
 
 // The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
-#[path = "../tests/planar_support/mod.rs"]
-mod planar_support;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use std::hint::black_box;
 
@@ -32,8 +32,8 @@ fn main() {
     let star = args[2] == "star";
     let n: usize = args[3].parse().expect("N");
     let iters: usize = args[4].parse().expect("ITERS");
-    let pa = planar_support::bench_polygon(n, DVec2::ZERO, 0.0, star);
-    let pb = planar_support::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
+    let pa = support::planar::bench_polygon(n, DVec2::ZERO, 0.0, star);
+    let pb = support::planar::bench_polygon(n, DVec2::new(0.37, 0.21), 0.13, star);
     match args[0].as_str() {
         "arealight" => {
             let sa = Shape::new(vec![pa]).unwrap();

@@ -101,6 +101,18 @@ pub enum GeomError {
         /// The largest supported magnitude.
         limit: f64,
     },
+    /// A coordinate of a vertex lies outside the supported range; the message names the vertex
+    /// and the range.
+    CoordinateOutOfRange {
+        /// Index of the ring in the input.
+        ring: usize,
+        /// Index of the vertex within the ring.
+        vertex: usize,
+        /// The offending magnitude.
+        value: f64,
+        /// The largest supported magnitude.
+        limit: f64,
+    },
     /// Silhouette edges do not close into loops: an endpoint is used by only one edge.
     OpenChain {
         /// Index (in the input slice) of an edge whose end has no successor.
@@ -148,6 +160,22 @@ pub enum GeomError {
         face: usize,
         /// Index of the vertex in front of it.
         vertex: usize,
+    },
+    /// (solid) A mesh that must bound a solid has two triangles that cross, overlap or touch
+    /// anywhere but along an edge or at a vertex they share as neighbours on the surface.
+    SelfIntersectingMesh {
+        /// Index of the first triangle.
+        triangle: usize,
+        /// Index of the second triangle.
+        other: usize,
+    },
+    /// (solid) A mesh that must bound a solid has a vertex whose triangles form more than one
+    /// fan (two parts of the surface touch at the vertex, as two cones tip to tip).
+    NonManifoldVertex {
+        /// Index of the vertex.
+        vertex: usize,
+        /// Index of a triangle of a second fan at that vertex.
+        triangle: usize,
     },
 }
 
@@ -207,6 +235,16 @@ impl fmt::Display for GeomError {
                 f,
                 "{what} is {value:e}, outside the supported range (magnitude at most {limit:e})"
             ),
+            GeomError::CoordinateOutOfRange {
+                ring,
+                vertex,
+                value,
+                limit,
+            } => write!(
+                f,
+                "a coordinate of vertex {vertex} in ring {ring} has magnitude {value:e}, outside \
+                 the supported range (at most {limit:e}); scale the input down"
+            ),
             GeomError::OpenChain { edge } => write!(
                 f,
                 "edge {edge} ends where no other edge starts; silhouette edges must form closed loops"
@@ -236,7 +274,19 @@ impl fmt::Display for GeomError {
             GeomError::OpenMesh { triangle } => write!(
                 f,
                 "triangle {triangle} has an edge not shared by exactly one other triangle running \
-                 the opposite way; a convex polyhedron must be a closed, consistently oriented mesh"
+                 the opposite way; a convex polyhedron or a solid must be a closed, consistently \
+                 oriented mesh"
+            ),
+            GeomError::SelfIntersectingMesh { triangle, other } => write!(
+                f,
+                "triangles {triangle} and {other} cross or touch away from a shared edge or \
+                 vertex: the mesh does not bound a solid; fix the mesh or use it per triangle"
+            ),
+            GeomError::NonManifoldVertex { vertex, triangle } => write!(
+                f,
+                "vertex {vertex} joins separate fans of triangles (triangle {triangle} is in a \
+                 second one): the surface touches itself there; split the vertex or use the mesh \
+                 per triangle"
             ),
             GeomError::NotConvex { face, vertex } => write!(
                 f,

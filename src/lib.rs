@@ -10,6 +10,8 @@
 //! - [`solid`]: 3D geometry without light: triangle meshes, convex polyhedra, silhouettes seen
 //!   from a point.
 //! - [`visibility`]: which part of a light a shading point sees, behind one trait with backends.
+//! - [`sdf`]: signed-distance scenes and approximate area-light soft shadows in them (beside
+//!   the exact shading, for comparison).
 //! - [`shade`]: scenes of lights and occluders, materials, and the radiance at a shading point.
 //!
 //! Scalars are `f64` and vectors are glam's `DVec2`/`DVec3`; glam is re-exported so that callers
@@ -37,6 +39,7 @@ mod error;
 pub mod ltc;
 pub(crate) mod math;
 pub mod planar;
+pub mod sdf;
 pub mod shade;
 pub mod solid;
 pub mod sphere;
@@ -44,8 +47,8 @@ pub mod visibility;
 
 /// Items public only for the crate's own tests, benchmarks, fuzz targets and examples: the
 /// planar fast path and robust pipeline called separately, the planar vertex classes, the demo
-/// scene, the reference's RNG, the silhouette and culling helpers. Not part of the API: they may
-/// change or vanish in any release.
+/// scene, the silhouette and culling helpers. Not part of the API: they may change or vanish in
+/// any release.
 #[doc(hidden)]
 pub mod internals {
     pub use crate::planar::boolean::intersect::MAX_PASSES;
@@ -54,7 +57,7 @@ pub mod internals {
         ContactClasses, boolean_fast, boolean_robust, contact_classes,
     };
     pub use crate::shade::demo::{Demo, DemoConfig, demo_scene};
-    pub use crate::shade::reference::Pcg32;
+    pub use crate::solid::fixtures::{bumpy_sphere, extruded_star, thesis_polyhedra, torus};
     pub use crate::solid::silhouette::{TriangleRole, convex_silhouette, triangle_polygon};
     pub use crate::visibility::cull::{above_horizon, may_occlude};
 }

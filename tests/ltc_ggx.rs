@@ -1,10 +1,11 @@
 //! GGX BRDF and visible-normal sampler: energy, reciprocity, sampler density.
 
-mod ltc_common;
+mod support;
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::{ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight};
-use ltc_common::{Rng, histogram_sigma, sphere_quad, view};
+use support::Rng;
+use support::ltc::{histogram_sigma, sphere_quad, view};
 
 fn mirror(v: DVec3) -> DVec3 {
     DVec3::new(-v.x, -v.y, v.z)
@@ -17,7 +18,7 @@ fn albedo_quad(v: DVec3, alpha: f64) -> f64 {
 
 #[test]
 fn albedo_by_quadrature_is_at_most_one_and_matches_sampler_weights() {
-    let mut rng = Rng(1);
+    let mut rng = Rng::from_state(1);
     for &alpha in &[0.02, 0.1, 0.3, 0.6, 1.0] {
         for &c in &[1.0, 0.8, 0.5, 0.2, 0.05] {
             let v = view(c);
@@ -73,7 +74,7 @@ fn albedo_tends_to_one_for_smooth_surfaces_at_normal_incidence() {
 
 #[test]
 fn brdf_is_reciprocal() {
-    let mut rng = Rng(2);
+    let mut rng = Rng::from_state(2);
     for _ in 0..2000 {
         let dir = |rng: &mut Rng| {
             let z = rng.range(0.01, 1.0);
@@ -125,7 +126,7 @@ fn vndf_pdf_integrates_to_one() {
 fn vndf_samples_follow_the_pdf() {
     // 200k samples in 10 x 12 polar bins about the mirror direction; every bin's frequency must be
     // within 5 binomial standard deviations of its quadrature probability.
-    let mut rng = Rng(3);
+    let mut rng = Rng::from_state(3);
     for &(alpha, c) in &[(0.05, 0.9), (0.3, 0.5), (0.8, 0.15)] {
         let v = view(c);
         let sigma = histogram_sigma(

@@ -1,12 +1,12 @@
 //! GGX shading of random quad lights with the fitted LTC tables, against brute-force integration
 //! of the true BRDF (height-correlated GGX) times the cosine over each quad (issue 5's measure).
 
-mod common;
+mod support;
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::{ggx_polygon_integral, ggx_vndf_weight, lookup};
 use arealight::sphere::SphericalPolygon;
-use common::Rng;
+use support::Rng;
 
 /// A random quad facing the origin: center direction in the upper hemisphere (some below, so
 /// that a fraction crosses the horizon), distance 1, half-sizes 0.1 to 0.8, random spin.

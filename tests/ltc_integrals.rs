@@ -2,17 +2,18 @@
 //! polygons above the horizon, stratified Monte Carlo (with a stated bound) for polygons crossing
 //! it, the signed-integral identity, and the exact-clip vs clip-free agreement.
 
-mod common;
+mod support;
 
 use arealight::glam::DVec3;
 use arealight::ltc::{clamped_cosine_integral, clamped_cosine_integral_clip_free};
 use arealight::sphere::SphericalPolygon;
-use common::{
-    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_integral, polar,
-    star_ring, triangle_quadrature,
-};
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{
+    assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_integral, polar, star_ring,
+    triangle_quadrature,
+};
 
 /// A random valid polygon (star-shaped rings, complements, rings with holes) around a center
 /// whose height above the horizon is drawn too, so that many polygons cross it.
@@ -147,7 +148,7 @@ fn hemisphere_with_hole_at_the_zenith() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(512), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(512), ..ProptestConfig::default() })]
 
     /// The clip-free formula (thesis eq. 4.6/4.7) agrees with exact clipping to 1e-12.
     #[test]
@@ -209,7 +210,7 @@ fn rational_edge_factor_error_is_as_documented() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     /// The rational variant stays within its documented error of the exact integral.
     #[test]
@@ -251,7 +252,7 @@ proptest! {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(512), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(512), ..ProptestConfig::default() })]
 
     /// Matrices of the fitted tables' form (`y` unchanged), which take their own transform path,
     /// agree with transform + exact clip too.

@@ -1,13 +1,14 @@
 //! The shipped GGX LTC table: lookup semantics and fit quality against the real BRDF.
 
-mod ltc_common;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::{LtcLookup, LtcTable, ggx_brdf_cos, ggx_sample_vndf, ggx_vndf_pdf, lookup};
-use ltc_common::{Rng, sphere_quad, view};
+use support::Rng;
+use support::ltc::{sphere_quad, view};
 
-fn channels(l: &LtcLookup) -> [f64; 7] {
+fn channels(l: &LtcLookup) -> [f64; 8] {
     [
         l.m_inv.x_axis.x,
         l.m_inv.z_axis.x,
@@ -16,16 +17,17 @@ fn channels(l: &LtcLookup) -> [f64; 7] {
         l.norm,
         l.albedo,
         l.fresnel,
+        l.m_inv.y_axis.y,
     ]
 }
 
 #[test]
 fn lookup_at_nodes_returns_stored_values() {
     let t = LtcTable::ggx();
-    let n = t.size();
-    assert_eq!(n, 64);
-    for k in 0..n {
-        for j in 0..n {
+    let (nv, nr) = (t.view_nodes(), t.roughness_nodes());
+    assert_eq!((nv, nr), (81, 64));
+    for k in 0..nr {
+        for j in 0..nv {
             let (c, a) = t.node(j, k).unwrap();
             let got = channels(&t.lookup(c, a).unwrap());
             let want = channels(&t.node_lookup(j, k).unwrap());
@@ -38,7 +40,7 @@ fn lookup_at_nodes_returns_stored_values() {
             }
         }
     }
-    assert!(t.node(n, 0).is_none() && t.node_lookup(0, n).is_none());
+    assert!(t.node(nv, 0).is_none() && t.node_lookup(0, nr).is_none());
 }
 
 #[test]
@@ -46,7 +48,7 @@ fn shortcut_lookup_agrees_with_the_table_method() {
     // `lookup` runs the same interpolation with the committed grid's constants folded in; it must
     // give the very same bits, at nodes, between them, at the ends and outside the ranges.
     let t = LtcTable::ggx();
-    let mut rng = Rng(21);
+    let mut rng = Rng::from_state(21);
     let mut inputs = vec![
         (1.0, 1.0),
         (0.0, 0.0),
@@ -57,9 +59,9 @@ fn shortcut_lookup_agrees_with_the_table_method() {
         (t.cos_min(), t.alpha_min()),
         (1.0 - 1e-17, 1e-300),
     ];
-    for k in 0..t.size() {
+    for k in 0..t.roughness_nodes() {
         inputs.push(t.node(k, k).unwrap());
-        inputs.push(t.node(t.size() - 1 - k, k).unwrap());
+        inputs.push(t.node(t.view_nodes() - 1 - k, k).unwrap());
     }
     for _ in 0..2000 {
         inputs.push((rng.range(-0.1, 1.1), rng.range(-0.1, 1.1)));
@@ -74,10 +76,10 @@ fn shortcut_lookup_agrees_with_the_table_method() {
 #[test]
 fn lookup_is_bilinear_between_nodes() {
     let t = LtcTable::ggx();
-    let mut rng = Rng(20);
+    let mut rng = Rng::from_state(20);
     for _ in 0..300 {
-        let j = (rng.f64() * 63.0) as usize;
-        let k = (rng.f64() * 63.0) as usize;
+        let j = (rng.f64() * (t.view_nodes() - 1) as f64) as usize;
+        let k = (rng.f64() * (t.roughness_nodes() - 1) as f64) as usize;
         let (c0, a0) = t.node(j, k).unwrap();
         let (c1, a1) = t.node(j + 1, k + 1).unwrap();
         let c = c0 + (c1 - c0) * rng.f64();
@@ -87,9 +89,11 @@ fn lookup_is_bilinear_between_nodes() {
         let v01 = channels(&t.node_lookup(j, k + 1).unwrap());
         let v11 = channels(&t.node_lookup(j + 1, k + 1).unwrap());
         // Interpolation weights, recovered from 1D lookups along the cell's edges (so the test does
-        // not assume the grid's parameterisation): the weight of the channel that changes most.
-        let weight = |lo: &[f64; 7], hi: &[f64; 7], mid: &[f64; 7]| {
-            let ch = (0..7)
+        // not assume the grid's parameterisation): the weight of the interpolated channel that
+        // changes most.
+        let weight = |lo: &[f64; 8], hi: &[f64; 8], mid: &[f64; 8]| {
+            let ch = (0..8)
+                .filter(|&ch| ch != 4)
                 .max_by(|&x, &y| (hi[x] - lo[x]).abs().total_cmp(&(hi[y] - lo[y]).abs()))
                 .unwrap();
             let w = (mid[ch] - lo[ch]) / (hi[ch] - lo[ch]);
@@ -101,8 +105,10 @@ fn lookup_is_bilinear_between_nodes() {
         };
         let tx = weight(&v00, &v10, &channels(&t.lookup(c, a0).unwrap()));
         let ty = weight(&v00, &v01, &channels(&t.lookup(c0, a).unwrap()));
-        let got = channels(&t.lookup(c, a).unwrap());
-        for ch in 0..7 {
+        let look = t.lookup(c, a).unwrap();
+        let got = channels(&look);
+        // Every channel but `norm` (4), which follows from the interpolated matrix and albedo.
+        for ch in (0..8).filter(|&ch| ch != 4) {
             let want = (v00[ch] * (1.0 - tx) + v10[ch] * tx) * (1.0 - ty)
                 + (v01[ch] * (1.0 - tx) + v11[ch] * tx) * ty;
             assert!(
@@ -111,6 +117,8 @@ fn lookup_is_bilinear_between_nodes() {
                 got[ch]
             );
         }
+        let h = look.ltc().unwrap().upper_hemisphere_mass();
+        assert!((look.norm * h / look.albedo - 1.0).abs() <= 1e-9);
     }
 }
 
@@ -153,8 +161,8 @@ fn out_of_range_inputs_clamp_and_nan_is_an_error() {
 #[test]
 fn every_node_is_a_valid_ltc_with_sane_scalars() {
     let t = LtcTable::ggx();
-    for k in 0..t.size() {
-        for j in 0..t.size() {
+    for k in 0..t.roughness_nodes() {
+        for j in 0..t.view_nodes() {
             let l = t.node_lookup(j, k).unwrap();
             assert!(l.ltc().is_ok(), "node ({j}, {k}) singular");
             assert!(l.albedo > 0.0 && l.albedo <= 1.0, "albedo {}", l.albedo);
@@ -171,7 +179,7 @@ fn every_node_is_a_valid_ltc_with_sane_scalars() {
 
 #[test]
 fn albedo_and_fresnel_match_quadrature() {
-    let mut rng = Rng(21);
+    let mut rng = Rng::from_state(21);
     for _ in 0..12 {
         let c = rng.range(0.05, 1.0);
         let alpha = rng.range(0.05, 1.0).powi(2);
@@ -239,7 +247,7 @@ fn percentile(v: &mut [f64], p: f64) -> f64 {
 
 /// Random points of the range: view 0..85 degrees, alpha = r^2 with r in [0.05, 1].
 fn fit_errors(shift_alpha: f64) -> Vec<f64> {
-    let mut rng = Rng(22);
+    let mut rng = Rng::from_state(22);
     (0..300)
         .map(|_| {
             let c = rng.range(0.0, 85f64.to_radians()).cos();

@@ -1,13 +1,13 @@
 //! Hand-built degenerate configurations with areas known in closed form, input validation, and
 //! the composition stress cases (chains of differences over triangles that share edges).
 
-mod planar_support;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::DVec2;
 use arealight::internals::{VertexClass, contact_classes};
 use arealight::planar::{BoolOp, Shape, boolean};
-use planar_support::*;
+use support::planar::*;
 
 /// Checks validity, identities, and the exact expected areas [A&B, A|B, A-B, A^B].
 fn expect(a: &str, b: &str, areas: [f64; 4]) {

@@ -4,13 +4,14 @@
 //! integer-grid polygons (exact degeneracies), and near-degenerate pairs (vertices a few ulps off
 //! the other operand's edges, near-copies, slightly rotated copies, far from the origin).
 
-mod planar_support;
+mod support;
 
 use arealight::glam::DVec2;
 use arealight::internals::{boolean_fast, boolean_robust};
 use arealight::planar::{BoolOp, Shape, boolean};
-use planar_support::*;
 use proptest::prelude::*;
+use support::Rng;
+use support::planar::*;
 
 /// Runs all four operations both ways; returns how many the fast path took.
 fn agree(a: &Shape, b: &Shape) -> Result<usize, TestCaseError> {
@@ -173,34 +174,21 @@ proptest! {
     }
 }
 
-/// A deterministic xorshift64 generator, for the loops that count how often the fast path runs.
-struct XorShift(u64);
-
-impl XorShift {
-    /// Uniform in `[0, 1)`.
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// A star-shaped ring around `c` with `3 + floor(extra * u)` vertices.
-    fn star(&mut self, c: DVec2, extra: f64) -> Vec<DVec2> {
-        let n = 3 + (self.next() * extra) as usize;
-        let radii: Vec<f64> = (0..n).map(|_| 0.2 + 1.8 * self.next()).collect();
-        star(c, &radii, 6.3 * self.next())
-    }
+/// A star-shaped ring around `c` with `3 + floor(extra * u)` vertices.
+fn random_star(rng: &mut Rng, c: DVec2, extra: f64) -> Vec<DVec2> {
+    let n = 3 + (rng.f64() * extra) as usize;
+    let radii: Vec<f64> = (0..n).map(|_| 0.2 + 1.8 * rng.f64()).collect();
+    star(c, &radii, 6.3 * rng.f64())
 }
 
 /// The fast path is not a dead branch: on random stars in general position it takes most
 /// operations (all but the symmetric difference, which it leaves to the robust path).
 #[test]
 fn fast_path_takes_generic_inputs() {
-    let mut rng = XorShift(0x9E37_79B9_7F4A_7C15u64);
+    let mut rng = Rng::new(1);
     let (mut taken, mut total) = (0, 0);
     for _ in 0..200 {
-        let mut ring = |c: DVec2| rng.star(c, 20.0);
+        let mut ring = |c: DVec2| random_star(&mut rng, c, 20.0);
         let a = Shape::new(vec![ring(DVec2::ZERO)]).unwrap();
         let c = DVec2::new(0.37, -0.21);
         let b = Shape::new(vec![ring(c)]).unwrap();
@@ -345,10 +333,10 @@ fn vertex_on_an_edge_of_its_own_shape_bails_out() {
 /// of these operations.
 #[test]
 fn chained_results_agree() {
-    let mut rng = XorShift(0x2545_F491_4F6C_DD1Du64);
+    let mut rng = Rng::new(2);
     let (mut taken, mut total) = (0, 0);
     for _ in 0..100 {
-        let mut ring = |c: DVec2| rng.star(c, 14.0);
+        let mut ring = |c: DVec2| random_star(&mut rng, c, 14.0);
         let a = Shape::new(vec![ring(DVec2::ZERO)]).unwrap();
         let b = Shape::new(vec![ring(DVec2::new(0.37, -0.21))]).unwrap();
         let c = Shape::new(vec![ring(DVec2::new(-0.3, 0.4))]).unwrap();

@@ -5,13 +5,13 @@
 //! `proptest-regressions/` and each one is also turned into a named test in
 //! `tests/planar_regressions.rs`.
 
-mod planar_support;
+mod support;
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
-use planar_support::*;
 use proptest::prelude::*;
 use proptest::test_runner::FileFailurePersistence;
+use support::planar::*;
 
 /// Relative tolerance against the references (they snap to an integer grid).
 const REF_TOL: f64 = 1e-7;

@@ -2,10 +2,10 @@
 //! records the property that found it and what was wrong, and checks validity and the identities
 //! (plus the chain property where that is what failed).
 
-mod planar_support;
+mod support;
 
 use arealight::planar::{BoolOp, Shape, boolean};
-use planar_support::*;
+use support::planar::*;
 
 fn chain(light: &str, tris: &[&str]) {
     let light = shape(light);

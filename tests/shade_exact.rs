@@ -1,17 +1,21 @@
 //! Exact soft shadows where "light polygon minus every occluder's projection" is wrong: occluders
 //! that straddle a light's plane, lie behind a light or pierce it, lights hiding other lights, and
-//! non-convex (mesh) lights with an occluder between their sheets. Each scene is checked on
+//! non-convex (mesh) lights with an occluder between their sheets, and closed non-convex lights
+//! (a torus, a bowl) shaded from their silhouettes. Each scene is checked on
 //! hundreds of random ground points, for both methods, against the Monte Carlo reference (exact
 //! ray-triangle visibility with the same opacity model: occluders, other lights and a mesh
 //! light's own triangles block).
 //!
+//! A query may give up (`GeomError::Undecidable`, which a renderer answers by falling back) on
+//! at most 1% of a scene's points; every other answer must be right.
+//!
 //! Confidence bound, in the style of tests/shade_mc.rs: with the LTC BRDF the analytic value and
 //! the estimate are the same integral, so per point and channel `|analytic - mc| <= 4.5
 //! sigma_hat + 1e-6`, with `sigma_hat` the estimator's standard error over 2048 samples per
-//! light. The file makes about 9 000 such checks (8 scenes x 900 and 24 random scenes x 75; the
-//! two methods share the estimates), so the per-check level must be a Bonferroni share of the
-//! family's: a normal deviate exceeds 4.5 sigma with probability 6.8e-6, which keeps the chance
-//! of any false alarm in the file near 6%. (At 4 sigma, 6.3e-5 per check, about one false alarm
+//! light. The file makes about 9 600 such checks (8 scenes x 900, one x 600 and 24 random
+//! scenes x 75; the two methods share the estimates), so the per-check level must be a
+//! Bonferroni share of the family's: a normal deviate exceeds 4.5 sigma with probability 6.8e-6,
+//! which keeps the chance of any false alarm in the file near 7%. (At 4 sigma, 6.3e-5 per check, about one false alarm
 //! per run would be expected; one was seen, |z| = 4.05 on one channel, which 400 000 samples at
 //! that point resolved to |z| < 1.3.) A point that fails is estimated once more with 16 times the
 //! samples on an independent stream and must pass the same bound there: points very close to a
@@ -22,12 +26,14 @@
 //!
 //! Every Monte Carlo test here fails with the naive rule (subtract every culled occluder's whole
 //! projection, lights transparent to each other), which is seed 000's Alg. 1 as written.
-//! The eight hand-built scenes also assert that they are scenes where the rule matters, by
+//! The nine hand-built scenes also assert that they are scenes where the rule matters, by
 //! recomputing the naive rule's diffuse integral from the public geometry API and counting the
 //! points where it differs from the new visible region's by more than 2%.
 
-use arealight::glam::DVec3;
-use arealight::internals::{Pcg32, TriangleRole, convex_silhouette, may_occlude, triangle_polygon};
+use arealight::glam::{DMat3, DVec3};
+use arealight::internals::{
+    TriangleRole, convex_silhouette, may_occlude, thesis_polyhedra, torus, triangle_polygon,
+};
 use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::shade::{
@@ -35,7 +41,12 @@ use arealight::shade::{
     ShadingFrame, TriangleMesh,
 };
 use arealight::solid::BoundingSphere;
+use arealight::solid::{ClosedMesh, nonconvex_silhouette};
 use arealight::sphere::SphericalPolygon;
+use support::Rng;
+use support::shade::{ground_point, point_on_mesh};
+
+mod support;
 
 /// The outcome of one scene: points checked, worst |z|, and the MC failures (empty on success).
 struct Report {
@@ -49,12 +60,12 @@ struct Report {
 /// Analytic (`method`) against Monte Carlo on `count` ground points in `[-h, h]^2`.
 fn run(scene: &Scene, method: Method, count: usize, h: f64, seed: u64) -> Report {
     let scene = scene.clone().with_method(method);
-    let mut rng = Pcg32::new(seed, 11);
+    let mut rng = Rng::new(seed * 100 + 11);
     let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
     let mc = MonteCarlo::new(2048, ReferenceBrdf::Ltc);
     let mc16 = MonteCarlo::new(16 * 2048, ReferenceBrdf::Ltc);
     let mut failures = Vec::new();
-    let mut retested = 0;
+    let (mut retested, mut gave_up) = (0, 0);
     let mut worst: f64 = 0.0;
     let (mut zsum, mut zn) = (0.0, 0usize);
     for i in 0..count {
@@ -66,6 +77,15 @@ fn run(scene: &Scene, method: Method, count: usize, h: f64, seed: u64) -> Report
         }
         let a = match scene.shade(x, n, v, &m) {
             Ok(a) => a,
+            // A give-up is a documented answer (the renderer falls back), not a wrong value;
+            // they are counted below and must stay rare. The one these scenes meet is the sphere
+            // layer's horizon clip of an edge within 1e-14 of the horizon (issue 24,
+            // tests/shade_known_failures.rs).
+            Err(e) if e.is_undecidable() => {
+                eprintln!("point {i} x {x}: gave up: {e}");
+                gave_up += 1;
+                continue;
+            }
             Err(e) => {
                 failures.push(format!("point {i} x {x}: error {e}"));
                 continue;
@@ -108,6 +128,9 @@ fn run(scene: &Scene, method: Method, count: usize, h: f64, seed: u64) -> Report
                 a[c], e.mean[c], e.std_error[c], e2.mean[c], e2.std_error[c]
             ));
         }
+    }
+    if gave_up * 100 > count {
+        failures.push(format!("{gave_up} give-ups in {count} points"));
     }
     let zmean = zsum / zn.max(1) as f64;
     if zn > 0 && zmean.abs() > 4.0 / (zn as f64).sqrt() {
@@ -176,14 +199,10 @@ fn exact_rule_diffuse(scene: &Scene, frame: &ShadingFrame) -> f64 {
 /// Asserts that on at least a tenth of `count` random ground points the naive rule is off by more
 /// than 2% (so that the Monte Carlo check below can tell the two apart).
 fn assert_naive_rule_fails(name: &str, scene: &Scene, count: usize, h: f64, seed: u64) {
-    let mut rng = Pcg32::new(seed, 12);
+    let mut rng = Rng::new(seed * 100 + 12);
     let mut differ = 0;
     for _ in 0..count {
-        let x = DVec3::new(
-            h * (2.0 * rng.next_f64() - 1.0),
-            h * (2.0 * rng.next_f64() - 1.0),
-            0.0,
-        );
+        let x = ground_point(&mut rng, h);
         let frame = ShadingFrame::new(x, DVec3::Z, DVec3::Z).unwrap();
         let (old, new) = (
             naive_rule_diffuse(scene, &frame),
@@ -203,28 +222,15 @@ fn assert_naive_rule_fails(name: &str, scene: &Scene, count: usize, h: f64, seed
 /// Shading point `i`: three in four on the ground square `[-h, h]^2` (normal `+z`), every fourth
 /// on an occluder's surface (a random point of a random triangle, with its normal), each with a
 /// random view at least about 17 degrees above the surface.
-fn shading_point(scene: &Scene, rng: &mut Pcg32, i: usize, h: f64) -> (DVec3, DVec3, DVec3) {
+fn shading_point(scene: &Scene, rng: &mut Rng, i: usize, h: f64) -> (DVec3, DVec3, DVec3) {
     let occ = scene.occluders();
     let (x, n) = if i % 4 == 3 && !occ.is_empty() {
-        let mesh = occ[(i / 4) % occ.len()].mesh();
-        let t = ((rng.next_f64() * mesh.triangle_count() as f64) as usize)
-            .min(mesh.triangle_count() - 1);
-        let [a, b, c] = mesh.triangle(t);
-        let (mut u, mut w) = (rng.next_f64(), rng.next_f64());
-        if u + w > 1.0 {
-            (u, w) = (1.0 - u, 1.0 - w);
-        }
-        (a + u * (b - a) + w * (c - a), mesh.triangle_normal(t))
+        point_on_mesh(rng, occ[(i / 4) % occ.len()].mesh())
     } else {
-        let x = DVec3::new(
-            h * (2.0 * rng.next_f64() - 1.0),
-            h * (2.0 * rng.next_f64() - 1.0),
-            0.0,
-        );
-        (x, DVec3::Z)
+        (ground_point(rng, h), DVec3::Z)
     };
     let (t, b) = n.any_orthonormal_pair();
-    let v = n * (0.3 + rng.next_f64()) + t * (rng.next_f64() - 0.5) + b * (rng.next_f64() - 0.5);
+    let v = n * (0.3 + rng.f64()) + t * (rng.f64() - 0.5) + b * (rng.f64() - 0.5);
     (x, n, v)
 }
 
@@ -428,6 +434,85 @@ fn occluder_in_the_gap_of_a_closed_non_convex_light() {
     check("closed two-box light with occluder", &scene, 300, 2.0, 27);
 }
 
+/// `mesh` scaled by `s`, rotated by `rot` and moved to `at`.
+fn moved(mesh: &TriangleMesh, s: f64, rot: DMat3, at: DVec3) -> TriangleMesh {
+    TriangleMesh::new(
+        mesh.vertices()
+            .iter()
+            .map(|&v| rot * (v * s) + at)
+            .collect(),
+        mesh.triangles().to_vec(),
+    )
+    .unwrap()
+}
+
+/// A tilted torus light above a bowl light whose cavity faces the ground, and a box: closed
+/// non-convex lights, which hide parts of themselves and of each other.
+fn non_convex_lights_scene() -> Scene {
+    let torus = moved(
+        &torus(0.6, 0.2, 12, 6).unwrap(),
+        1.0,
+        DMat3::from_rotation_x(0.6),
+        DVec3::new(-0.3, 0.1, 2.9),
+    );
+    let bowl = thesis_polyhedra()
+        .unwrap()
+        .into_iter()
+        .find(|(n, _)| *n == "bowl")
+        .unwrap()
+        .1;
+    let bowl = moved(
+        &bowl,
+        0.4,
+        DMat3::from_rotation_y(2.6),
+        DVec3::new(0.3, -0.2, 1.9),
+    );
+    Scene::new(
+        vec![
+            light(torus, DVec3::new(1.0, 2.0, 3.0)),
+            light(bowl, DVec3::new(2.5, 1.5, 1.0)),
+        ],
+        vec![cuboid(DVec3::new(-1.0, 0.6, 1.2), DVec3::new(0.3, 0.2, 0.25)).into()],
+    )
+    .unwrap()
+}
+
+#[test]
+fn non_convex_lights_are_shaded_from_their_silhouettes() {
+    // The scene shades each closed non-convex light from its silhouette, one polygon: its
+    // region is exactly the silhouette clipped to the upper hemisphere, wherever the silhouette
+    // is decided (checked on the same ground points as below), and it agrees with the Monte
+    // Carlo reference, which sees the lights' self-occlusion by ray casting. The naive rule
+    // fails here because the lights hide parts of each other.
+    let scene = non_convex_lights_scene();
+    let mut rng = Rng::new(2915);
+    let mut from_silhouette = 0;
+    for _ in 0..200 {
+        let x = DVec3::new(4.0 * rng.f64() - 2.0, 4.0 * rng.f64() - 2.0, 0.0);
+        let frame = ShadingFrame::new(x, DVec3::Z, DVec3::new(0.3, 0.1, 1.0)).unwrap();
+        for (i, l) in scene.lights().iter().enumerate() {
+            let Body::Mesh(m) = l.shape() else {
+                panic!("mesh lights")
+            };
+            let solid = ClosedMesh::new(m.clone()).unwrap();
+            let Ok(sil) = nonconvex_silhouette(&solid, &frame) else {
+                continue;
+            };
+            let upper = sil.clip_to_hemisphere(DVec3::Z);
+            let region = scene.light_region(i, &frame).unwrap();
+            let expect: Vec<SphericalPolygon> = if upper.is_empty() {
+                vec![]
+            } else {
+                vec![upper]
+            };
+            assert_eq!(region, expect, "light {i} x {x}");
+            from_silhouette += 1;
+        }
+    }
+    assert!(from_silhouette >= 390, "{from_silhouette}");
+    check("non-convex lights", &scene, 200, 2.0, 29);
+}
+
 #[test]
 fn occluders_touching_lights() {
     // Contacts, where the blocker and the light share points of the light's plane:
@@ -488,40 +573,37 @@ fn shading_never_fails_on_degenerate_points() {
             vec![cuboid(DVec3::new(0.5, 0.0, 2.5), DVec3::new(0.25, 0.25, 0.2)).into()],
         )
         .unwrap(),
+        non_convex_lights_scene(),
     ];
     let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
-    let mut rng = Pcg32::new(77, 13);
-    let dir = |rng: &mut Pcg32| {
-        let z = 2.0 * rng.next_f64() - 1.0;
-        let phi = std::f64::consts::TAU * rng.next_f64();
-        let r = (1.0 - z * z).sqrt();
-        DVec3::new(r * phi.cos(), r * phi.sin(), z)
-    };
+    let mut rng = Rng::new(7713);
     let (mut failures, mut per_tri_errors, mut total) = (Vec::new(), 0, 0);
-    for scene in &scenes {
+    for (k, scene) in scenes.iter().enumerate() {
         let meshes: Vec<&TriangleMesh> = scene
             .occluders()
             .iter()
             .chain(scene.lights().iter().map(|l| l.shape()))
             .map(|s| s.mesh())
             .collect();
-        for i in 0..1500 {
+        // The non-convex lights' degenerate points fall back to unions of front triangles,
+        // which cost more: fewer points there.
+        for i in 0..if k == 2 { 400 } else { 1500 } {
             let mesh = meshes[i % meshes.len()];
-            let t = (rng.next_u32() as usize) % mesh.triangle_count();
+            let t = rng.below(mesh.triangle_count());
             let [a, b, c] = mesh.triangle(t);
             let x = match i % 5 {
                 0 => a,
                 1 => (a + b) / 2.0,
                 // In the triangle's plane, outside it.
-                2 => a + (b - a) * (1.0 + 2.0 * rng.next_f64()) + (c - a) * rng.next_f64(),
+                2 => a + (b - a) * (1.0 + 2.0 * rng.f64()) + (c - a) * rng.f64(),
                 3 => (a + b + c) / 3.0,
                 _ => DVec3::new(
-                    3.0 * rng.next_f64() - 1.5,
-                    3.0 * rng.next_f64() - 1.5,
-                    4.0 * rng.next_f64(),
+                    3.0 * rng.f64() - 1.5,
+                    3.0 * rng.f64() - 1.5,
+                    4.0 * rng.f64(),
                 ),
             };
-            let (n, v) = (dir(&mut rng), dir(&mut rng));
+            let (n, v) = (rng.dir(), rng.dir());
             for method in [Method::Silhouette, Method::PerTriangle] {
                 total += 1;
                 match scene.clone().with_method(method).shade(x, n, v, &m) {
@@ -553,8 +635,8 @@ fn random_scenes_with_interpenetrating_objects() {
     // Random lights (quad, cuboid, icosphere, frustum, two-sheet mesh) with random boxes,
     // icospheres and rods placed so that they often cut through the light, touch it or sit behind
     // it, and a second light nearby: 24 scenes, 25 ground points each.
-    let mut rng = Pcg32::new(31, 14);
-    let mut r = |lo: f64, hi: f64| lo + (hi - lo) * rng.next_f64();
+    let mut rng = Rng::new(3114);
+    let mut r = |lo: f64, hi: f64| rng.range(lo, hi);
     let mut retested = 0;
     for case in 0..24u64 {
         let c = DVec3::new(r(-0.5, 0.5), r(-0.5, 0.5), r(2.0, 3.0));

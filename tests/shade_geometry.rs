@@ -4,32 +4,25 @@
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
-use arealight::internals::{Pcg32, TriangleRole, convex_silhouette, may_occlude, triangle_polygon};
+use arealight::internals::{TriangleRole, convex_silhouette, may_occlude, triangle_polygon};
 use arealight::shade::{
     Body, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
     ShadingFrame, TriangleMesh,
 };
 use arealight::solid::{BoundingSphere, Side, face_side};
+use support::Rng;
+use support::shade::ground_point;
 
-fn rand_dir(rng: &mut Pcg32) -> DVec3 {
-    let z = 2.0 * rng.next_f64() - 1.0;
-    let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
-}
+mod support;
 
 #[test]
 fn hulls_of_random_clouds_are_convex_and_silhouettes_match_per_triangle() {
-    let mut rng = Pcg32::new(3, 4);
+    let mut rng = Rng::new(304);
     for case in 0..40 {
-        let n = 4 + (rng.next_u32() % 60) as usize;
-        let scale = DVec3::new(
-            0.2 + rng.next_f64(),
-            0.2 + rng.next_f64(),
-            0.2 + rng.next_f64(),
-        );
+        let n = 4 + rng.below(60);
+        let scale = DVec3::new(0.2 + rng.f64(), 0.2 + rng.f64(), 0.2 + rng.f64());
         let pts: Vec<DVec3> = (0..n)
-            .map(|_| rand_dir(&mut rng) * rng.next_f64().cbrt() * scale)
+            .map(|_| rng.dir() * rng.f64().cbrt() * scale)
             .collect();
         let hull = ConvexPolyhedron::hull(&pts).unwrap();
         let mesh = hull.mesh();
@@ -53,8 +46,8 @@ fn hulls_of_random_clouds_are_convex_and_silhouettes_match_per_triangle() {
         assert_eq!(v - e + f, 2, "case {case}");
         // From outside, the silhouette covers what the front triangles cover.
         for _ in 0..5 {
-            let x = rand_dir(&mut rng) * (2.0 + 3.0 * rng.next_f64());
-            let frame = ShadingFrame::new(x, rand_dir(&mut rng), rand_dir(&mut rng)).unwrap();
+            let x = rng.dir() * (2.0 + 3.0 * rng.f64());
+            let frame = ShadingFrame::new(x, rng.dir(), rng.dir()).unwrap();
             let sil = convex_silhouette(&hull, &frame).unwrap();
             let sum: f64 = (0..mesh.triangle_count())
                 .filter_map(|t| triangle_polygon(mesh, t, &frame, TriangleRole::Emitter).unwrap())
@@ -75,22 +68,22 @@ fn hulls_of_random_clouds_are_convex_and_silhouettes_match_per_triangle() {
 fn culling_is_conservative() {
     // Whenever a point of the occluder's sphere, above the horizon, lies in front of a point of
     // the light's sphere along the same ray from x, the occluder must be kept.
-    let mut rng = Pcg32::new(5, 6);
+    let mut rng = Rng::new(506);
     let mut kept_needed = 0;
     for _ in 0..20_000 {
-        let x = rand_dir(&mut rng) * rng.next_f64() * 2.0;
-        let n = rand_dir(&mut rng);
+        let x = rng.dir() * rng.f64() * 2.0;
+        let n = rng.dir();
         let light = BoundingSphere {
-            center: rand_dir(&mut rng) * 4.0 * rng.next_f64(),
-            radius: 0.2 + rng.next_f64(),
+            center: rng.dir() * 4.0 * rng.f64(),
+            radius: 0.2 + rng.f64(),
         };
         let occ = BoundingSphere {
-            center: rand_dir(&mut rng) * 4.0 * rng.next_f64(),
-            radius: 0.1 + rng.next_f64(),
+            center: rng.dir() * 4.0 * rng.f64(),
+            radius: 0.1 + rng.f64(),
         };
         let keep = may_occlude(x, n, light, occ);
         for _ in 0..8 {
-            let p = occ.center + rand_dir(&mut rng) * occ.radius * rng.next_f64().cbrt();
+            let p = occ.center + rng.dir() * occ.radius * rng.f64().cbrt();
             let d = (p - x).normalize();
             if d.dot(n) <= 0.0 {
                 continue;
@@ -118,17 +111,13 @@ fn box_mesh(c: DVec3, h: DVec3) -> TriangleMesh {
 
 /// Analytic (per-triangle method) against Monte Carlo with the LTC BRDF on ground points.
 fn check_scene(scene: &Scene, seed: u64, points: usize) -> (usize, usize) {
-    let mut rng = Pcg32::new(seed, 7);
+    let mut rng = Rng::new(seed * 100 + 7);
     let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
     let mc = MonteCarlo::new(4096, ReferenceBrdf::Ltc);
     let (mut ok, mut errors) = (0, 0);
     for i in 0..points {
-        let x = DVec3::new(4.0 * rng.next_f64() - 2.0, 4.0 * rng.next_f64() - 2.0, 0.0);
-        let v = DVec3::new(
-            rng.next_f64() - 0.5,
-            rng.next_f64() - 0.5,
-            0.5 + rng.next_f64(),
-        );
+        let x = ground_point(&mut rng, 2.0);
+        let v = DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, 0.5 + rng.f64());
         let a = match scene.shade(x, DVec3::Z, v, &m) {
             Ok(a) => a,
             Err(e) => {
@@ -469,7 +458,7 @@ fn points_in_face_planes_see_the_same_region_both_ways() {
     // A case counts as checked only when the point really is outside the polyhedron, really sees
     // the face edge-on (by the facing predicate both paths use) and sees something at all; each
     // family of points must give more than 100 such cases.
-    let mut rng = Pcg32::new(17, 8);
+    let mut rng = Rng::new(1708);
     let shapes = [
         ConvexPolyhedron::cuboid(DVec3::new(0.1, -0.2, 0.5), DVec3::new(0.5, 0.3, 0.5)).unwrap(),
         ConvexPolyhedron::icosphere(DVec3::ZERO, 0.7, 1).unwrap(),
@@ -483,12 +472,12 @@ fn points_in_face_planes_see_the_same_region_both_ways() {
             let n = mesh.triangle_normal(t);
             let centroid = (a + b + c) / 3.0;
             let (u, _) = n.any_orthonormal_pair();
-            let d = u * (1.5 + 2.0 * rng.next_f64());
-            for (family, x) in [centroid + d, a + (b - a) * (2.0 + rng.next_f64())]
+            let d = u * (1.5 + 2.0 * rng.f64());
+            for (family, x) in [centroid + d, a + (b - a) * (2.0 + rng.f64())]
                 .into_iter()
                 .enumerate()
             {
-                let frame = ShadingFrame::new(x, rand_dir(&mut rng), DVec3::Z).unwrap();
+                let frame = ShadingFrame::new(x, rng.dir(), DVec3::Z).unwrap();
                 let sil = convex_silhouette(poly, &frame).unwrap();
                 let sum: f64 = (0..mesh.triangle_count())
                     .filter_map(|k| {

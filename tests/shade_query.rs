@@ -6,26 +6,22 @@
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
-use arealight::internals::{DemoConfig, Pcg32, demo_scene};
+use arealight::internals::{DemoConfig, demo_scene};
 use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
+use support::Rng;
+use support::shade::{ground_point, point_on_mesh, view_above};
+
+mod support;
 
 fn close(a: DVec3, b: DVec3) -> bool {
     (a - b).abs().max_element() <= 1e-12 * (a.abs().max_element() + b.abs().max_element()) + 1e-300
-}
-
-/// A random direction on the unit sphere.
-fn dir(rng: &mut Pcg32) -> DVec3 {
-    let z = 2.0 * rng.next_f64() - 1.0;
-    let phi = std::f64::consts::TAU * rng.next_f64();
-    let r = (1.0 - z * z).sqrt();
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
 /// Checks every identity at `count` points of `scene` (ground points and points on occluder
 /// surfaces, random views above the surface); returns how many (point, light) pairs were
 /// shadowed by more than 1% in some channel.
 fn check(scene: &Scene, count: usize, seed: u64) -> usize {
-    let mut rng = Pcg32::new(seed, 21);
+    let mut rng = Rng::new(seed * 100 + 21);
     let m = Material::new(
         DVec3::new(0.6, 0.5, 0.4),
         DVec3::new(0.04, 0.05, 0.06),
@@ -43,19 +39,11 @@ fn check(scene: &Scene, count: usize, seed: u64) -> usize {
     for i in 0..count {
         let occ = scene.occluders();
         let (x, n) = if i % 3 == 2 && !occ.is_empty() {
-            let mesh = occ[i % occ.len()].mesh();
-            let t = (rng.next_u32() as usize) % mesh.triangle_count();
-            let [a, b, c] = mesh.triangle(t);
-            let (u, v) = (rng.next_f64() * 0.5, rng.next_f64() * 0.5);
-            (a + (b - a) * u + (c - a) * v, mesh.triangle_normal(t))
+            point_on_mesh(&mut rng, occ[i % occ.len()].mesh())
         } else {
-            let x = DVec3::new(4.0 * rng.next_f64() - 2.0, 4.0 * rng.next_f64() - 2.0, 0.0);
-            (x, DVec3::Z)
+            (ground_point(&mut rng, 2.0), DVec3::Z)
         };
-        let mut v = dir(&mut rng);
-        if v.dot(n) < 0.1 {
-            v = (v - n * (v.dot(n) - 0.3)).normalize();
-        }
+        let v = view_above(&mut rng, n, 0.1);
         let parts = scene.shade_per_light(x, n, v, &m).unwrap();
         assert_eq!(parts.len(), scene.lights().len());
         let total = scene.shade(x, n, v, &m).unwrap();

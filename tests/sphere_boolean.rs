@@ -1,16 +1,17 @@
 //! Spherical set operations: solid-angle identities on random and degenerate operands, Monte
 //! Carlo checks for regions larger than a hemisphere, and the seed's per-triangle workflow.
 
-mod common;
+mod support;
 
 use arealight::glam::DVec3;
 use arealight::planar::BoolOp;
 use arealight::sphere::{SphericalPolygon, order_directed_edges};
-use common::{
-    Rng, assert_mc_agrees, boundary_edges, crossed_cells, icosphere, mc_solid_angle, star_ring,
-};
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{
+    assert_mc_agrees, boundary_edges, crossed_cells, icosphere, mc_solid_angle, star_ring,
+};
 
 /// Identity tolerance: 1e-11 of the sphere, below the 1e-10 * 4 pi.
 const TOL: f64 = 1e-11 * 4.0 * PI;
@@ -117,7 +118,7 @@ fn check_identities(a: &SphericalPolygon, b: &SphericalPolygon) -> Result<(), Te
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     #[test]
     fn identities_hold(seed in any::<u64>()) {

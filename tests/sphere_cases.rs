@@ -1,16 +1,17 @@
 //! Edge cases of the spherical primitives, each checked against a number known in closed form.
 
-mod common;
+mod support;
 
 use arealight::GeomError;
 use arealight::glam::{DVec2, DVec3};
 use arealight::sphere::{
     Gnomonic, SphericalPolygon, enclosing_cap, order_directed_edges, order_edges,
 };
-use common::{
-    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_solid_angle, polar,
-};
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{
+    assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_solid_angle, polar,
+};
 
 fn poly(rings: Vec<Vec<DVec3>>) -> SphericalPolygon {
     SphericalPolygon::new(rings).expect("valid test polygon")

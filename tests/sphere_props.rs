@@ -2,16 +2,16 @@
 //! independent quantity: an exact identity, a re-derivation, or a Monte Carlo estimate with a
 //! stated bound.
 
-mod common;
+mod support;
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::sphere::{Gnomonic, SphericalPolygon, order_edges};
-use common::{
-    Rng, assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_solid_angle, polar,
-    star_ring,
-};
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use support::Rng;
+use support::sphere::{
+    assert_mc_agrees, boundary_edges, crossed_cells, great_circle, mc_solid_angle, polar, star_ring,
+};
 
 fn unit() -> impl Strategy<Value = DVec3> {
     (-1.0f64..1.0, 0.0f64..2.0 * PI).prop_map(|(z, phi)| {
@@ -46,7 +46,7 @@ fn revalidate(p: &SphericalPolygon) -> Result<SphericalPolygon, arealight::GeomE
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: common::cases(256), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: support::cases(256), ..ProptestConfig::default() })]
 
     /// project then unproject returns the direction; unproject then project returns the point.
     #[test]

@@ -8,24 +8,13 @@ use arealight::visibility::plucker::{
     Orientation, PluckerLine, Sign, Stab, line_polygon, side_sign, vvset_orientation,
 };
 
-/// SplitMix64.
-struct Rng(u64);
+mod support;
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn f64(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform integer in `[-m, m]`.
-    fn int(&mut self, m: i64) -> i64 {
-        (self.next() % (2 * m as u64 + 1)) as i64 - m
-    }
+use support::Rng;
+
+/// Uniform integer in `[-m, m]`.
+fn int(rng: &mut Rng, m: i64) -> i64 {
+    rng.below(2 * m as usize + 1) as i64 - m
 }
 
 type I3 = [i128; 3];
@@ -77,7 +66,7 @@ fn coordinates_and_side_operator_follow_the_paper() {
     // l0..l2 = q - p; l3 = qz py - qy pz, l4 = qx pz - qz px, l5 = qy px - qx py; side(l, r) =
     // l3 r0 + l4 r1 + l5 r2 + l0 r3 + l1 r4 + l2 r5, written out as in the paper; and the side
     // equals det[q - p, r - p, s - p] (six times the tetrahedron's signed volume).
-    let mut rng = Rng(1);
+    let mut rng = Rng::from_state(1);
     let pt = |rng: &mut Rng| DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64() - 0.5) * 4.0;
     for _ in 0..2000 {
         let (p, q, r, s) = (pt(&mut rng), pt(&mut rng), pt(&mut rng), pt(&mut rng));
@@ -122,24 +111,34 @@ fn side_signs_are_exact_on_coplanar_and_nearly_coplanar_lattice_points() {
     // others plus a perturbation of at most one unit: the exact determinant is zero or tiny
     // next to its terms (~2^114), where plain f64 evaluation returns noise. side_sign must
     // match i128 arithmetic on every case, zero included.
-    let mut rng = Rng(2);
+    let mut rng = Rng::from_state(2);
     let m = 1i64 << 35;
     let (mut zeros, mut nonzeros, mut naive_wrong) = (0, 0, 0);
     for case in 0..20000 {
-        let p: I3 = [rng.int(m), rng.int(m), rng.int(m)].map(i128::from);
+        let p: I3 = [int(&mut rng, m), int(&mut rng, m), int(&mut rng, m)].map(i128::from);
         let q: I3 = add(
             p,
-            [rng.int(m / 8), rng.int(m / 8), rng.int(m / 8)].map(i128::from),
+            [
+                int(&mut rng, m / 8),
+                int(&mut rng, m / 8),
+                int(&mut rng, m / 8),
+            ]
+            .map(i128::from),
         );
         let r: I3 = add(
             p,
-            [rng.int(m / 8), rng.int(m / 8), rng.int(m / 8)].map(i128::from),
+            [
+                int(&mut rng, m / 8),
+                int(&mut rng, m / 8),
+                int(&mut rng, m / 8),
+            ]
+            .map(i128::from),
         );
-        let (a, b) = (i128::from(rng.int(3)), i128::from(rng.int(3)));
+        let (a, b) = (i128::from(int(&mut rng, 3)), i128::from(int(&mut rng, 3)));
         let delta: I3 = if case % 3 == 0 {
             [0, 0, 0]
         } else {
-            [rng.int(1), rng.int(1), rng.int(1)].map(i128::from)
+            [int(&mut rng, 1), int(&mut rng, 1), int(&mut rng, 1)].map(i128::from)
         };
         let s = add(add(p, add(scale(a, sub(q, p)), scale(b, sub(r, p)))), delta);
         // Lines p -> s and q -> r, and a permutation, so that every argument slot is exercised.
@@ -199,10 +198,10 @@ fn stab_exact(p: I3, q: I3, poly: &[I3]) -> Stab {
 fn line_polygon_matches_the_exact_crossing_point() {
     // Lattice lines against lattice triangles and parallelograms (either orientation): small
     // coordinates make crossings through vertices, along edges and in the plane common.
-    let mut rng = Rng(3);
+    let mut rng = Rng::from_state(3);
     let mut counts = [0usize; 4];
     for case in 0..60000 {
-        let pt = |rng: &mut Rng| [rng.int(3), rng.int(3), rng.int(3)].map(i128::from);
+        let pt = |rng: &mut Rng| [int(rng, 3), int(rng, 3), int(rng, 3)].map(i128::from);
         let a = pt(&mut rng);
         let (u, v) = (pt(&mut rng), pt(&mut rng));
         if cross(u, v) == [0, 0, 0] {
@@ -219,7 +218,7 @@ fn line_polygon_matches_the_exact_crossing_point() {
         let (mut p, mut q) = (pt(&mut rng), pt(&mut rng));
         if case % 10 == 9 {
             // A line in the polygon's plane: through, along or beside it.
-            let k = |rng: &mut Rng| i128::from(rng.int(2));
+            let k = |rng: &mut Rng| i128::from(int(rng, 2));
             p = add(a, add(scale(k(&mut rng), u), scale(k(&mut rng), v)));
             q = add(p, add(scale(k(&mut rng), u), scale(k(&mut rng), v)));
         }

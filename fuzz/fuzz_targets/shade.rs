@@ -186,8 +186,12 @@ fn expected_fault(x: DVec3, n: DVec3, v: DVec3) -> Option<GeomError> {
     None
 }
 
+/// `a <= b` up to the rounding of two evaluations of one region by different decompositions
+/// (the silhouette against face by face, with endpoints merged within
+/// `sphere::MATCH_TOLERANCE` = 1e-9 rad along the way): relative `1e-7`. The failures this
+/// target exists for are larger by orders of magnitude (the smallest seen was 0.7%).
 fn close_or_below(a: f64, b: f64) -> bool {
-    a <= b + 1e-9 * b.abs() + 1e-12
+    a <= b + 1e-7 * b.abs() + 1e-12
 }
 
 fuzz_target!(|case: Case| {

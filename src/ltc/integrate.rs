@@ -96,7 +96,11 @@ pub fn clamped_cosine_integral_rational(poly: &SphericalPolygon) -> f64 {
 ///
 /// # Errors
 ///
-/// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`.
+/// As [`SphericalPolygon::transformed`] for a singular or non-finite `m_inv`;
+/// [`crate::GeomError::Undecidable`] when the exact path's clip of the transformed polygon at the
+/// horizon is not consistent (its parts above and below do not partition the region's solid
+/// angle, or the integral exceeds the part above's solid angle over pi): a vertex's image a few
+/// ulps from the horizon, where the clip is delicate, rather than a possibly wrong value.
 pub fn ltc_integral(poly: &SphericalPolygon, m_inv: glam::DMat3) -> Result<f64, crate::GeomError> {
     transformed_integral(poly, m_inv, Exact)
 }
@@ -136,7 +140,9 @@ fn transformed_integral(
 }
 
 /// The exact path of [`transformed_integral`], kept out of line so that the clip-free path's
-/// code stays small and needs no large stack frame.
+/// code stays small and needs no large stack frame. The clip of the transformed polygon is
+/// checked ([`checked_upper_part`]): the clip-free path hands over exactly the configurations
+/// where clipping is delicate (a vertex's image within `HORIZON_TOLERANCE` of the horizon).
 #[cold]
 #[inline(never)]
 fn exact_transformed(
@@ -144,7 +150,39 @@ fn exact_transformed(
     m: glam::DMat3,
     edge: impl EdgeTerm,
 ) -> Result<f64, crate::GeomError> {
-    Ok(clipped_sum(&poly.transformed(m)?, edge))
+    let t = poly.transformed(m)?;
+    let up = checked_upper_part(&t, "the LTC integral's clip at the cosine's horizon")?;
+    let v = upper_sum(&up.0, edge);
+    // The clamped cosine is at most `1 / pi`: no more than the part's solid angle over pi (the
+    // rational factor's error and rounding aside).
+    if v > up.1 / PI + 1e-12 {
+        return Err(crate::GeomError::Undecidable(
+            "the LTC integral exceeds its clipped part's solid angle over pi",
+        ));
+    }
+    Ok(v)
+}
+
+/// The part of `poly` in the closed upper hemisphere with its solid angle, or
+/// [`crate::GeomError::Undecidable`] when the clip is not consistent with the region: the part
+/// cannot be larger than the region, nor leave out more than the lower hemisphere (both to
+/// `1e-9` of the sphere's solid angle, the sphere layer's own fuzzing tolerance). The sphere
+/// layer's clip can fail that near the horizon (issue 24, reproducer 1: a sliver clipped to the
+/// whole hemisphere, or the complement of one to nothing), and the integral of a wrong clip is a
+/// wrong value. Not a proof of the clip: a wrong part within those bounds passes (the clip of
+/// the other hemisphere, which would complete the partition check, fails the same way today and
+/// would flag correct parts). The check costs two solid angles, on the exact paths only.
+fn checked_upper_part(
+    poly: &SphericalPolygon,
+    what: &'static str,
+) -> Result<(SphericalPolygon, f64), crate::GeomError> {
+    const TOL: f64 = 4e-9 * PI;
+    let up = poly.clip_to_hemisphere(DVec3::Z);
+    let (wu, w) = (up.solid_angle(), poly.solid_angle());
+    if !(wu <= w + TOL && w - wu <= 2.0 * PI + TOL) {
+        return Err(crate::GeomError::Undecidable(what));
+    }
+    Ok((up, wu))
 }
 
 /// The GGX specular response to a uniform unit-radiance polygon light: approximately
@@ -156,11 +194,22 @@ fn exact_transformed(
 /// the view at `cos_theta_v` from the normal; `alpha` is GGX's roughness parameter (`alpha =
 /// roughness^2` in the usual artist mapping). Evaluated here: the table lookup, the clip to the
 /// shading horizon (the tables are fitted for LTCs clipped there), the transform by `M^-1`, the
-/// horizon handling in cosine space and Baum's edge sum.
+/// horizon handling in cosine space and Baum's edge sum. The clip is skipped for regions shown
+/// to lie in the upper hemisphere (every vertex above the horizon is not enough: the complement
+/// of a light above the point holds the whole lower hemisphere), and checked against the
+/// region's solid angle otherwise; where it fails the check, the part above the horizon is taken
+/// as the upper hemisphere less the complement's part (whose LTC integral is `albedo / norm` in
+/// closed form minus that of the complement's clip, if that one passes).
+///
+/// With `f0 = 1` the result lies in `[0, albedo]` for every region: `norm` is the albedo over
+/// the LTC's mass above the horizon.
 ///
 /// # Errors
 ///
-/// [`crate::GeomError::OutOfRange`] for NaN parameters (see [`super::lookup`]).
+/// [`crate::GeomError::OutOfRange`] for NaN parameters (see [`super::lookup`]);
+/// [`crate::GeomError::Undecidable`] where a clip at a horizon is not consistent within rounding:
+/// the shading one, of the region and of its complement, or the cosine space's on the exact path
+/// of [`ltc_integral`].
 pub fn ggx_polygon_integral(
     poly: &SphericalPolygon,
     cos_theta_v: f64,
@@ -176,14 +225,83 @@ pub fn ggx_polygon_integral(
     }
     let l = super::lookup(cos_theta_v, alpha)?;
     // The tables' LTCs are fitted as clipped to the shading horizon and renormalized (`norm`),
-    // so the light is clipped there first; the clip is skipped when nothing reaches below.
-    let above = poly.rings().flatten().all(|v| v.z > HORIZON_TOLERANCE) && !poly.is_full();
-    let integral = if above {
+    // so the light is clipped there first; the clip is skipped only for regions shown to lie in
+    // the upper hemisphere. Vertices above the horizon are not enough: a region may still
+    // contain the whole lower hemisphere (the complement of a light above the point).
+    let integral = if inside_upper_hemisphere(poly) {
         ltc_integral(poly, l.m_inv)?
     } else {
-        ltc_integral(&poly.clip_to_hemisphere(DVec3::Z), l.m_inv)?
+        match checked_upper_part(poly, "the clip at the shading horizon") {
+            Ok((up, _)) => ltc_integral(&up, l.m_inv)?,
+            // The complement's clip, where the region's is inconsistent: `P n H` is `H` less
+            // `P' n H`, and the LTC integral of `H` is in closed form (`albedo / norm`).
+            Err(e) => {
+                let (rest, _) = checked_upper_part(&poly.complement(), "").map_err(|_| e)?;
+                (l.albedo / l.norm - ltc_integral(&rest, l.m_inv)?).max(0.0)
+            }
+        }
     };
+    // No part of the upper hemisphere holds more of the LTC than all of it, `albedo / norm`
+    // (exactly, where rounding in the images under a map of condition up to about 1e7 at
+    // grazing views could put a region just short of the hemisphere a few 1e-9 above it).
+    let integral = integral.min(l.albedo / l.norm);
     Ok(l.specular_scale(f0.clamp(0.0, 1.0)) * integral)
+}
+
+/// Whether the region certainly lies in the open upper hemisphere: `false` when it does not or
+/// when that is not certain (and for the empty region, which needs no decision).
+///
+/// Every vertex must lie above the horizon by more than [`HORIZON_TOLERANCE`]: then no edge (a
+/// minor arc, a positive combination of its endpoints) meets the closed lower hemisphere, which
+/// is therefore wholly inside or wholly outside the region. The gnomonic map about `+z`,
+/// `p -> (x / z, y / z)`, takes the rings to plane polygons with the region on their left; the
+/// sum of their signed areas is the area of the region's image when that image is bounded (the
+/// region avoids the lower hemisphere), and minus the area of the bounded part it leaves out
+/// otherwise. So the sign decides, when it exceeds the rounding bound accumulated alongside.
+/// Each ring's area is taken about its own first vertex, so that a small ring far from the
+/// zenith keeps its relative precision: its terms are of the ring's size squared, not of its
+/// distance from the zenith times its size.
+///
+/// Linear in the vertices with one division per coordinate; an undecided sign (a region about
+/// `1e-15` of its distance from the zenith across, or less) answers `false`, and the caller
+/// clips, which is right either way.
+fn inside_upper_hemisphere(poly: &SphericalPolygon) -> bool {
+    if poly.is_full() {
+        return false;
+    }
+    let project = |v: DVec3| (v.z > HORIZON_TOLERANCE).then(|| (v.x / v.z, v.y / v.z));
+    // The signed area (twice), a bound on the error of its terms, and the sum of their sizes.
+    let (mut area, mut bound, mut size) = (0.0, 0.0, 0.0);
+    for ring in poly.rings() {
+        let Some((&first, rest)) = ring.split_first() else {
+            continue;
+        };
+        let Some(o) = project(first) else {
+            return false;
+        };
+        let size_o = o.0.abs() + o.1.abs();
+        // Offsets from the first vertex (the first offset is zero, and so is its term), each
+        // with a bound on its error per coordinate: a rounded quotient and a rounded difference,
+        // below `eps (|p| + |o|)`; doubled.
+        let (mut d, mut err_d, mut size_d) = ((0.0, 0.0), 0.0, 0.0);
+        for &v in rest {
+            let Some(p) = project(v) else {
+                return false;
+            };
+            let e = (p.0 - o.0, p.1 - o.1);
+            let err_e = 2.0 * f64::EPSILON * (p.0.abs() + p.1.abs() + size_o);
+            let size_e = e.0.abs() + e.1.abs();
+            area += d.0 * e.1 - d.1 * e.0;
+            // The inputs' errors times the other factor, and the products' and the difference's
+            // own rounding (doubled).
+            bound += size_d * err_e + size_e * err_d + 4.0 * f64::EPSILON * size_d * size_e;
+            size += size_d * size_e;
+            (d, err_d, size_d) = (e, err_e, size_e);
+        }
+    }
+    // The summation's rounding: below `n eps` times the sum of the terms' magnitudes.
+    let n = poly.vertex_count() as f64;
+    area > 2.0 * (bound + n * f64::EPSILON * size)
 }
 
 /// [`edge_factor_rational`] of `y / l` divided by `l`, as a fraction `num / den` of
@@ -578,14 +696,18 @@ impl ClipFree {
     }
 
     /// The total angle of the horizon arcs, the argument of the crossings' product, given at
-    /// least one crossing.
+    /// least one crossing; `None` where rounding decides between almost none and almost all of
+    /// the circle ([`arcs_undecided`]).
     #[inline(always)]
-    fn horizon_arcs(&self, edge: impl EdgeTerm) -> f64 {
+    fn horizon_arcs(&self, edge: impl EdgeTerm) -> Option<f64> {
         // The rational argument is a ratio of polynomials of degree 3 in the product's size:
         // brought within 1e±90 first, as before each factor, so that they neither underflow nor
         // overflow.
         let (re, im) = in_range(self.re, self.im);
-        counter_clockwise_arc(re, im, || edge.arg(re, im))
+        if arcs_undecided(re, im, self.crossings) {
+            return None;
+        }
+        Some(counter_clockwise_arc(re, im, || edge.arg(re, im)))
     }
 
     /// The integral, or `None` when no edge crosses the horizon but some vertex is below it
@@ -598,7 +720,7 @@ impl ClipFree {
             // the rational factor for the rational one, with the same relative error bound as
             // its edges). Exactly on the negative axis the arc is a half circle, which an edge
             // term cannot tell from a zero-length one.
-            self.horizon_arcs(edge)
+            self.horizon_arcs(edge)?
         } else if self.edges == 0 {
             0.0
         } else if !self.any_below {
@@ -622,6 +744,19 @@ fn in_range(re: f64, im: f64) -> (f64, f64) {
     } else {
         rescale_product(re, im, size)
     }
+}
+
+/// Whether the crossings' product `re + i im` (of `crossings` factors) lies within its rounding
+/// of the positive real axis, where the horizon arcs total either almost nothing or almost a
+/// full turn and the sign of `im` is noise: crossing points closer than rounding can resolve,
+/// as the two crossings next to a vertex a little below the horizon between two edges of a
+/// sliver (a vertex `1e-14` below the horizon in a wedge of 0.005 rad puts them `5e-17` apart).
+/// Each crossing point's direction is good to a few ulps; the margin allows 64 per factor.
+/// The exact path decides these.
+#[inline(always)]
+fn arcs_undecided(re: f64, im: f64, crossings: usize) -> bool {
+    const ARC_MARGIN: f64 = 64.0 * f64::EPSILON;
+    re > 0.0 && im.abs() <= ARC_MARGIN * crossings as f64 * re
 }
 
 /// The arc from the x-axis counter-clockwise to `re + i im` (not both zero), in `[0, 2 pi)`:
@@ -763,6 +898,9 @@ fn quad_sum(quad: &[DVec3], map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -
     // the crossings' product of the general loop.
     let (xo, xi) = (x_out.v, x_in.v);
     let (re, im) = (xo.x * xi.x + xo.y * xi.y, xo.x * xi.y - xo.y * xi.x);
+    if arcs_undecided(re, im, 2) {
+        return None;
+    }
     Some(integral_of_sum(t + counter_clockwise_arc(re, im, || arc)))
 }
 
@@ -841,17 +979,19 @@ fn transformed_clip_free(
     edge: impl EdgeTerm,
 ) -> Option<f64> {
     let (x, y, z) = (&m.x_axis, &m.y_axis, &m.z_axis);
-    if y.x == 0.0 && y.y == 1.0 && y.z == 0.0 && x.y == 0.0 && z.y == 0.0 {
-        // The form of the fitted tables' matrices (HDHN16 §4.1): `y` passes unchanged, so four
+    if y.x == 0.0 && y.z == 0.0 && x.y == 0.0 && z.y == 0.0 {
+        // The form of the fitted tables' matrices (HDHN16 §4.1): `y` only scaled, so five
         // products per vertex instead of nine; the images are the same.
-        let (m00, m02, m20, m22) = (x.x, z.x, x.z, z.z);
+        let (m00, m02, m20, m22, m11) = (x.x, z.x, x.z, z.z, y.y);
         let small = |e: f64| e.abs() <= CLIP_FREE_RANGE;
-        let in_range = small(m00) & small(m02) & small(m20) & small(m22);
-        if !(m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && in_range) {
+        let in_range = small(m00) & small(m02) & small(m20) & small(m22) & small(m11);
+        let regular =
+            m00 * m22 - m02 * m20 >= 1.0 / CLIP_FREE_RANGE && m11 >= 1.0 / CLIP_FREE_RANGE;
+        if !(regular && in_range) {
             // Far from the tables' matrices (or NaN): let the general path rescale it.
             return general_clip_free(poly, m, edge);
         }
-        let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, v.y, m20 * v.x + m22 * v.z);
+        let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, m11 * v.y, m20 * v.x + m22 * v.z);
         clip_free_sum(poly, map, edge)
     } else {
         general_clip_free(poly, m, edge)
@@ -859,7 +999,9 @@ fn transformed_clip_free(
 }
 
 /// Bound on the entries (at most this) and the determinant (at least its inverse) of the maps the
-/// clip-free path takes: the images of unit vectors then have lengths within about `2^±92`, so
+/// clip-free path takes (for the tables' form, on the xz block's determinant and on the `y`
+/// scale separately, which keeps its images' lengths within `2^±61`): the images of unit vectors
+/// then have lengths within about `2^±92`, so
 /// the crossing points (products of two images) and the edge terms' products of squared lengths
 /// stay far from overflow and underflow. The fitted tables' matrices lie well inside (entries up
 /// to about `1 / alpha_min = 1e4`).

@@ -8,13 +8,22 @@
 //!
 //! # Grid
 //!
-//! The committed GGX table is 64 x 64. The view axis is uniform in `sqrt(1 - cos_theta_v)` over
-//! `cos_theta_v` in `[COS_MIN, 1]` (`COS_MIN = 1e-3`); that is nearly uniform in the angle, with
-//! node spacing from 1.3 degrees at normal incidence to 1.8 degrees at grazing, as in the public
-//! implementation. The roughness axis is uniform in `sqrt(alpha)` (perceptual roughness) over
-//! `alpha` in `[ALPHA_MIN, 1]` (`ALPHA_MIN = 1e-4`), with the first node exactly at `ALPHA_MIN`:
-//! the LTC's `M^-1` entries, normalised by `M^-1[1][1]`, vary smoothly in it. Inputs outside
-//! these ranges are clamped.
+//! The committed GGX table has 81 view nodes and 64 roughness nodes. View nodes 0 to 62 are
+//! uniform in `sqrt(1 - cos_theta_v)` from `cos_theta_v = 1` down to `COS_KNEE = 1/32`: nearly
+//! uniform in the angle, with node spacing from 1.3 degrees at normal incidence to 1.8 degrees
+//! near the knee, as in the public implementation. Past the knee, at grazing views, the nodes are
+//! uniform in `ln(cos_theta_v)`, two per halving, down to `COS_MIN = 2^-14` (about `6.1e-5`):
+//! there a near-mirror lobe sits at an elevation of about `cos_theta_v` above the horizon, and
+//! its shape changes with that elevation's ratio, not its difference (a single cell from 0.03 down
+//! to 0.001 would interpolate between a lobe above the horizon and one half below it, through
+//! matrices that put the whole lobe under the horizon). The roughness axis is uniform in
+//! `sqrt(alpha)` (perceptual roughness) over `alpha` in `[ALPHA_MIN, 1]` (`ALPHA_MIN = 1e-4`),
+//! with the first node exactly at `ALPHA_MIN`: the LTC's `M^-1` entries, normalised by
+//! `M^-1[1][1]`, vary smoothly in it. Inputs outside these ranges are clamped.
+//!
+//! Every node has `M^-1[0][0] > 0` and every cell's interpolated determinant is positive (checked
+//! for every cell by `tests/ltc_robust.rs`), so every lookup's LTC has at least half its mass
+//! above the horizon and `norm` is at most twice the albedo.
 //!
 //! # References
 //!
@@ -36,13 +45,15 @@ use crate::math::sqrt;
 pub(crate) const CHANNELS: usize = 7;
 
 /// The per-cell quantities, in storage order: `M^-1`'s first column `(M00, M20)`, its last column
-/// `(M02, M22)`, then the scalars. The columns are what a vertex's `x` and `z` are multiplied by,
+/// `(M02, M22)`, then the scalars. (`norm` is not stored: it follows from the matrix and the
+/// albedo, see [`LtcLookup::norm`].) The columns are what a vertex's `x` and `z` are multiplied by,
 /// so each comes out of the bilinear lookup as one two-lane value that the transform uses as it
 /// is; stored by rows, they would have to be shuffled apart on every lookup (see BENCHMARKS.md,
 /// "ltc shading").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Channel {
-    /// `M^-1[0][0]` (row, column), with `M^-1` scaled so that `M^-1[1][1] = 1`.
+    /// `M^-1[0][0]` (row, column), with `M^-1` scaled so that its first row `(M00, 0, M02)` is a
+    /// unit vector (see [`LtcLookup::m_inv`]).
     M00 = 0,
     /// `M^-1[2][0]`.
     M20 = 1,
@@ -50,12 +61,12 @@ pub(crate) enum Channel {
     M02 = 2,
     /// `M^-1[2][2]`.
     M22 = 3,
-    /// Scale of the clamped-cosine integral, see [`LtcLookup::norm`].
-    Norm = 4,
     /// Directional albedo.
-    Albedo = 5,
+    Albedo = 4,
     /// Fresnel weight.
-    Fresnel = 6,
+    Fresnel = 5,
+    /// `M^-1[1][1]`.
+    M11 = 6,
 }
 
 impl Channel {
@@ -67,17 +78,30 @@ impl Channel {
         (Channel::M02, "M_INV_02"),
         (Channel::M20, "M_INV_20"),
         (Channel::M22, "M_INV_22"),
-        (Channel::Norm, "NORM"),
+        (Channel::M11, "M_INV_11"),
         (Channel::Albedo, "ALBEDO"),
         (Channel::Fresnel, "FRESNEL"),
     ];
 }
 
 /// The sampling grid of a table: node positions and the input -> grid-coordinate maps.
+///
+/// View nodes `0..=knee` are uniform in `sqrt(1 - cos_theta_v)` from `cos = 1` down to
+/// `cos_knee`; the nodes after the knee (the grazing tail, possibly none) are uniform in
+/// `ln(cos_theta_v)`, `tail_steps` per halving of the cosine, down to `cos_min`. Roughness nodes
+/// are uniform in `sqrt(alpha)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Grid {
-    /// Nodes per axis.
-    pub n: usize,
+    /// Number of view nodes (the faster-varying index of the node array).
+    pub n_view: usize,
+    /// Number of roughness nodes.
+    pub n_rough: usize,
+    /// Index of the last node of the uniform part of the view axis.
+    pub knee: usize,
+    /// `cos_theta_v` at node `knee`.
+    pub cos_knee: f64,
+    /// View nodes per halving of `cos_theta_v` in the grazing tail.
+    pub tail_steps: usize,
     /// Smallest `cos_theta_v` (the last view node).
     pub cos_min: f64,
     /// Smallest `alpha` of the table.
@@ -88,11 +112,21 @@ pub(crate) struct Grid {
     pub rough_from_zero: bool,
     /// `sqrt(alpha)` at the first roughness node.
     r_min: f64,
-    /// `(n - 1)^2 / (1 - cos_min)`: the view coordinate is `sqrt((1 - cos) * view_k)`.
+    /// `knee^2 / (1 - cos_knee)`: the view coordinate is `sqrt((1 - cos) * view_k)` up to the
+    /// knee.
     view_k: f64,
-    /// `(n - 1) / (1 - r_min)`: the roughness coordinate is `(sqrt(alpha) - r_min) * rough_k`.
+    /// `tail_steps / ln 2`: past the knee the view coordinate is `knee + ln(cos_knee / cos) *
+    /// tail_k`.
+    tail_k: f64,
+    /// `(n_rough - 1) / (1 - r_min)`: the roughness coordinate is `(sqrt(alpha) - r_min) *
+    /// rough_k`.
     rough_k: f64,
+    /// Per cell `j` of the uniform part, the curvature of its offset (see [`Grid::view_cell`]).
+    kappa: [f64; MAX_KNEE],
 }
+
+/// Largest `knee` a [`Grid`] supports (the uniform part's cells have a constant each).
+const MAX_KNEE: usize = 128;
 
 /// `sqrt` usable in constants: Newton's iteration from above, stopped when it no longer
 /// decreases (the correctly rounded root or one ulp above it).
@@ -111,58 +145,150 @@ const fn const_sqrt(x: f64) -> f64 {
 }
 
 impl Grid {
-    /// A grid of `n` nodes per axis (`n >= 2`) over `cos_theta_v` in `[cos_min, 1]` and `alpha`
-    /// in `[alpha_min, 1]`; the coordinate maps' constants are computed here, once, so that a
-    /// lookup needs no division.
-    pub const fn new(n: usize, cos_min: f64, alpha_min: f64, rough_from_zero: bool) -> Self {
+    /// A grid of `knee + 1` uniform view nodes down to `cos_knee`, then `n_view - 1 - knee` tail
+    /// nodes, `tail_steps` per halving of the cosine, the last at `cos_min` (which must be
+    /// `cos_knee * 2^-((n_view - 1 - knee) / tail_steps)`; without a tail, `cos_knee`), and
+    /// `n_rough` roughness nodes over `alpha` in `[alpha_min, 1]` (`knee >= 1`, `n_rough >= 2`,
+    /// `tail_steps >= 1`). The coordinate maps' constants are computed here, once, so that a
+    /// lookup needs no division on the uniform part.
+    #[allow(clippy::too_many_arguments)]
+    pub const fn new(
+        n_view: usize,
+        knee: usize,
+        cos_knee: f64,
+        tail_steps: usize,
+        cos_min: f64,
+        n_rough: usize,
+        alpha_min: f64,
+        rough_from_zero: bool,
+    ) -> Self {
         let r_min = if rough_from_zero {
             0.0
         } else {
             const_sqrt(alpha_min)
         };
-        let last = (n - 1) as f64;
+        let k = knee as f64;
+        let view_k = k * k / (1.0 - cos_knee);
+        assert!(
+            knee >= 1 && knee <= MAX_KNEE,
+            "the uniform part needs 1 to 128 cells"
+        );
+        let mut kappa = [0.0; MAX_KNEE];
+        let mut j = 0;
+        while j < knee {
+            // At the cell's middle, `x = j + 1/2` and `1 + cos = 2 - x^2 / view_k`.
+            let x = j as f64 + 0.5;
+            kappa[j] = -x / (2.0 * (2.0 * view_k - x * x));
+            j += 1;
+        }
         Self {
-            n,
+            n_view,
+            n_rough,
+            knee,
+            cos_knee,
+            tail_steps,
             cos_min,
             alpha_min,
             rough_from_zero,
             r_min,
-            view_k: last * last / (1.0 - cos_min),
-            rough_k: last / (1.0 - r_min),
+            view_k,
+            tail_k: tail_steps as f64 * core::f64::consts::LOG2_E,
+            rough_k: (n_rough - 1) as f64 / (1.0 - r_min),
+            kappa,
         }
     }
 
-    /// Continuous view coordinate in `[0, n - 1]` of a (non-NaN) `cos_theta_v`.
-    #[inline]
-    pub fn view_coord(&self, cos_theta: f64) -> f64 {
+    /// The view cell `j` in `[0, n_view - 2]` of a (non-NaN) `cos_theta_v` and the offset in it,
+    /// in `[0, 1]`: exactly `0` or `1` at a node.
+    ///
+    /// Up to the knee the cell is found uniformly in `sqrt(1 - cos) = sqrt(2) sin(theta / 2)`,
+    /// and the offset is made linear in the angle `theta` itself to second order, so that a
+    /// near-mirror lobe's interpolated axis (see [`LtcLookup::m_inv`]) turns with the mirror
+    /// direction: with `x` the coordinate, `u = sqrt(1 - cos)` and `g(u) = theta = 2 asin(u /
+    /// sqrt 2)`, an offset `t` linear in `u` corresponds to `t - (g'' / 2 g') du t (1 - t)` in
+    /// `theta`, and `g'' / g' = u / (1 + cos)`; with `du = u / x` that is `t + kappa t (1 - t)`,
+    /// `kappa = -x / (2 view_k (1 + cos))`, taken at the cell's middle (a constant per cell, no
+    /// division per lookup). Linear in `u` the axis would be off by up to `6e-5` rad near the
+    /// knee (a third of the width of a lobe of `alpha = 1e-4`); with the offset corrected, by
+    /// about `3e-7` rad.
+    #[inline(always)]
+    pub fn view_cell(&self, cos_theta: f64) -> (usize, f64) {
         let c = cos_theta.clamp(self.cos_min, 1.0);
-        // Uniform in sqrt(1 - cos theta) = sqrt(2) sin(theta / 2), nearly uniform in theta.
-        sqrt((1.0 - c) * self.view_k).clamp(0.0, (self.n - 1) as f64)
+        let last = self.n_view - 1;
+        if c >= self.cos_knee {
+            let x = sqrt((1.0 - c) * self.view_k).min(self.knee as f64);
+            let (j, t) = cell(x, last);
+            // `j <= knee`, and at `j = knee` (the knee node itself) `t = 0`.
+            let kappa = self.kappa[j.min(MAX_KNEE - 1)];
+            (j, t + kappa * t * (1.0 - t))
+        } else {
+            cell(self.tail_coord(c), last)
+        }
+    }
+
+    /// The continuous view coordinate past the knee (grazing views), out of line: a renderer's common views
+    /// never come here. The nodes are uniform in `ln(cos_theta_v)`, where near-mirror lobes
+    /// change shape with the view's elevation's ratio; within a cell the offset is linear in
+    /// `cos_theta_v` itself, which at grazing is the elevation of the mirror direction (to
+    /// third order) and so turns the interpolated lobe's axis (see [`LtcLookup::m_inv`]) to the
+    /// mirror direction: an offset linear in the logarithm would put it off by about an eighth
+    /// of the cell's squared width in `ln`, times the elevation (`4e-4` rad at `cos = 0.027`,
+    /// twice the width of a lobe of `alpha = 1e-4`).
+    #[cold]
+    #[inline(never)]
+    fn tail_coord(&self, c: f64) -> f64 {
+        let last = self.n_view - 1;
+        let x = self.knee as f64 + crate::math::ln(self.cos_knee / c) * self.tail_k;
+        let x = x.clamp(self.knee as f64, last as f64);
+        let j = (crate::math::floor(x) as usize).min(last - 1);
+        let (hi, lo) = (self.node_cos(j), self.node_cos(j + 1));
+        j as f64 + ((hi - c) / (hi - lo)).clamp(0.0, 1.0)
     }
 
     /// `cos_theta_v` at view node `j`.
     pub fn node_cos(&self, j: usize) -> f64 {
-        let t = j as f64 / (self.n - 1) as f64;
-        (1.0 - t * t * (1.0 - self.cos_min)).clamp(self.cos_min, 1.0)
+        if j >= self.n_view - 1 {
+            return self.cos_min;
+        }
+        if j >= self.knee {
+            let halvings = (j - self.knee) as f64 / self.tail_steps as f64;
+            return self.cos_knee * crate::math::powf(2.0, -halvings);
+        }
+        let t = j as f64 / self.knee as f64;
+        (1.0 - t * t * (1.0 - self.cos_knee)).clamp(self.cos_knee, 1.0)
     }
 
-    /// Continuous roughness coordinate in `[0, n - 1]` of a (non-NaN) `alpha`.
+    /// Continuous roughness coordinate in `[0, n_rough - 1]` of a (non-NaN) `alpha`.
     #[inline]
     pub fn rough_coord(&self, alpha: f64) -> f64 {
         let r = sqrt(alpha.clamp(self.alpha_min, 1.0));
-        ((r - self.r_min) * self.rough_k).clamp(0.0, (self.n - 1) as f64)
+        ((r - self.r_min) * self.rough_k).clamp(0.0, (self.n_rough - 1) as f64)
     }
 
     /// GGX `alpha` at roughness node `k`.
     pub fn node_alpha(&self, k: usize) -> f64 {
-        let t = k as f64 / (self.n - 1) as f64;
+        let t = k as f64 / (self.n_rough - 1) as f64;
         let r = self.r_min + (1.0 - self.r_min) * t;
         (r * r).clamp(self.alpha_min, 1.0)
+    }
+
+    /// Number of nodes.
+    pub fn nodes(&self) -> usize {
+        self.n_view * self.n_rough
     }
 }
 
 /// The grid of the committed GGX table.
-pub(crate) const GGX_GRID: Grid = Grid::new(data::SIZE, data::COS_MIN, data::ALPHA_MIN, false);
+pub(crate) const GGX_GRID: Grid = Grid::new(
+    data::VIEW_NODES,
+    data::KNEE,
+    data::COS_KNEE,
+    data::TAIL_STEPS,
+    data::COS_MIN,
+    data::ROUGH_NODES,
+    data::ALPHA_MIN,
+    false,
+);
 
 /// One table lookup: the LTC approximating the cosine-weighted GGX BRDF for one view angle and
 /// roughness, and the scalars that scale its polygon integral (\[HDHN16\] §4).
@@ -183,12 +309,19 @@ pub(crate) const GGX_GRID: Grid = Grid::new(data::SIZE, data::COS_MIN, data::ALP
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LtcLookup {
     /// `M^-1`: maps directions in the shading frame (normal `+z`, view in the xz-plane with
-    /// `x >= 0`) into the space where the lobe is a clamped cosine about `+z`. Its scale is
-    /// arbitrary (the table normalises `M^-1[1][1]` to 1); only directions matter.
+    /// `x >= 0`) into the space where the lobe is a clamped cosine about `+z`. Of the form
+    /// `[[m00, 0, m02], [0, m11, 0], [m20, 0, m22]]`; its scale is arbitrary, only directions
+    /// matter. The table stores each node's matrix with its first row `(m00, 0, m02)` a unit
+    /// vector: the lobe's axis, `M e_z`, is perpendicular to that row, so interpolating unit rows
+    /// turns the axis almost exactly by the fraction of the angle between the nodes' axes (a
+    /// near-mirror lobe, far narrower than the node spacing, follows the mirror direction);
+    /// rows of different lengths would pull it towards the longer one.
     pub m_inv: DMat3,
-    /// Multiplier of the clamped-cosine integral of `M^-1 P`. It is the albedo divided by the
-    /// fraction of the LTC above the horizon, so that a light covering the whole upper hemisphere
-    /// reproduces the albedo exactly (the LTC is fitted as clipped to `z > 0`, see `fit.rs`).
+    /// Multiplier of the clamped-cosine integral of `M^-1 P`: the albedo divided by the fraction
+    /// of the LTC `m_inv` above the horizon (the LTC is fitted as clipped to `z > 0`, see
+    /// `fit.rs`). It is computed from the lookup's own `m_inv` and `albedo` (in closed
+    /// form, see [`Ltc::upper_hemisphere_mass`]), not interpolated on its own, so that a light covering the whole upper
+    /// hemisphere reproduces `albedo` to rounding and no light gives more, between the nodes too.
     pub norm: f64,
     /// Directional albedo `integral over the hemisphere of f(v, l) cos(theta_l) dl` (no Fresnel).
     pub albedo: f64,
@@ -197,16 +330,29 @@ pub struct LtcLookup {
 }
 
 impl LtcLookup {
-    fn from_channels(v: &[f64]) -> Self {
-        let m_inv = DMat3::from_cols(
-            DVec3::new(v[Channel::M00 as usize], 0.0, v[Channel::M20 as usize]),
-            DVec3::Y,
-            DVec3::new(v[Channel::M02 as usize], 0.0, v[Channel::M22 as usize]),
-        );
+    /// The lookup from (interpolated) channels; `norm` from the matrix and the albedo
+    /// ([`horizon_norm`]). `UPPER`: the caller knows that `m00 > 0` and `det M^-1 > 0`, where
+    /// the general form's test and its second branch are not needed; both give the same bits
+    /// then.
+    #[inline(always)]
+    fn from_channels<const UPPER: bool>(v: &[f64]) -> Self {
+        let (m00, m20) = (v[Channel::M00 as usize], v[Channel::M20 as usize]);
+        let (m02, m22) = (v[Channel::M02 as usize], v[Channel::M22 as usize]);
+        let (m11, albedo) = (v[Channel::M11 as usize], v[Channel::Albedo as usize]);
+        let norm = if UPPER {
+            let r = sqrt(m00 * m00 + m20 * m20);
+            albedo * (2.0 * r) / (r + m00)
+        } else {
+            horizon_norm(m00, m20, m02, m22, albedo)
+        };
         LtcLookup {
-            m_inv,
-            norm: v[Channel::Norm as usize],
-            albedo: v[Channel::Albedo as usize],
+            m_inv: DMat3::from_cols(
+                DVec3::new(m00, 0.0, m20),
+                DVec3::new(0.0, m11, 0.0),
+                DVec3::new(m02, 0.0, m22),
+            ),
+            norm,
+            albedo,
             fresnel: v[Channel::Fresnel as usize],
         }
     }
@@ -236,14 +382,44 @@ impl LtcLookup {
     }
 }
 
+/// `albedo / h`, with `h` the mass above the horizon `z > 0` of the LTC whose inverse matrix is
+/// `[[m00, 0, m02], [0, 1, 0], [m20, 0, m22]]` (the tables' form).
+///
+/// The directions `w` with `w.z > 0` are those whose images `w_o = M^-1 w` satisfy
+/// `n . w_o > 0` with `n = M^T e_z`, the last row of `M`; for the tables' form that row is
+/// `(-m20, 0, m00) / det`, `det = m00 m22 - m02 m20`. The clamped cosine's mass in a half-space
+/// whose normal makes an angle `phi` with `+z` is `(1 + cos phi) / 2` (see
+/// [`Ltc::upper_hemisphere_mass`]), with `cos phi = sign(det) m00 / r`, `r = |(m00, m20)|`.
+/// When `cos phi < 0`, `r + r cos phi` is taken as `m20^2 / (r - r cos phi)`, which does not
+/// cancel. The committed table keeps `h >= 1/2` at every lookup (its nodes have `m00 > 0` and
+/// every cell's interpolated determinant is positive, see `tests/ltc_robust.rs`), so `norm` is
+/// at most twice the albedo there; that branch only serves other tables (the fitter's).
+#[inline(always)]
+fn horizon_norm(m00: f64, m20: f64, m02: f64, m22: f64, albedo: f64) -> f64 {
+    let r = sqrt(m00 * m00 + m20 * m20);
+    let t = if m00 * m22 - m02 * m20 >= 0.0 {
+        m00
+    } else {
+        -m00
+    };
+    // `2 r h = r + t`.
+    let twice_rh = if t >= 0.0 { r + t } else { m20 * m20 / (r - t) };
+    albedo * (2.0 * r) / twice_rh
+}
+
 /// A fitted LTC table over (view angle, roughness), with bilinear lookup.
 ///
 /// The crate ships one, for GGX: [`LtcTable::ggx`] (or the shortcut [`lookup`]).
 #[derive(Debug, Clone)]
 pub struct LtcTable {
     grid: Grid,
-    /// Node-major: `nodes[k * n + j]` holds every channel of roughness node `k`, view node `j`,
-    /// so that a bilinear lookup touches four cache lines instead of twenty-eight.
+    /// `norm` is the albedo over the LTC's mass above the horizon (this crate's tables, fitted
+    /// as clipped there); otherwise the albedo itself (a reproduction of the public fit, whose
+    /// LTC is not clipped).
+    horizon_norm: bool,
+    /// Node-major: `nodes[k * n_view + j]` holds every channel of roughness node `k`, view node
+    /// `j`, so that a bilinear lookup touches four cache lines instead of one per channel and
+    /// corner.
     nodes: Cow<'static, [Node]>,
 }
 
@@ -269,18 +445,19 @@ const fn interleave<const N: usize>(channels: [(Channel, &[f64; N]); CHANNELS]) 
     out
 }
 
-static GGX_NODES: [Node; data::SIZE * data::SIZE] = interleave([
+static GGX_NODES: [Node; data::VIEW_NODES * data::ROUGH_NODES] = interleave([
     (Channel::M00, &data::M_INV_00),
     (Channel::M02, &data::M_INV_02),
     (Channel::M20, &data::M_INV_20),
     (Channel::M22, &data::M_INV_22),
-    (Channel::Norm, &data::NORM),
+    (Channel::M11, &data::M_INV_11),
     (Channel::Albedo, &data::ALBEDO),
     (Channel::Fresnel, &data::FRESNEL),
 ]);
 
 static GGX_TABLE: LtcTable = LtcTable {
     grid: GGX_GRID,
+    horizon_norm: true,
     nodes: Cow::Borrowed(&GGX_NODES),
 };
 
@@ -291,10 +468,15 @@ impl LtcTable {
         &GGX_TABLE
     }
 
-    /// Builds a table from per-channel data (`k * n + j` order); used by the fitter.
+    /// Builds a table from per-channel data (`k * n_view + j` order); used by the fitter.
+    /// `horizon_norm`: see the field.
     #[cfg_attr(not(feature = "fit"), allow(dead_code))]
-    pub(crate) fn from_parts(grid: Grid, data: [alloc::vec::Vec<f64>; CHANNELS]) -> Self {
-        let nodes = (0..grid.n * grid.n)
+    pub(crate) fn from_parts(
+        grid: Grid,
+        data: [alloc::vec::Vec<f64>; CHANNELS],
+        horizon_norm: bool,
+    ) -> Self {
+        let nodes = (0..grid.nodes())
             .map(|i| {
                 let mut node = Node([0.0; 8]);
                 for (ch, values) in data.iter().enumerate() {
@@ -305,14 +487,21 @@ impl LtcTable {
             .collect();
         Self {
             grid,
+            horizon_norm,
             nodes: Cow::Owned(nodes),
         }
     }
 
-    /// Number of nodes along each axis.
+    /// Number of nodes along the view axis (index `j` of [`LtcTable::node`]).
     #[must_use]
-    pub fn size(&self) -> usize {
-        self.grid.n
+    pub fn view_nodes(&self) -> usize {
+        self.grid.n_view
+    }
+
+    /// Number of nodes along the roughness axis (index `k` of [`LtcTable::node`]).
+    #[must_use]
+    pub fn roughness_nodes(&self) -> usize {
+        self.grid.n_rough
     }
 
     /// The smallest GGX `alpha` the table resolves; smaller inputs are clamped to it.
@@ -332,7 +521,7 @@ impl LtcTable {
     /// when an index is out of range. Looking up exactly these inputs returns the stored values.
     #[must_use]
     pub fn node(&self, j: usize, k: usize) -> Option<(f64, f64)> {
-        (j < self.grid.n && k < self.grid.n)
+        (j < self.grid.n_view && k < self.grid.n_rough)
             .then(|| (self.grid.node_cos(j), self.grid.node_alpha(k)))
     }
 
@@ -340,9 +529,9 @@ impl LtcTable {
     /// upload the table as a texture; `None` when an index is out of range.
     #[must_use]
     pub fn node_lookup(&self, j: usize, k: usize) -> Option<LtcLookup> {
-        (j < self.grid.n && k < self.grid.n).then(|| {
+        (j < self.grid.n_view && k < self.grid.n_rough).then(|| {
             let v: [f64; CHANNELS] = core::array::from_fn(|ch| self.at(ch, k, j));
-            LtcLookup::from_channels(&v)
+            self.with_norm(LtcLookup::from_channels::<false>(&v))
         })
     }
 
@@ -357,7 +546,7 @@ impl LtcTable {
     }
 
     fn at(&self, ch: usize, k: usize, j: usize) -> f64 {
-        self.nodes[k * self.grid.n + j].0[ch]
+        self.nodes[k * self.grid.n_view + j].0[ch]
     }
 
     /// Looks up the LTC for view cosine `cos_theta_v` (view direction's `z` in the shading frame)
@@ -391,7 +580,24 @@ impl LtcTable {
     #[inline]
     pub fn lookup(&self, cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
         check_inputs(cos_theta_v, alpha)?;
-        Ok(interpolate(&self.grid, &self.nodes, cos_theta_v, alpha))
+        Ok(self.with_norm(interpolate::<false>(
+            &self.grid,
+            &self.nodes,
+            cos_theta_v,
+            alpha,
+        )))
+    }
+
+    /// `l` with the table's rule for `norm` (see the field `horizon_norm`).
+    fn with_norm(&self, l: LtcLookup) -> LtcLookup {
+        if self.horizon_norm {
+            l
+        } else {
+            LtcLookup {
+                norm: l.albedo,
+                ..l
+            }
+        }
     }
 }
 
@@ -439,11 +645,19 @@ fn cell(x: f64, last: usize) -> (usize, f64) {
 ///
 /// Shared by [`LtcTable::lookup`] and, with the committed grid's constants known at compile time,
 /// [`lookup`]; the latter then needs no bounds checks and no loads of the grid's parameters.
+///
+/// `UPPER`: the table is known to keep every interpolated LTC's axis above the horizon (see
+/// [`LtcLookup::from_channels`]).
 #[inline(always)]
-fn interpolate(grid: &Grid, nodes: &[Node], cos_theta_v: f64, alpha: f64) -> LtcLookup {
-    let n = grid.n;
-    let (j0, tx) = cell(grid.view_coord(cos_theta_v), n - 1);
-    let (k0, ty) = cell(grid.rough_coord(alpha), n - 1);
+fn interpolate<const UPPER: bool>(
+    grid: &Grid,
+    nodes: &[Node],
+    cos_theta_v: f64,
+    alpha: f64,
+) -> LtcLookup {
+    let n = grid.n_view;
+    let (j0, tx) = grid.view_cell(cos_theta_v);
+    let (k0, ty) = cell(grid.rough_coord(alpha), grid.n_rough - 1);
     // The four corner nodes lie in one window of the node array: (j0, k0) at its start,
     // (j0, k0 + 1) one row of `n` nodes later.
     let base = k0 * n + j0;
@@ -460,7 +674,7 @@ fn interpolate(grid: &Grid, nodes: &[Node], cos_theta_v: f64, alpha: f64) -> Ltc
     for (ch, out) in v.iter_mut().enumerate() {
         *out = w00 * c00[ch] + w10 * c10[ch] + w01 * c01[ch] + w11 * c11[ch];
     }
-    LtcLookup::from_channels(&v)
+    LtcLookup::from_channels::<UPPER>(&v)
 }
 
 /// Looks up the GGX LTC table: shorthand for `LtcTable::ggx().lookup(cos_theta_v, alpha)`.
@@ -480,7 +694,13 @@ fn interpolate(grid: &Grid, nodes: &[Node], cos_theta_v: f64, alpha: f64) -> Ltc
 #[inline]
 pub fn lookup(cos_theta_v: f64, alpha: f64) -> Result<LtcLookup, GeomError> {
     check_inputs(cos_theta_v, alpha)?;
-    Ok(interpolate(&GGX_GRID, &GGX_NODES, cos_theta_v, alpha))
+    // The committed table keeps every interpolated LTC's axis above the horizon (tested).
+    Ok(interpolate::<true>(
+        &GGX_GRID,
+        &GGX_NODES,
+        cos_theta_v,
+        alpha,
+    ))
 }
 
 #[cfg(test)]
@@ -495,7 +715,7 @@ mod tests {
             (Channel::M02, &data::M_INV_02),
             (Channel::M20, &data::M_INV_20),
             (Channel::M22, &data::M_INV_22),
-            (Channel::Norm, &data::NORM),
+            (Channel::M11, &data::M_INV_11),
             (Channel::Albedo, &data::ALBEDO),
             (Channel::Fresnel, &data::FRESNEL),
         ];
@@ -506,5 +726,40 @@ mod tests {
         }
         // Otherwise a swap of the two off-diagonal channels would go unnoticed.
         assert_ne!(data::M_INV_02, data::M_INV_20);
+    }
+
+    /// `horizon_norm` against the general closed form of the LTC's mass above the horizon
+    /// (`Ltc::upper_hemisphere_mass`, from the forward matrix), for maps of the tables' form of
+    /// either orientation and with the LTC's axis on either side of the horizon (the branch
+    /// without cancellation included).
+    #[test]
+    fn horizon_norm_is_the_albedo_over_the_mass_above_the_horizon() {
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut branches = [0; 2];
+        for _ in 0..2000 {
+            let (m00, m20, m02, m22) = (next(), next() * 3.0, next() * 3.0, next());
+            let m = DMat3::from_cols(
+                DVec3::new(m00, 0.0, m20),
+                DVec3::Y,
+                DVec3::new(m02, 0.0, m22),
+            );
+            let Ok(ltc) = Ltc::from_inverse(m) else {
+                continue;
+            };
+            let h = ltc.upper_hemisphere_mass();
+            let norm = horizon_norm(m00, m20, m02, m22, 0.7);
+            assert!(
+                (norm * h / 0.7 - 1.0).abs() < 1e-9,
+                "{m:?}: {norm} vs 0.7 / {h}"
+            );
+            branches[usize::from(h < 0.5)] += 1;
+        }
+        assert!(branches[0] > 100 && branches[1] > 100, "{branches:?}");
     }
 }

@@ -70,7 +70,7 @@ impl Default for Facts {
 
 impl Facts {
     /// The bounding box only; the other facts are left to be computed on demand.
-    fn bbox(contours: &[Contour]) -> Facts {
+    pub(crate) fn bbox(contours: &[Contour]) -> Facts {
         let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
         for c in contours {
             for &p in &c.pts {
@@ -89,10 +89,23 @@ impl Facts {
         }
     }
 
+    /// Largest coordinate magnitude inside the bounding box (0 for the empty shape).
+    pub(crate) fn bbox_scale(&self) -> f64 {
+        if self.lo.x > self.hi.x {
+            return 0.0;
+        }
+        self.lo.abs().max(self.hi.abs()).max_element()
+    }
+
     /// All facts.
-    fn all(contours: &[Contour]) -> Facts {
+    pub(crate) fn all(contours: &[Contour]) -> Facts {
+        Facts::with_separation(contours, min_separation2(contours))
+    }
+
+    /// All facts, the minimum vertex separation already known.
+    pub(crate) fn with_separation(contours: &[Contour], sep2: f64) -> Facts {
         Facts {
-            sep2: Some(min_separation2(contours)),
+            sep2: Some(sep2),
             self_contacts: Some(has_self_contacts(contours)),
             ..Facts::bbox(contours)
         }
@@ -354,7 +367,7 @@ impl Shape {
 
 /// Drops a repeated closing point, consecutive duplicates and exactly collinear middle points
 /// (spikes included), until none is left.
-fn clean_ring(mut pts: Vec<DVec2>) -> Vec<DVec2> {
+pub(crate) fn clean_ring(mut pts: Vec<DVec2>) -> Vec<DVec2> {
     // Each pass removes at least one point or stops, so the loop is bounded by the length.
     loop {
         let n = pts.len();
@@ -370,7 +383,12 @@ fn clean_ring(mut pts: Vec<DVec2>) -> Vec<DVec2> {
                 Some(&l) => l,
                 None => pts[n - 1],
             };
-            let c = pts[(i + 1) % n];
+            // The last point's successor is the first point kept, not the first point given
+            // (a repeated closing point has just dropped that one).
+            let c = match (i + 1 == n, out.first()) {
+                (true, Some(&f)) => f,
+                _ => pts[(i + 1) % n],
+            };
             if b == a || b == c || orient(a, b, c) == 0.0 {
                 changed = true;
                 continue;
@@ -388,7 +406,7 @@ fn clean_ring(mut pts: Vec<DVec2>) -> Vec<DVec2> {
 
 /// Rejects rings that cross or overlap themselves or each other; isolated touching points
 /// between different rings are allowed.
-fn check_crossings(rings: &[Vec<DVec2>]) -> Result<(), GeomError> {
+pub(crate) fn check_crossings(rings: &[Vec<DVec2>]) -> Result<(), GeomError> {
     for (ri, r) in rings.iter().enumerate() {
         let n = r.len();
         // Within one ring: non-adjacent edges must not meet at all.
@@ -503,7 +521,7 @@ fn nesting_depths(rings: &[Vec<DVec2>]) -> Vec<usize> {
 }
 
 /// Whether ring `r` lies inside ring `s` (rings known not to cross).
-fn ring_inside(r: &[DVec2], s: &[DVec2]) -> bool {
+pub(crate) fn ring_inside(r: &[DVec2], s: &[DVec2]) -> bool {
     let n = r.len();
     // A vertex off `s` decides; if all vertices touch `s`, an edge midpoint does (an edge with
     // both ends on `s` and not overlapping it runs strictly inside or outside).

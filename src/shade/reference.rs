@@ -30,7 +30,7 @@ use crate::sphere::SphericalTriangle;
 /// PCG32 (O'Neill 2014, `XSH RR` output): a small, fast, deterministic generator, so that the
 /// crate needs no RNG dependency and every estimate is reproducible from its seed.
 #[derive(Debug, Clone)]
-pub struct Pcg32 {
+pub(crate) struct Pcg32 {
     state: u64,
     inc: u64,
 }
@@ -38,7 +38,7 @@ pub struct Pcg32 {
 impl Pcg32 {
     /// A generator for `seed` on stream `stream` (different streams are independent sequences).
     #[must_use]
-    pub fn new(seed: u64, stream: u64) -> Self {
+    pub(crate) fn new(seed: u64, stream: u64) -> Self {
         let mut r = Pcg32 {
             state: 0,
             inc: (stream << 1) | 1,
@@ -50,7 +50,7 @@ impl Pcg32 {
     }
 
     /// The next 32 random bits.
-    pub fn next_u32(&mut self) -> u32 {
+    pub(crate) fn next_u32(&mut self) -> u32 {
         let old = self.state;
         self.state = old
             .wrapping_mul(6_364_136_223_846_793_005)
@@ -61,14 +61,14 @@ impl Pcg32 {
     }
 
     /// Uniform in `[0, 1)` with 53 random bits.
-    pub fn next_f64(&mut self) -> f64 {
+    pub(crate) fn next_f64(&mut self) -> f64 {
         let hi = u64::from(self.next_u32()) << 21;
         let lo = u64::from(self.next_u32()) >> 11;
         ((hi | lo) as f64) * (1.0 / (1u64 << 53) as f64)
     }
 
     /// Two uniform numbers in `[0, 1)`.
-    pub fn next_2d(&mut self) -> DVec2 {
+    pub(crate) fn next_2d(&mut self) -> DVec2 {
         DVec2::new(self.next_f64(), self.next_f64())
     }
 }

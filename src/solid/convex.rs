@@ -87,7 +87,7 @@ impl ConvexPolyhedron {
                 }
             }
         }
-        if let Some(e) = mesh.edges().iter().find(|e| e.f1.is_none()) {
+        if let Some(e) = mesh.edges().iter().find(|e| e.twin().is_none()) {
             return Err(GeomError::OpenMesh {
                 triangle: e.f0 as usize,
             });

@@ -39,12 +39,21 @@ pub enum Side {
     Front,
 }
 
+/// Whether the signed distance `s` is [`Side::Front`] given the tolerance `tol`: the one test
+/// of [`Side::of`] that callers deciding only front faces (convex silhouettes) need, spelled out
+/// so that it compiles to one comparison.
+#[inline]
+#[must_use]
+pub(crate) fn in_front(s: f64, tol: f64) -> bool {
+    s > tol
+}
+
 impl Side {
     /// The side of a signed distance `s` given the tolerance `tol` (see [`face_side`]).
     #[inline]
     #[must_use]
     pub(crate) fn of(s: f64, tol: f64) -> Side {
-        if s > tol {
+        if in_front(s, tol) {
             Side::Front
         } else if s < -tol {
             Side::Behind

@@ -85,10 +85,23 @@ pub struct MeshEdge {
     pub b: u32,
     /// The triangle around which `a -> b` is counter-clockwise.
     pub f0: u32,
-    /// The triangle running `b -> a` along the same edge; `None` on a border (the edge belongs to
-    /// `f0` alone) and on a non-manifold or inconsistently oriented edge (more than two triangles,
-    /// or two running the same way: each of them is then listed as an edge of its own).
-    pub f1: Option<u32>,
+    /// The triangle running `b -> a` along the same edge, or [`MeshEdge::BORDER`] on a border (the
+    /// edge belongs to `f0` alone) and on a non-manifold or inconsistently oriented edge (more
+    /// than two triangles, or two running the same way: each of them is then listed as an edge of
+    /// its own). A plain index rather than an `Option`, so that the silhouette loop over a convex
+    /// polyhedron's edges (all paired) tests nothing.
+    pub f1: u32,
+}
+
+impl MeshEdge {
+    /// The value of [`MeshEdge::f1`] for an edge with one triangle.
+    pub const BORDER: u32 = u32::MAX;
+
+    /// The second triangle, `None` for a border or non-manifold edge.
+    #[must_use]
+    pub fn twin(&self) -> Option<u32> {
+        (self.f1 != MeshEdge::BORDER).then_some(self.f1)
+    }
 }
 
 /// A triangle mesh: vertices and index triples. Triangles are counter-clockwise seen from the
@@ -112,7 +125,7 @@ pub struct MeshEdge {
 /// assert_eq!(quad.triangle_count(), 2);
 /// assert!(quad.triangle_normal(0).z < 0.0);
 /// // The diagonal is shared; the four sides are borders.
-/// assert_eq!(quad.edges().iter().filter(|e| e.f1.is_some()).count(), 1);
+/// assert_eq!(quad.edges().iter().filter(|e| e.twin().is_some()).count(), 1);
 /// assert_eq!(quad.edges().len(), 5);
 /// # Ok::<(), arealight::GeomError>(())
 /// ```
@@ -319,7 +332,7 @@ fn edge_adjacency(triangles: &[[u32; 3]]) -> (Vec<MeshEdge>, bool) {
                 a: lo,
                 b: hi,
                 f0,
-                f1: Some(f1),
+                f1,
             });
         } else {
             closed = false;
@@ -329,7 +342,7 @@ fn edge_adjacency(triangles: &[[u32; 3]]) -> (Vec<MeshEdge>, bool) {
                     a,
                     b,
                     f0: f,
-                    f1: None,
+                    f1: MeshEdge::BORDER,
                 });
             }
         }
@@ -398,7 +411,7 @@ mod tests {
         assert_eq!(m.edges().len(), 3 * m.triangle_count() / 2);
         let mut per_triangle = vec![0; m.triangle_count()];
         for e in m.edges() {
-            let f1 = e.f1.unwrap();
+            let f1 = e.twin().unwrap();
             assert!(runs(m, e.f0, e.a, e.b) && runs(m, f1, e.b, e.a), "{e:?}");
             per_triangle[e.f0 as usize] += 1;
             per_triangle[f1 as usize] += 1;
@@ -416,7 +429,7 @@ mod tests {
         assert!(
             on_01
                 .iter()
-                .all(|e| e.f1.is_none() && runs(&fan, e.f0, e.a, e.b))
+                .all(|e| e.twin().is_none() && runs(&fan, e.f0, e.a, e.b))
         );
         assert!(!fan.is_closed());
     }

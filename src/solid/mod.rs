@@ -22,15 +22,20 @@
 //! - Thesis 003: section 4.2 (silhouettes of convex polyhedra oriented by front faces).
 
 mod body;
+mod closed;
 mod convex;
 pub(crate) mod facing;
+pub(crate) mod fixtures;
 mod frame;
 mod mesh;
 mod primitives;
 pub(crate) mod separation;
 pub(crate) mod silhouette;
 
+pub use silhouette::{DEFAULT_REGION_RADII, SilhouetteBsp, nonconvex_silhouette};
+
 pub use body::Body;
+pub use closed::ClosedMesh;
 pub use convex::ConvexPolyhedron;
 pub use facing::{FACE_TOLERANCE, Side, face_side};
 pub use frame::ShadingFrame;

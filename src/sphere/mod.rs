@@ -1,5 +1,6 @@
 //! Spherical polygons: construction and validation, solid angle, containment, gnomonic
-//! projection, ordering of silhouette edges and hemisphere clipping.
+//! projection, ordering of silhouette edges, hemisphere clipping, triangulation and uniform
+//! sampling by solid angle.
 //!
 //! Directions are unit `DVec3`s; edges are minor great-circle arcs; the interior of a ring lies
 //! on its left (see [`SphericalPolygon`]). This layer knows nothing of light: it is the geometry
@@ -11,7 +12,8 @@ mod gnomonic;
 mod order;
 mod polygon;
 pub(crate) mod predicates;
-mod sample; // [shade] solid-angle sampling of spherical triangles
+mod sample;
+mod triangulate;
 mod wolfe;
 
 pub use boolean::MIN_CAP_COS;
@@ -19,5 +21,5 @@ pub use clip::HORIZON_TOLERANCE;
 pub use gnomonic::{Gnomonic, enclosing_cap};
 pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};
-pub use sample::SphericalTriangle; // [shade]
+pub use sample::{PolygonSampler, SAMPLE_TOLERANCE, SphericalTriangle};
 pub(crate) use wolfe::min_norm_point;

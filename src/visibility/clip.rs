@@ -13,14 +13,20 @@ use crate::planar::BoolOp;
 use crate::solid::facing::{Side, face_side, snapped_distance};
 use crate::solid::separation::{Separation, separating_plane};
 use crate::solid::silhouette::{
-    TriangleRole, clipped_triangle_polygon, convex_silhouette, triangle_polygon,
+    TriangleRole, clipped_triangle_polygon, convex_silhouette, nonconvex_silhouette,
+    triangle_polygon,
 };
-use crate::solid::{Body, BoundingSphere, ShadingFrame, TriangleMesh};
+use crate::solid::{Body, BoundingSphere, ClosedMesh, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
 
 /// What a failed union of a mesh light's front faces reports: the faces are valid polygons, so
 /// any error of [`SphericalPolygon::boolean`] is a rounding give-up.
 const UNION_FAILED: &str = "the union of a mesh light's front triangles failed within rounding";
+
+/// What a face's piece that grew under subtractions reports (the face-by-face path of
+/// [`ClipVisibility::visible_region`]).
+const DIFFERENCE_GREW: &str =
+    "subtracting blockers from a light face returned more than the face within rounding";
 
 /// What a failed subtraction of a blocker's region reports (as [`UNION_FAILED`]).
 const DIFFERENCE_FAILED: &str =
@@ -54,6 +60,9 @@ pub struct ClipVisibility<L> {
     light_bounds: Vec<BoundingSphere>,
     occluder_bounds: Vec<BoundingSphere>,
     method: Method,
+    /// Per light: its mesh validated as a solid ([`ClosedMesh`]) when it is a closed,
+    /// non-planar mesh light that bounds one (then its region is its non-convex silhouette).
+    solids: Vec<Option<ClosedMesh>>,
     /// Per light `i` and blocker slot `j` (occluders first, then lights, see
     /// [`ClipVisibility::slot`]), at `i * blockers + j`: a plane separating the convex hulls of
     /// the two, or `None` when they overlap (the blocker interpenetrates the light, or is the
@@ -78,7 +87,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// Computes, once, a separating plane between every light and every other object (the fast
     /// path of [`ClipVisibility::visible_region`]): `lights x (occluders + lights)`
     /// minimum-norm-point runs, each a few passes over the two vertex lists (and, only for hulls
-    /// that touch, one scan of their face normals).
+    /// that touch, one scan of their face normals); and validates each closed non-planar mesh
+    /// light as a solid ([`ClosedMesh::new`], about `n log n` in its triangle count), which
+    /// lets its region be its silhouette.
     #[must_use]
     pub fn new(lights: Vec<L>, occluders: Vec<Body>) -> Self {
         let light_bounds = lights
@@ -100,12 +111,20 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 });
             }
         }
+        let solids = lights
+            .iter()
+            .map(|l| match l.as_ref() {
+                Body::Mesh(m) if m.is_closed() && !m.is_planar() => ClosedMesh::new(m.clone()).ok(),
+                _ => None,
+            })
+            .collect();
         ClipVisibility {
             lights,
             occluders,
             light_bounds,
             occluder_bounds,
             method: Method::Silhouette,
+            solids,
             separations,
         }
     }
@@ -265,25 +284,34 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// [`ClipVisibility::visible_region`] with all blockers (`blocked`) or none but the light's
-    /// own triangles, its pieces checked by [`upper_pieces`].
+    /// own triangles. The pieces of the paths that run many set operations on single or cut
+    /// triangles (the per-triangle method, mesh lights, face by face) are checked by
+    /// [`upper_pieces`]; the silhouette of a convex light minus whole silhouettes, the path a
+    /// renderer runs most, costs no check.
     fn region(
         &self,
         light: usize,
         frame: &ShadingFrame,
         blocked: bool,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        upper_pieces(self.region_unchecked(light, frame, blocked)?)
+        let (pieces, checked) = self.region_unchecked(light, frame, blocked)?;
+        if checked {
+            upper_pieces(pieces)
+        } else {
+            Ok(pieces)
+        }
     }
 
+    /// The region and whether its pieces need [`upper_pieces`] (see [`ClipVisibility::region`]).
     fn region_unchecked(
         &self,
         light: usize,
         frame: &ShadingFrame,
         blocked: bool,
-    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+    ) -> Result<(Vec<SphericalPolygon>, bool), GeomError> {
         let body = self.light_body(light)?;
         if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[light]) {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), false));
         }
         let mesh = body.mesh();
         // Step 2: separated blockers (culled ones, behind the light, are not even listed).
@@ -337,10 +365,14 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 }
                 out.retain(|p| !p.is_empty());
             }
-            return Ok(out);
+            // Checked where pieces came out of set operations on single triangles: differences
+            // (whole blockers) or the union of a non-convex mesh light's front faces.
+            let silhouette = matches!((body, self.method), (Body::Convex(_), Method::Silhouette));
+            let combined =
+                !whole.is_empty() || (matches!(body, Body::Mesh(_)) && !mesh.is_planar());
+            return Ok((out, !silhouette && combined));
         }
         // Step 4: face by face.
-        let up = DVec3::Z;
         let mut whole_regions = Vec::new();
         for &b in &whole {
             self.blocker_regions(light, b, frame, &mut whole_regions)?;
@@ -353,7 +385,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             let Some(piece) = triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? else {
                 continue;
             };
-            let mut piece = subtract_all(piece.clip_to_hemisphere(up), &whole_regions)?;
+            let face_part = upper_part(&piece)?;
+            let mut piece = subtract_all(face_part.clone(), &whole_regions)?;
             for (k, (b, reach)) in straddling.iter().enumerate() {
                 let b = *b;
                 if piece.is_empty() {
@@ -379,10 +412,17 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 piece = subtract_cut(piece, body, false, mesh, f, frame)?;
             }
             if !piece.is_empty() {
+                // Differences only remove: a piece larger than the face's part it started from
+                // is a set operation gone wrong within rounding. The face-by-face path runs many
+                // differences of cut slivers, where the sphere layer is most exposed; two solid
+                // angles per face are small next to them.
+                if piece.solid_angle() > face_part.solid_angle() * (1.0 + 1e-9) + 1e-12 {
+                    return Err(GeomError::Undecidable(DIFFERENCE_GREW));
+                }
                 out.push(piece);
             }
         }
-        Ok(out)
+        Ok((out, true))
     }
 
     /// How blocker `b` acts on front triangle `f` of light `light` (step 3 of
@@ -412,6 +452,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// - a convex light with [`Method::PerTriangle`], or a planar mesh light: each front-facing
     ///   triangle, one piece each (seed 000 section 4.4). Their projections cannot overlap, so
     ///   their integrals add up exactly;
+    /// - a closed mesh light that bounds a solid ([`ClosedMesh`]) with [`Method::Silhouette`]:
+    ///   its silhouette ([`nonconvex_silhouette`], thesis 003 section 4.3), one piece: the union
+    ///   of its front faces' projections without computing a union. Where the silhouette gives
+    ///   up (the point in the plane of a face that bounds it, or on the surface), the union
+    ///   below is computed instead;
     /// - any other mesh light: the union of its front-facing triangles, one piece. The union, not
     ///   the sum, makes a non-convex light's self-occlusion right: where front faces overlap in
     ///   projection, the nearer one is seen, with the same radiance.
@@ -434,21 +479,29 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        let up = DVec3::Z;
         let body = self.light_body(light)?;
-        if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
-            let s = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
-            return Ok(if s.is_empty() {
+        let one = |s: SphericalPolygon| {
+            if s.is_empty() {
                 Vec::new()
             } else {
                 alloc::vec![s]
-            });
+            }
+        };
+        if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
+            return Ok(one(upper_part(&convex_silhouette(p, frame)?)?));
+        }
+        if let (Some(solid), Method::Silhouette) = (&self.solids[light], self.method) {
+            match nonconvex_silhouette(solid, frame) {
+                Ok(s) => return Ok(one(upper_part(&s)?)),
+                Err(e) if e.is_undecidable() => {}
+                Err(e) => return Err(e),
+            }
         }
         let mesh = body.mesh();
         let mut pieces = Vec::new();
         for t in 0..mesh.triangle_count() {
             if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Emitter)? {
-                let p = p.clip_to_hemisphere(up);
+                let p = upper_part(&p)?;
                 if !p.is_empty() {
                     pieces.push(p);
                 }
@@ -478,12 +531,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         frame: &ShadingFrame,
         out: &mut Vec<SphericalPolygon>,
     ) -> Result<(), GeomError> {
-        let up = DVec3::Z;
         let (x, n) = (frame.origin(), frame.normal());
         let lb = self.light_bounds[light];
         match (self.blocker(b).0, self.method) {
             (Body::Convex(p), Method::Silhouette) => {
-                let occ = convex_silhouette(p, frame)?.clip_to_hemisphere(up);
+                let occ = upper_part(&convex_silhouette(p, frame)?)?;
                 if !occ.is_empty() {
                     out.push(occ);
                 }
@@ -495,7 +547,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                         continue;
                     }
                     if let Some(p) = triangle_polygon(mesh, t, frame, TriangleRole::Blocker)? {
-                        let p = p.clip_to_hemisphere(up);
+                        let p = upper_part(&p)?;
                         if !p.is_empty() {
                             out.push(p);
                         }
@@ -541,7 +593,6 @@ fn subtract_cut(
     f: usize,
     frame: &ShadingFrame,
 ) -> Result<SphericalPolygon, GeomError> {
-    let up = DVec3::Z;
     let (x, up_world) = (frame.origin(), frame.normal());
     let face_bound = triangle_bound(light_mesh.triangle(f));
     let bm = blocker.mesh();
@@ -560,7 +611,7 @@ fn subtract_cut(
         // Cut by the same predicate that decided the blocker straddles the face.
         let dist = bm.triangle(t).map(|v| snapped_distance(light_mesh, f, v));
         if let Some(p) = clipped_triangle_polygon(bm, t, dist, frame)? {
-            let p = p.clip_to_hemisphere(up);
+            let p = upper_part(&p)?;
             if !p.is_empty() {
                 piece = piece
                     .boolean(&p, BoolOp::Difference)
@@ -572,6 +623,59 @@ fn subtract_cut(
         }
     }
     Ok(piece)
+}
+
+/// What a clip that added part of the horizon outside its polygon reports (see [`upper_part`]).
+const CLIP_LEFT_POLYGON: &str =
+    "the horizon clip of a region added a horizon arc outside the region within rounding";
+
+/// Both ends of an edge within this of the horizon (in `z`) make it a horizon edge for
+/// [`upper_part`].
+const ON_HORIZON: f64 = 1e-12;
+
+/// Horizon edges at least this long (radians) are checked by [`upper_part`]: what a clip that
+/// joins an exit to an entry the long way round the circle adds is this long (its arcs are up to
+/// `2 pi / 3`); the short ones of a region cut by the horizon near the point cost no check.
+const LONG_ARC: f64 = 0.5;
+
+/// How far above a horizon edge's midpoint (radians) [`upper_part`] looks for the region.
+const ABOVE_ARC: f64 = 1e-7;
+
+/// The part of `p` in the upper hemisphere (`clip_to_hemisphere(+z)`), checked where the clip
+/// added a long arc of the horizon.
+///
+/// The clipped region lies above each of its horizon edges and inside `p`, so the direction
+/// [`ABOVE_ARC`] above such an edge's midpoint is in `p` (unless `p` is thinner than that there).
+/// A clip that joins the points where a sliver of `p` leaves and re-enters the hemisphere the
+/// long way round the circle breaks this (a whole hemisphere for a sliver, or a ring that runs
+/// over itself along the circle), and would be integrated as a large part of the sky: it is a
+/// give-up, [`GeomError::Undecidable`]. One containment test per long horizon edge.
+fn upper_part(p: &SphericalPolygon) -> Result<SphericalPolygon, GeomError> {
+    let c = p.clip_to_hemisphere(DVec3::Z);
+    // Most parts do not touch the horizon at all (a light above it): one pass over the
+    // vertices, without the edge pairs.
+    let mut touches = false;
+    for r in c.rings() {
+        for v in r {
+            touches |= v.z.abs() <= ON_HORIZON;
+        }
+    }
+    if !touches || p.is_full() {
+        return Ok(c);
+    }
+    for r in c.rings() {
+        for k in 0..r.len() {
+            let (a, b) = (r[k], r[(k + 1) % r.len()]);
+            if a.z.abs() <= ON_HORIZON
+                && b.z.abs() <= ON_HORIZON
+                && a.angle_between(b) >= LONG_ARC
+                && !p.contains((a + b).normalize() + DVec3::Z * ABOVE_ARC)
+            {
+                return Err(GeomError::Undecidable(CLIP_LEFT_POLYGON));
+            }
+        }
+    }
+    Ok(c)
 }
 
 /// What a region that left the upper hemisphere reports (see [`upper_pieces`]).

@@ -97,6 +97,83 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     ))
 }
 
+/// Splits the rings of one ring soup at every contact among all its edges, within a ring and
+/// across rings, to the same fixpoint as [`split`]: afterwards any two edges meet only in shared
+/// endpoints or are identical (the same two points, in either direction).
+///
+/// This is [`split`] with both operands the same edge set, welding after every pass. Every unordered pair of distinct
+/// edges is classified once by the same pair test, so crossings, vertices on or within the
+/// snapping distance of edges, and collinear overlaps (a ring doubling back over itself, two rings
+/// sharing a stretch) are resolved by the same rules and snapped to the same points. Pairs of
+/// edges that follow each other in a ring share an endpoint and are settled by the test's
+/// common-endpoint shortcut unless they fold back onto each other.
+pub(crate) fn split_within(r: &mut Rings, scale: f64) -> Result<(), GeomError> {
+    let snap2 = {
+        let s = SNAP_REL * scale;
+        s * s
+    };
+    let mut dirty: SmallVec<[bool; 64]> = SmallVec::new();
+    let mut ins = Inserts::new();
+    let mut ins_b = Inserts::new();
+    let mut by_x = SnapIndex::default();
+    let mut boxes: SmallVec<[EdgeBox; 32]> = SmallVec::new();
+    let mut events: SmallVec<[(f64, u32); 64]> = SmallVec::new();
+    let mut active: SmallVec<[u32; 32]> = SmallVec::new();
+    for pass in 0..MAX_PASSES {
+        ins.clear();
+        ins_b.clear();
+        edge_boxes(r, &mut boxes);
+        let bx: &[EdgeBox] = &boxes;
+        let mut test = |i: usize, j: usize| {
+            let (box_i, p0, p1) = &bx[i];
+            let (box_j, q0, q1) = &bx[j];
+            if boxes_overlap(box_i, box_j) {
+                pair(
+                    [*p0, *p1, *q0, *q1],
+                    (i as u32, j as u32),
+                    (&mut by_x, &r.pts, &[]),
+                    snap2,
+                    &mut ins,
+                    &mut ins_b,
+                );
+            }
+        };
+        let is_dirty = |i: usize| pass == 0 || dirty.get(i).copied().unwrap_or(true);
+        // A sweep over the edges' left ends: only pairs whose x-ranges overlap are tested, and
+        // after the first pass only pairs with an edge next to a point inserted by the last one.
+        events.clear();
+        events.extend(bx.iter().enumerate().map(|(i, e)| (e.0[0], i as u32)));
+        events.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        active.clear();
+        for &(x, id) in &events {
+            let i = id as usize;
+            active.retain(|j| bx[*j as usize].0[1] >= x);
+            for &j in &active {
+                let j = j as usize;
+                if is_dirty(i) || is_dirty(j) {
+                    test(j, i);
+                }
+            }
+            active.push(id);
+        }
+        ins.extend(ins_b.drain(..));
+        if ins.is_empty() {
+            return Ok(());
+        }
+        apply(r, &mut ins, &mut dirty);
+        // Three or more edges through one point (a ring crossing two edges that overlap each
+        // other, or a triple crossing) give one crossing per pair, each off by its own rounding:
+        // points an ulp apart that would be inserted into each other's edges pass after pass.
+        // Welding makes them one vertex; the rebuilt rings are tested again in full.
+        if weld(r, &mut Rings::default(), scale) == Weld::Moved {
+            dirty.clear();
+        }
+    }
+    Err(GeomError::Degenerate(
+        "edge intersections did not settle; the rings have long nearly-overlapping edges",
+    ))
+}
+
 /// What [`weld`] found among the operands' vertices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Weld {

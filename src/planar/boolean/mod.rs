@@ -284,17 +284,23 @@ fn run(
 ) -> Result<Option<Shape>, GeomError> {
     // Trivial cases first: they need no geometry and keep chains of operations cheap.
     if a.is_empty() || b.is_empty() {
-        return Ok(Some(match op {
-            BoolOp::Intersection => Shape::empty(),
-            BoolOp::Difference => a.clone(),
-            BoolOp::Union | BoolOp::Xor => {
-                if a.is_empty() {
-                    b.clone()
-                } else {
-                    a.clone()
-                }
-            }
-        }));
+        let s = if a.is_empty() { b } else { a };
+        let passes = match op {
+            BoolOp::Intersection => true,
+            BoolOp::Difference => a.is_empty() || settled(a, s.facts.bbox_scale()),
+            BoolOp::Union | BoolOp::Xor => settled(s, s.facts.bbox_scale()),
+        };
+        if passes {
+            return Ok(Some(match op {
+                BoolOp::Intersection => Shape::empty(),
+                BoolOp::Difference => a.clone(),
+                BoolOp::Union | BoolOp::Xor => s.clone(),
+            }));
+        }
+        if path == Path::FastOnly {
+            return Ok(None);
+        }
+        return robust(ws, a, b, op, s.facts.bbox_scale()).map(Some);
     }
     let (fa, fb) = (&a.facts, &b.facts);
     let (box_a, box_b) = (
@@ -307,18 +313,25 @@ fn run(
             hi: fb.hi,
         },
     );
-    if box_a.disjoint(&box_b) {
-        return Ok(Some(match op {
-            BoolOp::Intersection => Shape::empty(),
-            BoolOp::Difference => a.clone(),
-            BoolOp::Union | BoolOp::Xor => {
-                let mut c: Vec<Contour> = a.contours.clone();
-                c.extend(b.contours.iter().cloned());
-                Shape::from_contours(c)
-            }
-        }));
-    }
     let scale = box_a.scale().max(box_b.scale());
+    if box_a.disjoint(&box_b) {
+        let passes = match op {
+            BoolOp::Intersection => true,
+            BoolOp::Difference => settled(a, scale),
+            BoolOp::Union | BoolOp::Xor => settled(a, scale) && settled(b, scale),
+        };
+        if passes {
+            return Ok(Some(match op {
+                BoolOp::Intersection => Shape::empty(),
+                BoolOp::Difference => a.clone(),
+                BoolOp::Union | BoolOp::Xor => {
+                    let mut c: Vec<Contour> = a.contours.clone();
+                    c.extend(b.contours.iter().cloned());
+                    Shape::from_contours(c)
+                }
+            }));
+        }
+    }
     // The fast path needs operands in generic position, in particular no two vertices within
     // the snapping distance (which `weld` would merge) and no vertex of an operand on an edge
     // of another of its contours (which `split_self_contacts` would insert). Within an operand
@@ -345,6 +358,33 @@ fn run(
     if path == Path::FastOnly {
         return Ok(None);
     }
+    robust(ws, a, b, op, scale).map(Some)
+}
+
+/// Whether the operation's result may take the contours of `s` as they are: every contour bounds
+/// more than a sliver at `scale` and, for shapes from [`Shape::new`] (whose minimum vertex
+/// separation is cached), no two vertices are within the snapping distance. Results of earlier
+/// operations were welded and regularized at a scale at least their own; only a larger `scale`
+/// can turn their loops into slivers.
+///
+/// Otherwise the robust pipeline runs even against the empty shape, and welds and drops what any
+/// other operation would.
+fn settled(s: &Shape, scale: f64) -> bool {
+    let snap = intersect::SNAP_REL * scale;
+    s.facts.sep2.is_none_or(|d| d > snap * snap)
+        && s.contours
+            .iter()
+            .all(|c| trace::clearly_survives(&c.pts, scale))
+}
+
+/// The robust pipeline (weld, split, label, trace) on any two shapes.
+fn robust(
+    ws: &mut Workspace,
+    a: &Shape,
+    b: &Shape,
+    op: BoolOp,
+    scale: f64,
+) -> Result<Shape, GeomError> {
     ws.a.fill(a);
     ws.b.fill(b);
     intersect::weld(&mut ws.a, &mut ws.b, scale);
@@ -357,7 +397,7 @@ fn run(
     let contours = trace::trace(&edges, l.ra.pts.len() + l.rb.pts.len(), l.scale)?;
     // Give the (possibly spilled) buffers back for the next call.
     (ws.a, ws.b) = (l.ra, l.rb);
-    Ok(Some(Shape::from_contours(contours)))
+    Ok(Shape::from_contours(contours))
 }
 
 /// [`boolean`] through the robust pipeline only, skipping the generic-position fast path; for

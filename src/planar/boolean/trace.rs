@@ -48,6 +48,13 @@ pub(crate) struct Edge {
     q: DVec2,
 }
 
+impl Edge {
+    /// A directed edge from node `from` at `p` to node `to` at `q`.
+    pub(crate) fn new(from: u32, to: u32, p: DVec2, q: DVec2) -> Edge {
+        Edge { from, to, p, q }
+    }
+}
+
 pub(crate) type Edges = SmallVec<[Edge; 64]>;
 
 /// Collects the directed result edges of both operands for `op`.
@@ -268,6 +275,24 @@ pub(crate) fn regularize(pts: impl Iterator<Item = DVec2>, scale: f64) -> Option
         }
     }
     survives(&out, scale).then(|| Contour { pts: out.to_vec() })
+}
+
+/// [`survives`] with a square-root-free test first: the perimeter is at most the sum of the
+/// edges' `|dx| + |dy|`, so an area above [`SLIVER_REL`] times the scale times that sum passes
+/// without measuring the perimeter.
+pub(crate) fn clearly_survives(pts: &[DVec2], scale: f64) -> bool {
+    let n = pts.len();
+    let l1: f64 = pts
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .chain(core::iter::once((pts[n - 1], pts[0])))
+        .map(|(p, q)| {
+            let d = (q - p).abs();
+            d.x + d.y
+        })
+        .sum();
+    let area2 = signed_area2(pts).abs();
+    area2 > SLIVER_REL * scale * l1 || survives(pts, scale)
 }
 
 /// Whether a loop without repeated or collinear consecutive points bounds more than a sliver:

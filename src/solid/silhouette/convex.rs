@@ -60,8 +60,7 @@ pub fn convex_silhouette(
     let mut contour: SmallVec<[(u32, u32); 24]> = SmallVec::new();
     for e in poly.edges() {
         // Every edge of a convex polyhedron has both faces (checked by `from_mesh`).
-        let Some(f1) = e.f1 else { continue };
-        match (front(s[e.f0 as usize]), front(s[f1 as usize])) {
+        match (front(s[e.f0 as usize]), front(s[e.f1 as usize])) {
             (true, false) => contour.push((e.b, e.a)),
             (false, true) => contour.push((e.a, e.b)),
             _ => {}
@@ -121,7 +120,7 @@ fn order_edges_of(
 /// Walks directed edges (vertex index pairs) as one loop: `Some(vertex indices)` when every
 /// vertex used has exactly one outgoing edge and the walk from the first edge uses all of them,
 /// `None` otherwise (several loops or pinches: left to the general path).
-fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<SmallVec<[u32; 24]>> {
+pub(crate) fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<SmallVec<[u32; 24]>> {
     const NONE: u32 = u32::MAX;
     if edges.len() < 3 {
         return None;

@@ -1,12 +1,18 @@
 //! Spherical polygons of objects seen from a point, in the [`ShadingFrame`](crate::solid::ShadingFrame):
 //! the silhouette of a convex polyhedron (one polygon per point), and single mesh triangles,
-//! whole or cut by a plane (the per-triangle method). Non-convex silhouettes will sit beside
-//! these.
+//! whole or cut by a plane (the per-triangle method), and the silhouette of any closed mesh
+//! (non-convex, thesis 003 section 4.3).
 
+mod bsp;
 mod convex;
+mod nonconvex;
 mod triangle;
 
+pub use bsp::{DEFAULT_REGION_RADII, SilhouetteBsp};
 pub use convex::convex_silhouette;
+pub use nonconvex::nonconvex_silhouette;
+#[allow(unused_imports)]
+pub(crate) use nonconvex::{Arc, Outline, evaluate_rings, outline};
 pub(crate) use triangle::clipped_triangle_polygon;
 pub use triangle::{TriangleRole, triangle_polygon};
 

@@ -1,6 +1,5 @@
-//! Helpers shared by the planar integration tests: a compact text format for shapes, the
-//! identity checks, and adapters to the reference clippers (i_overlay, clipper2).
-#![allow(dead_code)]
+//! Planar shapes: a compact text format, the identity checks, generators (proptest strategies
+//! and the benchmark polygons), and adapters to the reference clippers (i_overlay, clipper2).
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
@@ -225,6 +224,20 @@ pub fn bench_polygon(n: usize, center: DVec2, phase: f64, star: bool) -> Vec<DVe
             let t = phase + std::f64::consts::TAU * k as f64 / n as f64;
             let r = if star && k % 2 == 1 { 0.55 } else { 1.0 };
             center + DVec2::new(t.cos(), t.sin()) * r
+        })
+        .collect()
+}
+
+/// A star ring of `n` vertices (`n` even, not a multiple of 3) that crosses itself: the star
+/// polygon {n/3} (vertex `j` at angle `3 * 2 pi j / n`, going three times around the centre)
+/// with radii alternating 1 and 0.6, so that each edge crosses the edges of the neighbouring
+/// turns (a few crossings per vertex) and the faces wind up to three times.
+pub fn self_intersecting_star(n: usize) -> Vec<DVec2> {
+    (0..n)
+        .map(|j| {
+            let t = std::f64::consts::TAU * (3 * j) as f64 / n as f64;
+            let r = if j % 2 == 0 { 1.0 } else { 0.6 };
+            DVec2::new(t.cos(), t.sin()) * r
         })
         .collect()
 }

@@ -1,40 +1,11 @@
-//! Helpers shared by the integration tests: a small deterministic RNG, polygon generators and an
-//! independent Monte Carlo estimator of solid angles with a stated confidence bound.
-#![allow(dead_code)]
+//! Spherical generators and references: polygons star-shaped about a direction, an independent
+//! stratified Monte Carlo estimator of solid angles and integrals with a stated confidence bound,
+//! Gauss-Legendre quadrature over spherical triangles.
 
+use super::Rng;
 use arealight::glam::DVec3;
 use arealight::sphere::SphericalPolygon;
 use std::f64::consts::PI;
-
-/// SplitMix64: tiny, deterministic, good enough for test sampling.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
-    }
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.f64()
-    }
-    /// Uniform direction on the sphere.
-    pub fn dir(&mut self) -> DVec3 {
-        let z = self.range(-1.0, 1.0);
-        let phi = self.range(0.0, 2.0 * PI);
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        DVec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-}
 
 /// The point at geodesic distance `rho` from unit `c` in azimuth `theta` (about `c`).
 pub fn polar(c: DVec3, rho: f64, theta: f64) -> DVec3 {
@@ -160,15 +131,6 @@ pub fn great_circle(n: DVec3) -> impl Iterator<Item = (DVec3, DVec3)> {
     let (u, v) = n.normalize().any_orthonormal_pair();
     let q = [u, v, -u, -v];
     (0..4).map(move |i| (q[i], q[(i + 1) % 4]))
-}
-
-/// Number of proptest cases: `default`, or `PROPTEST_CASES` from the environment for longer
-/// opt-in stress runs (`PROPTEST_CASES=20000 cargo test --release --test sphere_props`).
-pub fn cases(default: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
 }
 
 /// Gauss–Legendre nodes and weights on [0, 1], by Newton iteration on P_n.

@@ -1,28 +1,8 @@
-//! Shared helpers of the `ltc_*` tests: a seeded RNG and sphere quadrature about a pole.
-#![allow(dead_code)]
+//! Quadrature about a pole for peaked integrands, and histogram checks of samplers against their
+//! densities.
 
 use arealight::glam::{DMat3, DVec3};
 use std::f64::consts::PI;
-
-/// SplitMix64: small, seeded, good enough for test inputs.
-pub struct Rng(pub u64);
-
-impl Rng {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.f64()
-    }
-}
 
 /// An orthonormal frame whose third column is `pole`.
 pub fn frame(pole: DVec3) -> DMat3 {
