@@ -269,14 +269,18 @@ pub(crate) fn query(
 const MERGE_TOLERANCE: f64 = 1e-13;
 
 /// Drops the vertices of a convex polygon that repeat their predecessor within `1e-12` of the
-/// longest edge (cut points a rounding away from a corner): a node line through two such points
-/// would be an ill-defined plane.
+/// longest edge or [`WELD_MAGNITUDE`] of the largest coordinate (cut points a rounding away
+/// from a corner): a node line through two such points would be an ill-defined plane.
 pub(crate) fn weld(poly: &mut Fragment) {
     let n = poly.len();
     let longest = (0..n)
         .map(|i| (poly[(i + 1) % n] - poly[i]).length())
         .fold(0.0, f64::max);
-    let tol = 1e-12 * longest;
+    let magnitude = poly
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f64::max);
+    let tol = (1e-12 * longest).max(WELD_MAGNITUDE * magnitude);
     let mut out = Fragment::new();
     for &p in poly.iter() {
         if out.last().is_none_or(|&q: &DVec3| (p - q).length() > tol) {
@@ -288,6 +292,14 @@ pub(crate) fn weld(poly: &mut Fragment) {
     }
     *poly = out;
 }
+
+/// Points of a polygon closer than this times its largest coordinate are one point for
+/// [`weld`]: a cut point is rounded at `1.1e-16` of its coordinates, so two computed points
+/// that close are the same point within a few roundings. Without it, a blocker cut by the
+/// tangent plane through one of its vertices (the vertex a rounding above the plane) left a
+/// triangle of three points a few ulps apart, whose edges' lines are rounding noise; its
+/// node planes made the query hide the whole light behind it.
+const WELD_MAGNITUDE: f64 = 1e-14;
 
 /// Relative area below which a fragment is a sliver: twice its area at most this times its
 /// squared perimeter (the threshold below which the sphere layer calls a ring zero-area).
