@@ -64,7 +64,7 @@
 pub(crate) mod demo;
 mod material;
 mod query;
-mod ratio;
+pub mod ratio;
 pub(crate) mod reference;
 mod scene;
 

@@ -58,7 +58,7 @@ use crate::visibility::Visibility;
 #[cfg(doc)]
 use super::query::LightShading;
 
-/// Ratio estimator settings (see the [module documentation](self)).
+/// Ratio estimator settings (see the [module documentation](crate::shade::ratio)).
 ///
 /// # Examples
 ///
@@ -136,7 +136,7 @@ impl RatioEstimator {
 
     /// The estimated radiance at `point` (the arguments of [`Scene::shade`]) with the random
     /// sequence given by `seed`: the sum over lights of `U * R`, with the standard error from
-    /// the delta method (see the [module documentation](self)).
+    /// the delta method (see the [module documentation](crate::shade::ratio)).
     ///
     /// # Errors
     ///
