@@ -107,6 +107,9 @@ const BUILD_FULL_MARGIN: f64 = 1e-6;
 /// `SphericalPolygon::triangulate` keeps for [`SphericalTriangle::sample`].
 const HEMISPHERE_MARGIN: f64 = 1e-6;
 
+/// Most corners (of a ring, or two bridged rings) the dynamic program is run on.
+const DP_MAX: usize = 96;
+
 /// How far (relative to the box) a cell vertex may lie from a mesh vertex it is snapped to.
 pub(crate) const SNAP_REL: f64 = 1e-9;
 
@@ -379,8 +382,9 @@ impl Orientation<'_> {
     }
 }
 
-/// A small open-addressing map from index triples (each below `2^21`) to booleans, for the
-/// per-leaf memos of the certificate.
+/// A small open-addressing map from index triples to booleans, for the per-leaf memos of the
+/// certificate. Triples with an index of `2^21` or more are not memoized (they would not fit
+/// the key).
 #[derive(Debug, Default)]
 struct Memo {
     /// `(key + 1, value)`; key 0 marks an empty slot.
@@ -402,8 +406,12 @@ impl Memo {
         i
     }
 
+    fn fits(t: [u32; 3]) -> bool {
+        t.iter().all(|&i| i < 1 << 21)
+    }
+
     fn get(&self, t: [u32; 3]) -> Option<bool> {
-        if self.slots.is_empty() {
+        if self.slots.is_empty() || !Self::fits(t) {
             return None;
         }
         let s = self.slots[self.slot(Self::key(t))];
@@ -411,6 +419,9 @@ impl Memo {
     }
 
     fn insert(&mut self, t: [u32; 3], v: bool) {
+        if !Self::fits(t) {
+            return;
+        }
         if 2 * (self.len + 1) > self.slots.len() {
             let size = (2 * self.slots.len()).max(64);
             let old = core::mem::replace(&mut self.slots, alloc::vec![(0, false); size]);
@@ -679,7 +690,9 @@ fn sequences(canon: &[u32], ends: &[u32], dirs: &[DVec3]) -> Vec<Vec<u32>> {
 /// sides are already triangulable.
 fn polygon_dp(seq: &[u32], mut allowed: impl FnMut([u32; 3]) -> bool) -> Option<Vec<[u32; 3]>> {
     let n = seq.len();
-    if n < 3 {
+    // The program takes up to n^3 tests of n steps each: beyond DP_MAX corners the other
+    // candidates must do.
+    if !(3..=DP_MAX).contains(&n) {
         return None;
     }
     // best[i * n + j]: the apex k of a triangulation of i..=j, or NONE.
