@@ -300,13 +300,14 @@ impl TriangleMesh {
                 }
             })
             .collect();
-        let span = |t: &[robust::Coord<f64>; 3]| {
-            let xs = t.map(|c| c.x);
-            (
-                xs.iter().copied().fold(f64::INFINITY, f64::min),
-                xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            )
-        };
+        // Each triangle's extent along the first coordinate, for the sweep.
+        let spans: Vec<(f64, f64)> = tris
+            .iter()
+            .map(|t| {
+                let xs = t.map(|c| c.x);
+                (xs[0].min(xs[1]).min(xs[2]), xs[0].max(xs[1]).max(xs[2]))
+            })
+            .collect();
         let separated = |s: &[robust::Coord<f64>; 3], t: &[robust::Coord<f64>; 3]| {
             (0..3).any(|k| {
                 let (a, b) = (s[k], s[(k + 1) % 3]);
@@ -314,12 +315,12 @@ impl TriangleMesh {
             })
         };
         let mut order: Vec<usize> = (0..tris.len()).collect();
-        order.sort_by(|&a, &b| span(&tris[a]).0.total_cmp(&span(&tris[b]).0));
+        order.sort_by(|&a, &b| spans[a].0.total_cmp(&spans[b].0));
         let mut found: Option<(usize, usize)> = None;
         for (k, &a) in order.iter().enumerate() {
-            let hi = span(&tris[a]).1;
+            let hi = spans[a].1;
             for &b in &order[k + 1..] {
-                if span(&tris[b]).0 >= hi {
+                if spans[b].0 >= hi {
                     break;
                 }
                 if !separated(&tris[a], &tris[b]) && !separated(&tris[b], &tris[a]) {
