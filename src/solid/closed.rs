@@ -10,7 +10,7 @@ use robust::{Coord, orient2d, orient3d};
 
 use super::mesh::TriangleMesh;
 use crate::GeomError;
-use crate::sphere::predicates::c3;
+use crate::sphere::predicates::{c3, triangle_solid_angle};
 
 /// A closed triangle mesh that bounds a solid: every edge is shared by exactly two triangles
 /// running opposite ways, the triangles around every vertex form a single fan, and no two
@@ -128,11 +128,11 @@ impl ClosedMesh {
         let verts = self.mesh.vertices();
         let mut total = 0.0;
         for t in self.mesh.triangles() {
-            let [a, b, c] = t.map(|i| verts[i as usize] - x);
-            let (la, lb, lc) = (a.length(), b.length(), c.length());
-            let det = a.dot((b - a).cross(c - a));
-            let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-            total += 2.0 * crate::math::atan2(det, den);
+            // A vertex at the point itself (on the surface) adds nothing.
+            if let [Some(a), Some(b), Some(c)] = t.map(|i| (verts[i as usize] - x).try_normalize())
+            {
+                total += triangle_solid_angle(a, b, c);
+            }
         }
         total > 2.0 * core::f64::consts::TAU * 0.75
     }
