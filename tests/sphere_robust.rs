@@ -1044,3 +1044,52 @@ fn fuzz_sphere_horizon_vertex_under_a_snapped_flat_edge() {
         }
     }
 }
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: a thin sliver dipping below the circle: the
+/// ring leaves the circle at `+x`, runs 0.02 rad along it 4.3e-4 below, and comes back up to a
+/// vertex `1.2e-12` straight above `+x`, which is snapped (its next edge lies along the
+/// circle). The snap moves the exit of that shallow edge by `1.2e-12 / 0.02 = 6e-11` along the
+/// circle, onto the entry at `+x` within an ulp, and the exact order of the two projections set
+/// the lower part to the whole hemisphere (partition error 2 pi). With a snapped crossing, a
+/// chain whose exit and entry meet within rounding is now joined by the orientation of the loop
+/// through its vertices as given (the sliver, about 1e-14 sr, below rounding of the snap).
+#[test]
+fn fuzz_sphere_horizon_snapped_exit_onto_its_entry() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(-1.0, 33.0, 75.0),
+        unit(0.0, -81.0, -65.0),
+        unit(36.0, 0.0, 0.0),
+        unit(48.0, 0.0, -1.0),
+        unit(127.0, 0.0, 0.0),
+    ];
+    let n = unit(0.0, 48.0, 1.0);
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..5)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 5]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 5.0;
+    let eps = 1e-12 * (1.0 + 131.0 / 256.0);
+    for neighbour in [1e-12, 0.5e-12, 1.5e-12] {
+        for h in [eps, -eps, 0.0, 1e-14] {
+            let mut ring = base.to_vec();
+            ring[2] = at_height(ring[2], neighbour * size);
+            ring[1] = at_height(ring[1], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring]) else {
+                continue;
+            };
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            assert_clips_partition(&p, n, 1e-11, &what);
+            let c = p.complement();
+            assert_clips_partition(&c, n, 1e-11, &what);
+            // The complement's part below is the sliver: far below a hemisphere.
+            assert!(c.clip_to_hemisphere(-n).solid_angle() < 1e-11, "{what}");
+        }
+    }
+}
