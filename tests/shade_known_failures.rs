@@ -366,7 +366,6 @@ fn clip_of_an_edge_running_just_above_the_horizon() {
 /// which holds all of `a` (`a n b = a`). `a - b` comes back as the upper hemisphere (2 pi)
 /// instead of (nearly) nothing. The identity `|a - b| + |a n b| = |a|` must hold.
 #[test]
-#[ignore = "issue 24 (sphere robustness: difference of polygons with nearly antipodal vertices)"]
 fn difference_of_polygons_with_nearly_antipodal_vertices() {
     let a = SphericalPolygon::new(vec![vec![
         DVec3::new(
