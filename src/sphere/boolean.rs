@@ -68,7 +68,8 @@ impl SphericalPolygon {
     ///
     /// Only [`GeomError::Undecidable`] (both operands are valid polygons, so nothing else can be
     /// wrong with the input), when `f64` cannot resolve the operands' contacts consistently (the
-    /// planar operation does not settle, or no projection gives a valid result); valid operands
+    /// planar operation does not settle, or neither a projection nor the octant split, in the
+    /// coordinate frame or a rotated one, gives a valid result); valid operands
     /// in exactly degenerate positions (shared vertices and edges) are supported. In the crate's
     /// tests this happens for about one difference in ten thousand of a chain over a mesh whose
     /// vertex copies are jittered by `1e-11`.
@@ -104,18 +105,39 @@ impl SphericalPolygon {
             return Ok(r);
         }
         // The operands are valid: what fails from here on is a numerical give-up.
-        match split(self, other, op) {
-            Ok(r) if r.validate().is_ok() => Ok(r),
-            Ok(_) => Err(GeomError::Undecidable(BOOLEAN_FAILED)),
-            Err(e) => Err(e.give_up(BOOLEAN_FAILED)),
-        }
+        let first = match split(self, other, op) {
+            Ok(r) if r.validate().is_ok() => return Ok(r),
+            Ok(_) => GeomError::Undecidable(BOOLEAN_FAILED),
+            Err(e) => e.give_up(BOOLEAN_FAILED),
+        };
+        rotated_split(self, other, op).ok_or(first)
     }
+}
+
+/// [`split`] in a rotated frame, for when the coordinate octants cut the operands badly: a piece
+/// thinner than the octant merge resolves (a corner of an operand poking `1e-13` across a
+/// coordinate plane) leaves pieces that do not close. The rotation (1 rad about `(1, 2, 3)`, no
+/// coordinate plane mapped near another) moves the cuts elsewhere. The rotated operands and the
+/// result rotated back must validate; `None` otherwise.
+fn rotated_split(
+    a: &SphericalPolygon,
+    b: &SphericalPolygon,
+    op: BoolOp,
+) -> Option<SphericalPolygon> {
+    let r = glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 1.0);
+    let (ra, rb) = (a.transformed(r).ok()?, b.transformed(r).ok()?);
+    ra.validate().ok()?;
+    rb.validate().ok()?;
+    let result = split(&ra, &rb, op).ok()?;
+    let back = result.transformed(r.transpose()).ok()?;
+    back.validate().ok()?;
+    Some(back)
 }
 
 /// What [`SphericalPolygon::boolean`] reports when neither a projection nor the octant split
 /// gives a valid result and the failure is not already an [`GeomError::Undecidable`].
 const BOOLEAN_FAILED: &str = "spherical boolean: the operands are closer to a degenerate contact \
-     than f64 resolves (no projection and no octant split gave a valid result)";
+     than f64 resolves (no projection and no octant split, plain or rotated, gave a valid result)";
 
 /// Results that need no geometry: an empty or full operand.
 fn trivial(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<SphericalPolygon> {

@@ -9,7 +9,7 @@ use smallvec::SmallVec;
 use super::exact;
 use super::polygon::{
     COINCIDENT_TOLERANCE, SphericalPolygon, Verts, close_ring, far_side_inside, folds_back,
-    is_sliver, nearest_feature, regularized, ring_left_area, rings_contain,
+    is_sliver, nearest_feature, regularized, ring_left_area, ring_small_area_err, rings_contain,
 };
 use super::predicates::{arcs_intersect, normalize_any, orient};
 use crate::GeomError;
@@ -781,8 +781,39 @@ fn single_chain_gap(chain: &Chain, scratch: &[DVec3], frame: &Frame) -> (Joins, 
     let gap = if gap < 0.0 { gap + 2.0 * PI } else { gap };
     let tol = x.err + e.err;
     let clear = gap > tol && gap < 2.0 * PI - tol;
+    // A vertex snapped onto the circle can move its crossing by its height over its edge's
+    // slope, far more than rounding: the exact order of two such points a rounding apart is
+    // then an artifact of the snap. The chain closed on itself is a small loop either way, and
+    // which side of it is inside (its orientation, well beyond its rounding) tells whether the
+    // exit joins the entry at once or a full turn round.
+    let snapped =
+        matches!(x.feature, Feature::Vertex(_)) || matches!(e.feature, Feature::Vertex(_));
+    let loop_sign = || {
+        // The loop through the vertices as given (before the snap), whose crossing points it
+        // approximates far better than their projections do.
+        let given = |c: &Crossing| match c.feature {
+            Feature::Vertex(p) => p,
+            Feature::Edge { .. } => c.point,
+        };
+        let mut ring: Verts = scratch[chain.start..chain.end].iter().copied().collect();
+        ring[0] = given(e);
+        let last = ring.len() - 1;
+        ring[last] = given(x);
+        let (area, err) = ring_small_area_err(&ring);
+        if area.abs() > 4.0 * err {
+            area.signum() as i8
+        } else {
+            0
+        }
+    };
     let gap = if clear {
         gap
+    } else if snapped && loop_sign() != 0 {
+        if loop_sign() > 0 {
+            gap.min(2.0 * PI - gap)
+        } else {
+            gap.max(2.0 * PI - gap)
+        }
     } else {
         match frame.turn_sign(x.feature, e.feature) {
             // The entry just after the exit (or just before it): a short arc, or nearly all.

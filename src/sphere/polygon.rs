@@ -107,17 +107,8 @@ impl SphericalPolygon {
                 if !p.is_finite() {
                     return Err(GeomError::NonFinite { ring: r, vertex: i });
                 }
-                // A vertex that is a unit vector to rounding (as normalize leaves it) is kept bit
-                // for bit: normalizing it again moves it by an ulp, which can put it on the other
-                // side of an edge passing within an ulp (a vertex exactly on another edge's great
-                // circle in the caller's coordinates, beyond its end), and the stored polygon
-                // would cross itself where the given one does not.
-                let u = if (p.length_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
-                    p
-                } else {
-                    renormalized = true;
-                    normalize_any(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?
-                };
+                let u = unit_as_given(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?;
+                renormalized |= u != p;
                 poly.verts.push(u);
                 raw.push(scale_pow2(p));
             }
@@ -352,7 +343,7 @@ impl SphericalPolygon {
         }
         let mut out = self.clone();
         for v in out.verts.iter_mut() {
-            *v = normalize_any(m * *v)
+            *v = unit_as_given(m * *v)
                 .ok_or(GeomError::Degenerate("a vertex maps to the zero vector"))?;
         }
         Ok(if det < 0.0 {
@@ -836,6 +827,21 @@ pub(crate) fn close_ring(verts: &mut Verts, ends: &mut SmallVec<[u32; 2]>, start
         verts.truncate(start);
     } else {
         ends.push(w as u32);
+    }
+}
+
+/// `p` as a unit vector: `p` itself, bit for bit, when its squared length is within `4 eps` of
+/// 1 (as [`normalize_any`] leaves a vector), else normalized; `None` for zero or non-finite `p`.
+///
+/// Normalizing a unit vector again moves it by an ulp, which can put it on the other side of an
+/// edge passing within an ulp (a vertex exactly on another edge's great circle in the caller's
+/// coordinates, beyond its end): the stored polygon would cross itself where the given one does
+/// not, and a polygon passed through the identity map would not be itself.
+pub(crate) fn unit_as_given(p: DVec3) -> Option<DVec3> {
+    if (p.length_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
+        Some(p)
+    } else {
+        normalize_any(p)
     }
 }
 
