@@ -2,44 +2,7 @@
 //! seed 000 compares against (section 4.2, figure 6): the analytic unshadowed shading times a
 //! Monte Carlo estimate of the shadowed-to-unshadowed ratio.
 //!
-//! Per light `i` and RGB channel, with `U_i` the analytic unshadowed radiance (the LTC integrals
-//! over the light's unoccluded region, exactly [`LightShading::unshadowed`] of
-//! [`Scene::shade_per_light`]) and `n` directions `l_k` drawn uniformly by solid angle over the
-//! same region ([`LightSampling`]):
-//!
-//! `L_i = U_i * R_i`, `R_i = sum_k f(l_k) V(l_k) / sum_k f(l_k)`,
-//!
-//! `f` the BRDF times the cosine ([`ReferenceBrdf`]) and `V` the exact visibility of the light's
-//! surface along `l_k` past every other object (the Monte Carlo reference's ray tests). Seed
-//! 000's `U * SN / UN` is this with the shadowed (`SN`) and unshadowed (`UN`) estimates from the
-//! same samples. The same samples make the numerator and denominator correlated, which is the
-//! point: where a light is unoccluded `R_i = 1` exactly and the result is the analytic value,
-//! noise-free; noise appears only in penumbrae.
-//!
-//! # What it estimates
-//!
-//! `R_i` is a ratio of two sample means, so it is consistent but not unbiased: it converges to
-//! `S_i / U'_i` (`S_i = integral of f V`, `U'_i = integral of f` over the region, for the
-//! sampled BRDF), but its expectation for finite `n` is that of a ratio, not the ratio of the
-//! expectations; the bias is `O(1 / n)`, below the noise (`O(1 / sqrt(n))`) for any `n` worth
-//! using. For one sample, `R_i` is `V(l_1)`, whose expectation is the fraction of the region's
-//! *solid angle* that is visible, whatever the BRDF (`tests/shade_ratio.rs` checks this
-//! identity). The limit is:
-//!
-//! - with [`ReferenceBrdf::Ltc`] (the BRDF the analytic path integrates), `U'_i = U_i`, so
-//!   `L_i -> S_i`: the analytic shadowed radiance of [`Scene::shade`];
-//! - with [`ReferenceBrdf::True`] (what a renderer would use, and what seed 000 compares), the
-//!   LTC unshadowed radiance scaled by the true BRDF's shadow ratio: exact where the light is
-//!   unoccluded (up to the LTC fit), the \[HHM18\] approximation in penumbrae.
-//!
-//! The standard error is the delta method's: `Var(R) ~ sum_k (y_k - R x_k)^2 / (n (n - 1) xbar^2)`
-//! with `x_k = f(l_k) / pdf`, `y_k = x_k V(l_k)`; since `V` is 0 or 1 the sum is
-//! `(1 - R)^2 sum_{V=1} x_k^2 + R^2 sum_{V=0} x_k^2`, formed without cancellation.
-//!
-//! # References
-//!
-//! - \[HHM18\] E. Heitz, S. Hill, M. McGuire. *Combining analytic direct illumination and
-//!   stochastic shadows.* I3D 2018.
+//! See [`RatioEstimator`].
 
 use alloc::vec::Vec;
 
@@ -58,7 +21,43 @@ use crate::visibility::Visibility;
 #[cfg(doc)]
 use super::query::LightShading;
 
-/// Ratio estimator settings (see the [module documentation](self)).
+/// The ratio estimator of Heitz, Hill and McGuire (\[HHM18\]), the stochastic-shadow baseline
+/// seed 000 compares against (section 4.2, figure 6): the analytic unshadowed shading times a
+/// Monte Carlo estimate of the shadowed-to-unshadowed ratio.
+///
+/// Per light `i` and RGB channel, with `U_i` the analytic unshadowed radiance (the LTC integrals
+/// over the light's unoccluded region, exactly [`LightShading::unshadowed`] of
+/// [`Scene::shade_per_light`]) and `n` directions `l_k` drawn uniformly by solid angle over the
+/// same region ([`LightSampling`]):
+///
+/// `L_i = U_i * R_i`, `R_i = sum_k f(l_k) V(l_k) / sum_k f(l_k)`,
+///
+/// `f` the BRDF times the cosine ([`ReferenceBrdf`]) and `V` the exact visibility of the light's
+/// surface along `l_k` past every other object (the Monte Carlo reference's ray tests). Seed
+/// 000's `U * SN / UN` is this with the shadowed (`SN`) and unshadowed (`UN`) estimates from the
+/// same samples. The same samples make the numerator and denominator correlated, which is the
+/// point: where a light is unoccluded `R_i = 1` exactly and the result is the analytic value,
+/// noise-free; noise appears only in penumbrae.
+///
+/// # What it estimates
+///
+/// `R_i` is a ratio of two sample means, so it is consistent but not unbiased: it converges to
+/// `S_i / U'_i` (`S_i = integral of f V`, `U'_i = integral of f` over the region, for the
+/// sampled BRDF), but its expectation for finite `n` is that of a ratio, not the ratio of the
+/// expectations; the bias is `O(1 / n)`, below the noise (`O(1 / sqrt(n))`) for any `n` worth
+/// using. For one sample, `R_i` is `V(l_1)`, whose expectation is the fraction of the region's
+/// *solid angle* that is visible, whatever the BRDF (`tests/shade_ratio.rs` checks this
+/// identity). The limit is:
+///
+/// - with [`ReferenceBrdf::Ltc`] (the BRDF the analytic path integrates), `U'_i = U_i`, so
+///   `L_i -> S_i`: the analytic shadowed radiance of [`Scene::shade`];
+/// - with [`ReferenceBrdf::True`] (what a renderer would use, and what seed 000 compares), the
+///   LTC unshadowed radiance scaled by the true BRDF's shadow ratio: exact where the light is
+///   unoccluded (up to the LTC fit), the \[HHM18\] approximation in penumbrae.
+///
+/// The standard error is the delta method's: `Var(R) ~ sum_k (y_k - R x_k)^2 / (n (n - 1) xbar^2)`
+/// with `x_k = f(l_k) / pdf`, `y_k = x_k V(l_k)`; since `V` is 0 or 1 the sum is
+/// `(1 - R)^2 sum_{V=1} x_k^2 + R^2 sum_{V=0} x_k^2`, formed without cancellation.
 ///
 /// # Examples
 ///
@@ -84,6 +83,11 @@ use super::query::LightShading;
 /// assert!(((e.mean - exact).abs() - 5.0 * e.std_error).max_element() <= 0.0);
 /// # Ok::<(), arealight::GeomError>(())
 /// ```
+///
+/// # References
+///
+/// - \[HHM18\] E. Heitz, S. Hill, M. McGuire. *Combining analytic direct illumination and
+///   stochastic shadows.* I3D 2018.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RatioEstimator {
     /// Samples per light.
@@ -136,7 +140,7 @@ impl RatioEstimator {
 
     /// The estimated radiance at `point` (the arguments of [`Scene::shade`]) with the random
     /// sequence given by `seed`: the sum over lights of `U * R`, with the standard error from
-    /// the delta method (see the [module documentation](self)).
+    /// the delta method (see [`RatioEstimator`]).
     ///
     /// # Errors
     ///
