@@ -342,7 +342,10 @@ fn one_pass(spec: &str) {
         .unwrap()
         .with_reuse(variant != "plucker_reset");
     // PLUCKER_BUDGET=<bytes>: the context's budget (what the memory cap does).
-    if let Some(b) = std::env::var("PLUCKER_BUDGET").ok().and_then(|b| b.parse().ok()) {
+    if let Some(b) = std::env::var("PLUCKER_BUDGET")
+        .ok()
+        .and_then(|b| b.parse().ok())
+    {
         ctx = ctx.with_budget(b);
     }
     for f in &case.frames {

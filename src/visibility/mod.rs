@@ -20,7 +20,7 @@ pub mod plucker;
 use alloc::vec::Vec;
 
 pub use clip::{ClipVisibility, Method};
-pub use plucker::{PluckerContext, PluckerVisibility};
+pub use plucker::{PluckerContext, PluckerVisibility, WithContext};
 
 use crate::GeomError;
 use crate::solid::ShadingFrame;
