@@ -16,10 +16,11 @@
 mod clip;
 pub(crate) mod cull;
 pub mod plucker;
+mod union;
 
 use alloc::vec::Vec;
 
-pub use clip::{ClipVisibility, Method};
+pub use clip::{BVH_MIN_TRIANGLES, ClipVisibility, Method};
 pub use plucker::{PluckerContext, PluckerVisibility, WithContext};
 
 use crate::GeomError;
