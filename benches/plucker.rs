@@ -268,10 +268,20 @@ fn run(c: &mut Criterion, name: &str, cases: Vec<Case>) {
             s.peak_cached_bytes / 1024,
             s.fragments as f64 / s.queries as f64,
         );
+        // The clipping backend gives up (`Undecidable`) on a few terrain points (the sphere
+        // layer's horizon clip, tests/visibility_known_failures.rs); a give-up is timed as an
+        // answer.
+        let gave_up = frames
+            .iter()
+            .filter(|f| clip.visible_region(0, f).is_err())
+            .count();
+        if gave_up > 0 {
+            eprintln!("{name} {triangles}: the clipping backend gives up on {gave_up} queries");
+        }
         group.bench_with_input(BenchmarkId::new("clip", triangles), frames, |b, fr| {
             b.iter(|| {
                 for f in fr {
-                    black_box(clip.visible_region(0, f).unwrap());
+                    let _ = black_box(clip.visible_region(0, f));
                 }
             })
         });
@@ -312,7 +322,9 @@ fn scale(c: &mut Criterion) {
 /// One pass of one variant, for counting instructions on a machine too loaded for timings:
 /// `PLUCKER_ONE_PASS=<terrain|boxes>/<variant>/<index 0..5> valgrind --tool=callgrind
 /// target/release/deps/plucker-<hash>` (the scene is built either way; callgrind's
-/// `--toggle-collect` is not needed: subtract the count of the variant `none`).
+/// `--toggle-collect` is not needed: subtract the count of the variant `none`). With
+/// `PLUCKER_BUDGET=<bytes>` the context of the `plucker_reuse` and `plucker_reset` variants has
+/// that budget.
 fn one_pass(spec: &str) {
     let parts: Vec<&str> = spec.split('/').collect();
     let [scene, variant, index] = parts[..] else {
@@ -329,10 +341,17 @@ fn one_pass(spec: &str) {
     let mut ctx = PluckerContext::new(case.cell)
         .unwrap()
         .with_reuse(variant != "plucker_reset");
+    // PLUCKER_BUDGET=<bytes>: the context's budget (what the memory cap does).
+    if let Some(b) = std::env::var("PLUCKER_BUDGET")
+        .ok()
+        .and_then(|b| b.parse().ok())
+    {
+        ctx = ctx.with_budget(b);
+    }
     for f in &case.frames {
         match variant {
             "none" => {}
-            "clip" => drop(black_box(clip.visible_region(0, f).unwrap())),
+            "clip" => drop(black_box(clip.visible_region(0, f))),
             "plucker_call" => drop(black_box(pl.visible_region(0, f).unwrap())),
             "plucker_reuse" | "plucker_reset" => {
                 drop(black_box(pl.visible_region_in(&mut ctx, 0, f).unwrap()))

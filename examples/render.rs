@@ -41,6 +41,9 @@
 //!   occluders (cube, icosphere, ellipsoid) to include, 0 to 3 each (default 3 and 3).
 //! - `--threads T`: worker threads (default 2).
 //! - `--out DIR`: where the images go (default: the current directory).
+//! - `--plucker`: also shade the analytic image through the lazy Pluecker-space backend (seed
+//!   002; trees reused per thread), and print its time and largest per-pixel difference from
+//!   the clipping backend's image.
 //! - `--time-factors F1,F2,...`: the budgets of the two stochastic methods as multiples of the
 //!   analytic time (default `1,10`: equal time, and ten times as long); their images are written
 //!   for the first.
@@ -57,6 +60,8 @@
 use arealight::glam::DVec3;
 use arealight::internals::{Demo, DemoConfig, demo_scene};
 use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf};
+use arealight::visibility::{PluckerContext, PluckerVisibility};
+use std::cell::RefCell;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -73,6 +78,7 @@ USAGE: cargo run --release --example render -- [FLAGS]
   --occluders O    number of occluders 0..=3: cube, icosphere, ellipsoid (default 3)
   --threads T      worker threads (default 2)
   --out DIR        output directory (default .)
+  --plucker        also shade with the Pluecker backend; print the largest difference
   --time-factors F budgets of ratio estimator and Monte Carlo as multiples of the analytic
                    time, comma-separated (default 1,10); images are written for the first
   --help           this text
@@ -88,6 +94,7 @@ struct Args {
     out: PathBuf,
     /// Budgets of the stochastic methods, in multiples of the analytic time.
     time_factors: Vec<f64>,
+    plucker: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -100,6 +107,7 @@ fn parse_args() -> Result<Args, String> {
         threads: 2,
         out: PathBuf::from("."),
         time_factors: vec![1.0, 10.0],
+        plucker: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -118,6 +126,7 @@ fn parse_args() -> Result<Args, String> {
             "--occluders" => a.cfg.occluders = num(value("--occluders")?, "--occluders")?.min(3),
             "--threads" => a.threads = num(value("--threads")?, "--threads")?.max(1),
             "--out" => a.out = PathBuf::from(value("--out")?),
+            "--plucker" => a.plucker = true,
             "--time-factors" => {
                 a.time_factors = value("--time-factors")?
                     .split(',')
@@ -346,6 +355,31 @@ fn run(args: &Args) -> Result<(), String> {
         .collect();
 
     let (analytic, t_analytic, failures) = render_analytic(args, &demo, &hits);
+    if args.plucker {
+        thread_local!(static CTX: RefCell<Option<PluckerContext>> = const { RefCell::new(None) });
+        let pl = PluckerVisibility::from_clip(demo.scene.visibility().clone());
+        let t = Instant::now();
+        let img = render(w, h, args.threads, &hits, |_, hit| match hit {
+            Hit::Surface(p, n, v, m) => CTX.with_borrow_mut(|c| {
+                let ctx = c.get_or_insert_with(|| PluckerContext::new(0.1).unwrap());
+                let vis = pl.with_context(ctx);
+                demo.scene
+                    .shade_with(&vis, *p, *n, *v, m)
+                    .unwrap_or(DVec3::NAN)
+            }),
+            Hit::Nothing => DVec3::ZERO,
+            Hit::Emitter(l) => *l,
+        });
+        let d = img
+            .iter()
+            .zip(&analytic)
+            .map(|(a, b)| (*a - *b).abs().max_element());
+        let (max, failed) = d.fold((0.0f64, 0), |(m, f), x| {
+            (m.max(x), f + usize::from(x.is_nan()))
+        });
+        let secs = t.elapsed().as_secs_f64();
+        println!("plucker: time {secs:.2} s, max difference per pixel {max:.1e}, {failed} failed");
+    }
     let (reference, ref_note) = reference_image(args, &demo, &hits)?;
     let ratio_shader = |spp: u32, i: usize, p, n, v, m: &Material| {
         let seed = 0xBEEF_0000_0000 ^ i as u64;

@@ -136,6 +136,64 @@ impl Scene {
         Ok(total)
     }
 
+    /// [`Scene::shade`] with the visible regions of another [`Visibility`] backend over the same
+    /// lights and occluders, e.g. a
+    /// [`PluckerVisibility`](crate::visibility::PluckerVisibility) built from
+    /// [`Scene::visibility`] (or one of its per-thread
+    /// [`PluckerVisibility::with_context`](crate::visibility::PluckerVisibility::with_context)
+    /// views, which reuse trees across calls). The integration is [`Scene::shade`]'s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
+    /// use arealight::visibility::PluckerVisibility;
+    /// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+    /// let cube = ConvexPolyhedron::cuboid(DVec3::new(0.3, 0.0, 1.5), DVec3::splat(0.25))?;
+    /// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![cube.into()])?;
+    /// let floor = Material::new(DVec3::splat(0.8), DVec3::splat(0.04), 0.5)?;
+    /// let (x, n, v) = (DVec3::ZERO, DVec3::Z, DVec3::new(0.3, 0.0, 1.0));
+    /// let clip = scene.shade(x, n, v, &floor)?;
+    /// assert_eq!(scene.shade_with(scene.visibility(), x, n, v, &floor)?, clip);
+    /// let plucker = PluckerVisibility::from_clip(scene.visibility().clone());
+    /// let lazy = scene.shade_with(&plucker, x, n, v, &floor)?;
+    /// assert!((lazy - clip).abs().max_element() <= 1e-12 * clip.max_element());
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`]; [`GeomError::OutOfRange`] when `vis` has another number of lights.
+    pub fn shade_with(
+        &self,
+        vis: &dyn Visibility,
+        point: DVec3,
+        normal: DVec3,
+        view: DVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        if vis.light_count() != self.lights().len() {
+            return Err(GeomError::OutOfRange {
+                what: "light count of the visibility backend (the scene's)",
+                value: vis.light_count() as f64,
+                limit: self.lights().len() as f64,
+            });
+        }
+        let frame = ShadingFrame::new(point, normal, view)?;
+        let spec = specular_setup(&frame, material)?;
+        let mut total = DVec3::ZERO;
+        for (i, light) in self.lights().iter().enumerate() {
+            let (diffuse, specular) = integrals(&vis.visible_region(i, &frame)?, spec)?;
+            let mut out = material.albedo() * diffuse;
+            if let Some((_, scale)) = spec {
+                out += scale * specular;
+            }
+            total += out * light.radiance();
+        }
+        Ok(total)
+    }
+
     /// The contribution of light `light` alone to [`Scene::shade`] (occluders included).
     ///
     /// # Errors

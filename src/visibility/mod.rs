@@ -21,7 +21,7 @@ mod union;
 use alloc::vec::Vec;
 
 pub use clip::{BVH_MIN_TRIANGLES, ClipVisibility, Method};
-pub use plucker::{PluckerContext, PluckerVisibility};
+pub use plucker::{PluckerContext, PluckerVisibility, WithContext};
 
 use crate::GeomError;
 use crate::solid::ShadingFrame;

@@ -540,6 +540,77 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
     }
 }
 
+/// A [`PluckerVisibility`] seen through one thread's [`PluckerContext`]: a [`Visibility`] whose
+/// [`Visibility::visible_region`] is [`PluckerVisibility::visible_region_in`], so that code
+/// written against the trait (e.g. `Scene::shade_with`) reuses trees. Not `Sync`: one per
+/// thread, as the context.
+#[derive(Debug)]
+pub struct WithContext<'a, L> {
+    backend: &'a PluckerVisibility<L>,
+    ctx: core::cell::RefCell<&'a mut PluckerContext>,
+}
+
+impl<L: AsRef<Body>> PluckerVisibility<L> {
+    /// This backend answering through `ctx` (see [`WithContext`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
+    /// use arealight::visibility::{PluckerContext, PluckerVisibility};
+    /// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+    /// let cube = ConvexPolyhedron::cuboid(DVec3::new(0.3, 0.0, 1.5), DVec3::splat(0.25))?;
+    /// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![cube.into()])?;
+    /// let floor = Material::diffuse(DVec3::splat(0.8))?;
+    /// let plucker = PluckerVisibility::from_clip(scene.visibility().clone());
+    /// let mut ctx = PluckerContext::new(0.25)?;
+    /// for k in 0..8 {
+    ///     let x = DVec3::new(0.01 * k as f64, 0.0, 0.0);
+    ///     let clip = scene.shade(x, DVec3::Z, DVec3::Z, &floor)?;
+    ///     let vis = plucker.with_context(&mut ctx);
+    ///     let lazy = scene.shade_with(&vis, x, DVec3::Z, DVec3::Z, &floor)?;
+    ///     assert!((lazy - clip).abs().max_element() <= 1e-12 * clip.max_element());
+    /// }
+    /// // The eight points share one cell: one tree, reused.
+    /// assert_eq!((ctx.stats().queries, ctx.stats().trees_built), (8, 1));
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    #[must_use]
+    pub fn with_context<'a>(&'a self, ctx: &'a mut PluckerContext) -> WithContext<'a, L> {
+        WithContext {
+            backend: self,
+            ctx: core::cell::RefCell::new(ctx),
+        }
+    }
+}
+
+impl<L: AsRef<Body>> Visibility for WithContext<'_, L> {
+    fn light_count(&self) -> usize {
+        self.backend.light_count()
+    }
+
+    /// [`PluckerVisibility::visible_region_in`] with the context.
+    fn visible_region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        // Calls do not nest (the backend never calls back into the trait), so the borrow is
+        // always free.
+        let mut ctx = self.ctx.borrow_mut();
+        self.backend.visible_region_in(&mut ctx, light, frame)
+    }
+
+    fn unoccluded_region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        self.backend.unoccluded_region(light, frame)
+    }
+}
+
 impl<L: AsRef<Body>> Visibility for PluckerVisibility<L> {
     fn light_count(&self) -> usize {
         self.lights.len()
