@@ -112,7 +112,7 @@ pub const SHAFT_MARGIN: f64 = 1e-12;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shaft {
     apex: DVec3,
-    planes: SmallVec<[(DVec3, f64); 6]>,
+    planes: SmallVec<[(DVec3, f64); 10]>,
     /// `SHAFT_MARGIN * |apex|_1`: the part of every tolerance that does not depend on the box.
     apex_tol: f64,
 }
@@ -128,7 +128,7 @@ impl Shaft {
     /// conditions as [`may_occlude`] with planes instead of a bounding sphere per object.
     #[must_use]
     pub fn to_sphere(x: DVec3, n: DVec3, target: BoundingSphere) -> Shaft {
-        let mut planes: SmallVec<[(DVec3, f64); 6]> = SmallVec::new();
+        let mut planes: SmallVec<[(DVec3, f64); 10]> = SmallVec::new();
         planes.push((n, 0.0));
         let to = target.center - x;
         let d = to.length();
@@ -159,7 +159,7 @@ impl Shaft {
     /// than `far` from `x` along the unit `axis`.
     #[must_use]
     pub fn from_cone(x: DVec3, n: DVec3, sides: &[DVec3], axis: DVec3, far: f64) -> Shaft {
-        let mut planes: SmallVec<[(DVec3, f64); 6]> = SmallVec::new();
+        let mut planes: SmallVec<[(DVec3, f64); 10]> = SmallVec::new();
         planes.push((n, 0.0));
         planes.push((-axis, -far));
         planes.extend(sides.iter().map(|&s| (s, 0.0)));

@@ -63,10 +63,24 @@ pub(crate) const MIN_LIGHT_COS: f64 = 0.2;
 /// without clipping (about 84 degrees).
 const MIN_WHOLE_COS: f64 = 0.1;
 
-/// The box around `L` is its bounding box in the chart widened by this fraction of its larger
-/// side on every side, so that clipping artefacts (cut points, edges along the box) stay away
-/// from `L`.
-const BOX_MARGIN: f64 = 0.125;
+/// The octagon around `L` in the chart is widened by this fraction of its width on every side,
+/// so that clipping artefacts (cut points, edges along its sides) stay away from `L`.
+const OCTAGON_MARGIN: f64 = 0.02;
+
+/// Outward normals of the octagon's sides, 45 degrees apart.
+const OCTAGON: [DVec2; 8] = {
+    const H: f64 = core::f64::consts::FRAC_1_SQRT_2;
+    [
+        DVec2::new(1.0, 0.0),
+        DVec2::new(H, H),
+        DVec2::new(0.0, 1.0),
+        DVec2::new(-H, H),
+        DVec2::new(-1.0, 0.0),
+        DVec2::new(-H, -H),
+        DVec2::new(0.0, -1.0),
+        DVec2::new(H, -H),
+    ]
+};
 
 /// Triangles whose corners all project within this many half-sizes of the box around `L` (from
 /// its centre) are taken whole, the rest clipped.
@@ -238,8 +252,7 @@ pub(crate) fn one_pass(
                 // Front faces of a non-planar light may overlap in projection: their union
                 // first, so that L has winding 1.
                 let rings = core::mem::take(&mut soup);
-                let l = Shape::with_fill_rule(rings, FillRule::NonZero)
-                    .map_err(|e| e.give_up(PASS_FAILED))?;
+                let l = fill(rings, FillRule::NonZero)?;
                 soup.extend(l.contours().map(<[DVec2]>::to_vec));
                 light_shape = Some(l);
             }
@@ -248,7 +261,11 @@ pub(crate) fn one_pass(
     if soup.is_empty() {
         return Ok(Some(Vec::new()));
     }
-    let light_rings = soup.len();
+    let light_soup = soup;
+    // Blocker rings first: the planar pass first checks whether its rings are already simple
+    // (quadratic, ring by ring), and a small blocker ring that crosses the light's boundary
+    // ends that check at once.
+    let mut soup: Vec<Vec<DVec2>> = Vec::new();
     for &(body, accel) in blockers {
         match body {
             Body::Convex(p) => {
@@ -280,21 +297,36 @@ pub(crate) fn one_pass(
             }
         }
     }
-    if soup.len() == light_rings {
+    if soup.is_empty() {
         // No blocker reaches the light's cone: the region is the light's.
         return Ok(Some(match (light, light_shape) {
             (LightRegion::Pieces(p), _) => p.to_vec(),
             (_, Some(l)) => unproject(&l, &chart.g),
             (_, None) => {
-                let l = Shape::with_fill_rule(soup, FillRule::NonZero)
-                    .map_err(|e| e.give_up(PASS_FAILED))?;
+                let l = fill(light_soup, FillRule::NonZero)?;
                 unproject(&l, &chart.g)
             }
         }));
     }
-    let visible =
-        Shape::with_fill_rule(soup, FillRule::Positive).map_err(|e| e.give_up(PASS_FAILED))?;
+    soup.extend(light_soup);
+    let visible = fill(soup, FillRule::Positive)?;
     Ok(Some(unproject(&visible, &chart.g)))
+}
+
+/// Rings up to this many vertices in all go through the planar pass's check for rings that are
+/// already simple (quadratic); larger soups, which are rarely simple here, skip it.
+const TRY_SIMPLE_MAX: usize = 40;
+
+/// The planar pass: [`Shape::with_fill_rule`], skipping its check for simple rings on larger
+/// soups; a failure is a give-up.
+fn fill(rings: Vec<Vec<DVec2>>, rule: FillRule) -> Result<Shape, GeomError> {
+    let n: usize = rings.iter().map(Vec::len).sum();
+    if n <= TRY_SIMPLE_MAX {
+        Shape::with_fill_rule(rings, rule)
+    } else {
+        Shape::with_fill_rule_resolving(rings, rule)
+    }
+    .map_err(|e| e.give_up(PASS_FAILED))
 }
 
 /// The empty slot of [`Work::table`] (no edge has it: its two vertices would be equal).
@@ -317,9 +349,10 @@ struct Work {
 /// directions, the box's four planes through the point, and the zone of whole triangles.
 struct Chart {
     g: Gnomonic,
-    /// Unit normals (local frame) of the planes through the point that bound the box's cone:
-    /// a direction `d` lies in the cone iff `sides[k] . d >= 0` for all four.
-    sides: [DVec3; 4],
+    /// Unit normals (local frame) of the planes through the point that bound the cone over the
+    /// octagon around the light in the chart: a direction `d` lies in the cone iff
+    /// `sides[k] . d >= 0` for all eight.
+    sides: [DVec3; 8],
     /// The same for the zone of triangles taken whole, in world axes.
     whole_world: [DVec3; 4],
 }
@@ -366,24 +399,39 @@ impl Chart {
         }
         let Some(c) = c else { return Ok(None) };
         let g = Gnomonic::new(c)?;
-        let (mut lo, mut hi) = (DVec2::ZERO, DVec2::ZERO);
+        // The octagon around the light: its support in eight directions 45 degrees apart
+        // (the bounding box and the box turned by 45 degrees), widened by a margin.
+        let mut support = [f64::NEG_INFINITY; 8];
         for &d in &dirs {
             let Some(q) = g.project(d) else {
                 return Ok(None);
             };
-            lo = lo.min(q);
-            hi = hi.max(q);
+            for (k, e) in OCTAGON.iter().enumerate() {
+                support[k] = support[k].max(e.dot(q));
+            }
         }
-        let m = BOX_MARGIN * (hi - lo).max_element() + 1e-9;
-        let (lo, hi) = (lo - DVec2::splat(m), hi + DVec2::splat(m));
+        let size = (support[0] + support[4]).max(support[2] + support[6]);
+        let m = OCTAGON_MARGIN * size + 1e-9;
+        let (u, v) = g.axes();
+        // A direction d projects inside {q : e . q <= k} iff d . (k c - e.x u - e.y v) >= 0
+        // (given c . d > 0, which the eight planes together imply: the octagon is bounded).
+        let sides = core::array::from_fn(|k| {
+            let (e, h) = (OCTAGON[k], support[k] + m);
+            (h * c - e.x * u - e.y * v).normalize()
+        });
+        // Triangles with every corner inside this box (and within WHOLE_MAX) are taken whole.
+        let (lo, hi) = (
+            DVec2::new(-support[4], -support[6]) - DVec2::splat(m),
+            DVec2::new(support[0], support[2]) + DVec2::splat(m),
+        );
         let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
         let w = DVec2::splat(WHOLE_MAX);
         let (wlo, whi) = (
             (mid - WHOLE_ZONE * half).max(-w),
             (mid + WHOLE_ZONE * half).min(w),
         );
-        let sides = box_planes(&g, lo, hi);
-        let whole_world = box_planes(&g, wlo, whi).map(|n| frame.dir_to_world(n));
+        let whole_world = box_planes(&g, wlo.min(DVec2::ZERO), whi.max(DVec2::ZERO))
+            .map(|n| frame.dir_to_world(n));
         Ok(Some(Chart {
             g,
             sides,
@@ -650,6 +698,8 @@ fn chain(work: &mut Work, mut emit: impl FnMut(&[u32])) -> Result<(), GeomError>
 /// than [`COINCIDENT_TOLERANCE`] are merged, and rings left with fewer than three dropped.
 fn unproject(shape: &Shape, g: &Gnomonic) -> Vec<SphericalPolygon> {
     let contours: Vec<&[DVec2]> = shape.contours().collect();
+    let mut by_x: Vec<DVec2> = contours.iter().flat_map(|c| c.iter().copied()).collect();
+    by_x.sort_unstable_by(|p, q| p.x.total_cmp(&q.x));
     let mut verts: SmallVec<[DVec3; 12]> = SmallVec::new();
     let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
     for contour in &contours {
@@ -657,7 +707,7 @@ fn unproject(shape: &Shape, g: &Gnomonic) -> Vec<SphericalPolygon> {
         let n = contour.len();
         for (i, &q) in contour.iter().enumerate() {
             push_distinct(&mut verts, start, g.unproject(q));
-            for p in touching(&contours, q, contour[(i + 1) % n]) {
+            for p in touching(&by_x, q, contour[(i + 1) % n]) {
                 push_distinct(&mut verts, start, g.unproject(p));
             }
         }
@@ -685,29 +735,29 @@ fn push_distinct(verts: &mut SmallVec<[DVec3; 12]>, start: usize, d: DVec3) {
     }
 }
 
-/// Vertices of any contour lying exactly inside the segment `a-b` (not at its ends), in order
-/// from `a`: a bounding-box filter, then exact collinearity and betweenness.
-fn touching(contours: &[&[DVec2]], a: DVec2, b: DVec2) -> SmallVec<[DVec2; 2]> {
+/// Vertices (all contours' vertices, sorted by `x`) lying exactly inside the segment `a-b` (not
+/// at its ends), in order from `a`: the vertices in the segment's `x` range, a `y` range
+/// filter, then exact collinearity and betweenness.
+fn touching(by_x: &[DVec2], a: DVec2, b: DVec2) -> SmallVec<[DVec2; 2]> {
     let (lo, hi) = (a.min(b), a.max(b));
     let d = b - a;
     let mut hits: SmallVec<[(f64, DVec2); 2]> = SmallVec::new();
-    for c in contours {
-        for &p in c.iter() {
-            if p.cmplt(lo).any() || p.cmpgt(hi).any() || p == a || p == b {
-                continue;
-            }
-            let o = robust::orient2d(
-                robust::Coord { x: a.x, y: a.y },
-                robust::Coord { x: b.x, y: b.y },
-                robust::Coord { x: p.x, y: p.y },
-            );
-            if o != 0.0 {
-                continue;
-            }
-            let t = (p - a).dot(d) / d.length_squared();
-            if t > 0.0 && t < 1.0 && !hits.iter().any(|h| h.1 == p) {
-                hits.push((t, p));
-            }
+    let first = by_x.partition_point(|p| p.x < lo.x);
+    for &p in by_x[first..].iter().take_while(|p| p.x <= hi.x) {
+        if p.y < lo.y || p.y > hi.y || p == a || p == b {
+            continue;
+        }
+        let o = robust::orient2d(
+            robust::Coord { x: a.x, y: a.y },
+            robust::Coord { x: b.x, y: b.y },
+            robust::Coord { x: p.x, y: p.y },
+        );
+        if o != 0.0 {
+            continue;
+        }
+        let t = (p - a).dot(d) / d.length_squared();
+        if t > 0.0 && t < 1.0 && !hits.iter().any(|h| h.1 == p) {
+            hits.push((t, p));
         }
     }
     hits.sort_by(|x, y| x.0.total_cmp(&y.0));
