@@ -355,7 +355,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         blocked: bool,
     ) -> Result<(Vec<SphericalPolygon>, bool), GeomError> {
         let body = self.light_body(light)?;
-        if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[light]) {
+        if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[light])
+            || self.seen_from_inside(light, body, frame.origin())
+        {
             return Ok((Vec::new(), false));
         }
         let mesh = body.mesh();
@@ -489,7 +491,19 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 Side::On => {}
             }
         }
+        // A triangle of an open blocker lying in f's plane hides nothing of f (it is met no
+        // earlier than f), so the blocker is not whole on x's side: cut it face by face.
+        let body = self.blocker(b).0;
+        let flat_in_plane = || {
+            let bm = body.mesh();
+            !bm.is_closed()
+                && bm.triangles().iter().any(|t| {
+                    t.iter()
+                        .all(|&i| face_side(mesh, f, bm.vertices()[i as usize]) == Side::On)
+                })
+        };
         match (front, behind) {
+            (true, false) if flat_in_plane() => Reach::Straddles,
             (true, false) => Reach::Whole,
             (false, _) => Reach::Nothing,
             (true, true) => Reach::Straddles,
@@ -551,7 +565,22 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        if self.seen_from_inside(light, self.light_body(light)?, frame.origin()) {
+            return Ok(Vec::new());
+        }
         upper_pieces(self.light_region_unchecked(light, frame)?)
+    }
+
+    /// Whether `x` is inside closed light `light` (`body`). Seen from inside, every ray leaves
+    /// the light through a back face before it can meet a front one, and its outer surface
+    /// emits nothing inwards: the light has no region there, though a convex light's silhouette
+    /// is then the whole sphere and a non-convex one's front faces need not be empty. A point
+    /// on the surface of a convex light has no front face either and receives nothing from it.
+    fn seen_from_inside(&self, light: usize, body: &Body, x: DVec3) -> bool {
+        match body {
+            Body::Convex(p) => !p.has_front_face(x),
+            _ => self.solids[light].as_ref().is_some_and(|s| s.encloses(x)),
+        }
     }
 
     fn light_region_unchecked(
