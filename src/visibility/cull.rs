@@ -159,10 +159,10 @@ impl Shaft {
     /// than `far` from `x` along the unit `axis`.
     #[must_use]
     pub fn from_cone(x: DVec3, n: DVec3, sides: &[DVec3], axis: DVec3, far: f64) -> Shaft {
-        let mut planes: SmallVec<[(DVec3, f64); 10]> = SmallVec::new();
-        planes.push((n, 0.0));
+        // The side planes first: they reject most of what lies outside.
+        let mut planes: SmallVec<[(DVec3, f64); 10]> = sides.iter().map(|&s| (s, 0.0)).collect();
         planes.push((-axis, -far));
-        planes.extend(sides.iter().map(|&s| (s, 0.0)));
+        planes.push((n, 0.0));
         Shaft {
             apex: x,
             planes,
@@ -183,6 +183,41 @@ impl Shaft {
             // The largest value of n . (p - apex) over the box.
             n.dot(rel) + n.abs().dot(h) >= d - (base + SHAFT_MARGIN * d.abs())
         })
+    }
+
+    /// The set of all planes, as a mask for [`Shaft::classify_box`].
+    #[must_use]
+    pub fn all_planes(&self) -> u32 {
+        (1u32 << self.planes.len()) - 1
+    }
+
+    /// [`Shaft::may_meet_box`] against the planes in `mask` (bit `k` for plane `k`): `None` when
+    /// the box lies outside one of them, else the planes of `mask` the box is not certainly
+    /// inside of (beyond the same margin). A box inside a smaller box needs testing only against
+    /// those: a hierarchy's traversal passes the mask down and tests fewer planes as it descends.
+    #[must_use]
+    #[inline]
+    pub fn classify_box(&self, lo: DVec3, hi: DVec3, mask: u32) -> Option<u32> {
+        let c = 0.5 * (lo + hi);
+        let h = 0.5 * (hi - lo);
+        let rel = c - self.apex;
+        let base = SHAFT_MARGIN * (rel.abs().element_sum() + h.element_sum()) + self.apex_tol;
+        let mut out = 0;
+        let mut m = mask;
+        while m != 0 {
+            let k = m.trailing_zeros();
+            m &= m - 1;
+            let (n, d) = self.planes[k as usize];
+            let (mid, spread) = (n.dot(rel), n.abs().dot(h));
+            let tol = base + SHAFT_MARGIN * d.abs();
+            if mid + spread < d - tol {
+                return None;
+            }
+            if mid - spread < d + tol {
+                out |= 1 << k;
+            }
+        }
+        Some(out)
     }
 
     /// Whether the triangle `tri` may meet the shaft: `false` only when its three corners lie

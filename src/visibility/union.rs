@@ -353,6 +353,8 @@ struct Chart {
     /// octagon around the light in the chart: a direction `d` lies in the cone iff
     /// `sides[k] . d >= 0` for all eight.
     sides: [DVec3; 8],
+    /// The octagon in the chart: `OCTAGON[k] . q <= limits[k]` for all eight.
+    limits: [f64; 8],
     /// The same for the zone of triangles taken whole, in world axes.
     whole_world: [DVec3; 4],
 }
@@ -419,6 +421,7 @@ impl Chart {
             let (e, h) = (OCTAGON[k], support[k] + m);
             (h * c - e.x * u - e.y * v).normalize()
         });
+        let limits = core::array::from_fn(|k| support[k] + m);
         // Triangles with every corner inside this box (and within WHOLE_MAX) are taken whole.
         let (lo, hi) = (
             DVec2::new(-support[4], -support[6]) - DVec2::splat(m),
@@ -435,8 +438,42 @@ impl Chart {
         Ok(Some(Chart {
             g,
             sides,
+            limits,
             whole_world,
         }))
+    }
+
+    /// A ring of the chart clipped to the octagon (Sutherland–Hodgman against its eight
+    /// lines), `None` when nothing of it is left; the ring itself when it lies inside.
+    ///
+    /// The ring need not be simple: clipping against one half-plane replaces each excursion
+    /// outside by a piece of the line, a change of winding number only outside, so inside the
+    /// octagon (and in `L`) every winding number is kept, while the walked rings' parts beyond
+    /// it (the culled triangles' border, contours outside the light) leave the planar pass.
+    fn clip_ring(&self, ring: &[DVec2], buf: &mut Vec<DVec2>) -> Option<Vec<DVec2>> {
+        let inside = |q: DVec2| (0..8).all(|k| OCTAGON[k].dot(q) <= self.limits[k]);
+        if ring.iter().all(|&q| inside(q)) {
+            return Some(ring.to_vec());
+        }
+        let mut poly = ring.to_vec();
+        for (&e, &h) in OCTAGON.iter().zip(&self.limits) {
+            buf.clear();
+            for i in 0..poly.len() {
+                let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+                let (sa, sb) = (h - e.dot(a), h - e.dot(b));
+                if sa >= 0.0 {
+                    buf.push(a);
+                }
+                if (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0) {
+                    buf.push(a + (b - a) * (sa / (sa - sb)));
+                }
+            }
+            core::mem::swap(&mut poly, buf);
+            if poly.len() < 3 {
+                return None;
+            }
+        }
+        Some(poly)
     }
 
     /// The projection of a direction known to lie in the chart's hemisphere (`NaN` otherwise,
@@ -548,21 +585,25 @@ fn mesh_rings(
                     .iter()
                     .all(|n| n.dot(c) - n.abs().dot(h) >= 0.0)
             };
+            // State: the shaft's planes still to test, and whether the box is inside the zone.
             bvh.for_each_with(
-                false,
-                |lo, hi, inside| {
-                    shaft
-                        .may_meet_box(lo, hi)
-                        .then(|| inside || inside_zone(lo, hi))
+                (shaft.all_planes(), false),
+                |lo, hi, (mask, inside)| {
+                    let mask = shaft.classify_box(lo, hi, mask)?;
+                    Some((mask, inside || inside_zone(lo, hi)))
                 },
-                |t, inside| visit(t as usize, inside),
+                |t, (_, inside)| visit(t as usize, inside),
             );
         }
         None => (0..mesh.triangle_count()).for_each(|t| visit(t, false)),
     }
     let project = |i: u32| chart.project(frame.to_local(verts[i as usize]));
+    let mut buf = Vec::new();
     chain(work, |ring| {
-        soup.push(ring.iter().map(|&i| project(i)).collect())
+        let ring: Vec<DVec2> = ring.iter().map(|&i| project(i)).collect();
+        if let Some(r) = chart.clip_ring(&ring, &mut buf) {
+            soup.push(r);
+        }
     })
 }
 
