@@ -48,7 +48,7 @@ use smallvec::SmallVec;
 
 use super::cull::Shaft;
 use crate::GeomError;
-use crate::planar::{FillRule, Shape};
+use crate::planar::{BoolOp, FillRule, Shape, boolean};
 use crate::solid::facing::{FACE_TOLERANCE, Side};
 use crate::solid::silhouette::convex_silhouette;
 use crate::solid::{Body, BoundingSphere, Bvh, ShadingFrame, TriangleMesh};
@@ -308,8 +308,19 @@ pub(crate) fn one_pass(
             }
         }));
     }
-    soup.extend(light_soup);
-    let visible = fill(soup, FillRule::Positive)?;
+    let visible = match light_shape {
+        // A light resolved by its own pass is a valid shape: the blockers' union, then one
+        // difference (the planar booleans have a fast path for operands in generic position,
+        // such as one convex silhouette over a light's outline).
+        Some(l) => {
+            let u = fill(soup, FillRule::NonZero)?;
+            boolean(&l, &u, BoolOp::Difference).map_err(|e| e.give_up(PASS_FAILED))?
+        }
+        None => {
+            soup.extend(light_soup);
+            fill(soup, FillRule::Positive)?
+        }
+    };
     Ok(Some(unproject(&visible, &chart.g)))
 }
 
@@ -595,7 +606,15 @@ fn mesh_rings(
                 |t, (_, inside)| visit(t as usize, inside),
             );
         }
-        None => (0..mesh.triangle_count()).for_each(|t| visit(t, false)),
+        None => {
+            // A light wholly above the horizon and inside the zone has only whole triangles.
+            let b = mesh.bounding_sphere();
+            let rel = b.center - x;
+            let inside = role == Role::Light
+                && up.dot(rel) >= b.radius
+                && chart.whole_world.iter().all(|n| n.dot(rel) >= b.radius);
+            (0..mesh.triangle_count()).for_each(|t| visit(t, inside));
+        }
     }
     let project = |i: u32| chart.project(frame.to_local(verts[i as usize]));
     let mut buf = Vec::new();
