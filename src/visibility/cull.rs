@@ -85,8 +85,8 @@ pub fn above_horizon(x: DVec3, n: DVec3, light: BoundingSphere) -> bool {
 pub const SHAFT_MARGIN: f64 = 1e-12;
 
 /// A convex region of space, the part of the scene that may hide a light from a point: the
-/// points `p` with `n_k . (p - apex) >= d_k` for each of up to six planes `(n_k, d_k)`, `n_k`
-/// unit (the region holds the apex's neighbourhood only where every `d_k <= 0`).
+/// points `p` with `n_k . (p - apex) >= d_k` for each of a few planes `(n_k, d_k)` (at most 32),
+/// `n_k` unit.
 ///
 /// Built as the shaft from a shading point to a light's bounding sphere ([`Shaft::to_sphere`]:
 /// four planes circumscribing the cone, a far plane and the horizon), or from the planes of a
@@ -157,10 +157,14 @@ impl Shaft {
     /// The points above the tangent plane at `x` (unit normal `n`) in the cone from `x` on the
     /// inner side of every plane through `x` with the (unit, world) normals `sides`, no farther
     /// than `far` from `x` along the unit `axis`.
+    ///
+    /// Side planes past the 30th are left out (a larger region, so still conservative): the
+    /// masks of [`Shaft::classify_box`] have 32 bits.
     #[must_use]
     pub fn from_cone(x: DVec3, n: DVec3, sides: &[DVec3], axis: DVec3, far: f64) -> Shaft {
         // The side planes first: they reject most of what lies outside.
-        let mut planes: SmallVec<[(DVec3, f64); 10]> = sides.iter().map(|&s| (s, 0.0)).collect();
+        let mut planes: SmallVec<[(DVec3, f64); 10]> =
+            sides.iter().take(30).map(|&s| (s, 0.0)).collect();
         planes.push((-axis, -far));
         planes.push((n, 0.0));
         Shaft {
