@@ -553,11 +553,7 @@ fn mesh_rings(
     // one (then tested here); `inside` says the leaf lies in the zone of whole triangles.
     let tested = bvh.is_some() || role == Role::Light;
     let mut visit = |t: usize, inside: bool| {
-        let idx = mesh.triangles()[t];
-        let tri = idx.map(|i| verts[i as usize]);
-        if !tested && !shaft.may_meet_triangle(&tri) {
-            return;
-        }
+        // The facing first: it needs no corner, and drops the back faces of closed components.
         let side = Side::of(normals[t].dot(rel) - offsets[t], tol);
         // Seen from the front a triangle's corners run clockwise in the chart (its axes are
         // right-handed seen from outside the sphere): winding -1 as given, +1 reversed.
@@ -567,6 +563,11 @@ fn mesh_rings(
             (Side::Front, Role::Blocker(_)) => true,
             (Side::Behind, Role::Blocker(_)) | (Side::Front, Role::Light) => false,
         };
+        let idx = mesh.triangles()[t];
+        let tri = idx.map(|i| verts[i as usize]);
+        if !tested && !shaft.may_meet_triangle(&tri) {
+            return;
+        }
         let idx = if keep_order {
             idx
         } else {
