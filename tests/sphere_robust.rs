@@ -10,6 +10,47 @@ fn v(x: f64, y: f64, z: f64) -> DVec3 {
     DVec3::new(x, y, z)
 }
 
+/// Both clips of `p` at `n` validate, partition `p` to `tol`, and agree in containment with `p`
+/// and the hemisphere on a 20000-point Fibonacci lattice, at the directions farther than 1e-6
+/// rad from every edge's great circle and from the horizon (an independent check of the
+/// region: `p`'s own containment and the sign of `d . n`).
+fn assert_clips_partition(p: &SphericalPolygon, n: DVec3, tol: f64, what: &str) {
+    let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
+    up.validate()
+        .unwrap_or_else(|e| panic!("{what}: {e}: {up:?}"));
+    down.validate()
+        .unwrap_or_else(|e| panic!("{what}: {e}: {down:?}"));
+    assert!(
+        (up.solid_angle() + down.solid_angle() - p.solid_angle()).abs() < tol,
+        "{what}: {} + {} vs {}",
+        up.solid_angle(),
+        down.solid_angle(),
+        p.solid_angle()
+    );
+    let count = 20000;
+    let mut checked = 0;
+    for i in 0..count {
+        let z = 1.0 - (2.0 * i as f64 + 1.0) / count as f64;
+        let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let r = (1.0 - z * z).sqrt();
+        let d = v(r * phi.cos(), r * phi.sin(), z);
+        let clear = p.rings().all(|ring| {
+            (0..ring.len()).all(|k| {
+                let c = ring[k].cross(ring[(k + 1) % ring.len()]);
+                d.dot(c).abs() > 1e-6 * c.length()
+            })
+        });
+        if !clear || d.dot(n).abs() < 1e-6 {
+            continue;
+        }
+        checked += 1;
+        let inside = p.contains(d);
+        assert_eq!(up.contains(d), inside && d.dot(n) > 0.0, "{what}: {d:?}");
+        assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{what}: {d:?}");
+    }
+    assert!(checked > count * 8 / 10, "{what}: {checked}");
+}
+
 /// Issue 24, reproducer 1: a triangle with one vertex `h = 1e-13` above the horizon and two
 /// below. The part above is the tiny triangle cut off near the apex; in the gnomonic plane about
 /// `+x` (great circles are lines, the horizon is the line `t = 0`) it has the apex `(0, h)` and
@@ -811,4 +852,195 @@ fn census_horizon_near_antipodal_edge_across_the_circle_keeps_the_lower_part() {
         assert_eq!(down.contains(d), inside && d.dot(n) < 0.0, "{d:?}");
     }
     assert!(checked > count * 9 / 10);
+}
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: a ring of integer directions one vertex of
+/// which, `v0 = (-1, -1, -100)`, lies exactly on the great circle of the edge from
+/// `(-1, 0, 3)` to `(0, -1, -103)` in integers, 0.01 rad beyond the crossing of that edge with
+/// the circle; normalized, it is within 1e-17 of the edge, on the side away from its two
+/// neighbours.
+///
+/// Two ulp-sized moves put it on the wrong side, and the lower clip crossed itself there: `new`
+/// normalized the given unit vectors once more (an ulp each), so the stored polygon itself
+/// failed `validate`; and the clip's shortened edge (its far end the rounded crossing) turns by
+/// the crossing's rounding. Now unit vertices are stored as given, and a vertex the shortened
+/// edge passes on the wrong side (its exact side of the input's edge is known) is put on it: the
+/// lower part touches itself at `v0`.
+///
+/// Checked: the stored polygon is the given rings bit for bit and validates; both clips
+/// validate, partition the polygon to rounding, and agree in containment with the polygon and
+/// the hemisphere on a Fibonacci lattice away from every edge's great circle and the horizon.
+#[test]
+fn fuzz_sphere_horizon_vertex_on_another_edges_circle_beyond_its_crossing() {
+    let ints = [
+        (-1, -1, -100),
+        (-7, -1, -1),
+        (-1, -103, 31),
+        (-1, 0, 3),
+        (0, -1, -103),
+        (0, 3, 99),
+        (0, 0, 34),
+        (0, -35, 0),
+    ];
+    let base: Vec<DVec3> = ints
+        .iter()
+        .map(|&(x, y, z)| v(x as f64, y as f64, z as f64).normalize())
+        .collect();
+    let n = v(34.0, -1.0, 0.0).normalize();
+    // The fuzz case moved vertex 5 to these heights along the great circle through n.
+    for h in [1e-9f64, -1e-9, 0.0, 1e-12, -1e-14] {
+        let mut ring = base.clone();
+        let flat = (ring[5] - n * ring[5].dot(n)).normalize();
+        ring[5] = flat * (1.0f64 - h * h).sqrt() + n * h;
+        let p = SphericalPolygon::new(vec![ring.clone()]).unwrap();
+        assert_eq!(p.rings().next().unwrap(), &ring[..], "h = {h:e}");
+        p.validate().unwrap();
+        assert_clips_partition(&p, n, 1e-13, &format!("h = {h:e}"));
+    }
+}
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the complement of a ring that runs along the
+/// circle for half a turn: from a vertex on it, along a 135-degree edge to a vertex `1.6e-12`
+/// off it (snapped: that edge lies along the circle), then along a 45-degree edge to a vertex
+/// `1.6e-14` off it (just beyond the vertex tolerance, and that edge is not flat by its far end).
+/// The lower clip kept the last vertex, so its edge left the snapped one at `2e-14` rad, and the
+/// circle arc joined there ran back over it: a fold validation rejects. A vertex within the flat
+/// slope of its chord to a snapped neighbour is now snapped too.
+///
+/// Checked: both clips validate, partition the polygon (to the documented snapping, far below
+/// 1e-11 here), and agree in containment with the polygon and the hemisphere on a Fibonacci
+/// lattice away from every edge's great circle and the horizon.
+#[test]
+fn fuzz_sphere_horizon_vertex_beside_a_snapped_vertex_along_the_circle() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(0.0, 1.0, -113.0),
+        unit(-113.0, 38.0, -113.0),
+        unit(0.0, 0.0, 1.0),
+        unit(-53.0, 0.0, -53.0),
+    ];
+    let n = unit(1.0, -53.0, 0.0);
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..4)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 4]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 4.0;
+    for neighbour in [-1e-12, -0.5e-12, 1e-12] {
+        for h in [1e-14, -1e-14, 0.0, 1e-13, -1e-13, 1e-15, -1e-15] {
+            let mut ring = base.to_vec();
+            ring[1] = at_height(ring[1], neighbour * size);
+            ring[0] = at_height(ring[0], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring.clone()]) else {
+                continue;
+            };
+            let p = p.complement();
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            assert_clips_partition(&p, n, 1e-11, &what);
+        }
+    }
+}
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the complement of a ring with two vertices
+/// `1.3e-14` apart, `1.3e-14` and `2.5e-14` above the circle, the second of them the end of a
+/// long edge from far below, the ring folding back there at an angle validation accepts. The
+/// upper clip replaced that long edge by the `2.5e-14` piece from its rounded crossing, whose
+/// direction is known only to `1e-16 / 2.5e-14`: the fold became one validation rejects.
+/// Results whose first or last kept vertex of a chain folds back are now regularized (the
+/// spike, `1e-30` sr, is cut).
+#[test]
+fn fuzz_sphere_horizon_fold_at_the_end_of_a_short_cut_edge() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(-1.0, -1.0, -1.0),
+        unit(34.0, -3.0, -1.0),
+        unit(-128.0, 33.0, 0.0),
+        unit(99.0, 0.0, 0.0),
+    ];
+    let n = unit(-113.0, -1.0, -1.0);
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..4)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 4]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 4.0;
+    let mut tried = 0;
+    for neighbour in [1e-14, 2e-14, 0.5e-14] {
+        for h in [1.137e-14, -1.137e-14, 0.0, 3e-14, 1e-15] {
+            let mut ring = base.to_vec();
+            ring[0] = at_height(ring[0], neighbour * size);
+            ring[3] = at_height(ring[3], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring]) else {
+                continue;
+            };
+            tried += 1;
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            assert_clips_partition(&p.complement(), n, 1e-12, &what);
+            assert_clips_partition(&p, n, 1e-12, &what);
+        }
+    }
+    assert!(tried >= 10, "{tried}");
+}
+
+/// Found by `fuzz/fuzz_targets/sphere_horizon.rs`: the complement of a ring with a 135-degree
+/// edge `1.2e-13` above the circle at its end `v1` (snapped: the edge lies along the circle),
+/// then a steep `1.1e-13` edge straight down to a vertex `v2` `1.5e-14` above the circle (just
+/// beyond the vertex tolerance), then far below. Snapping `v1` moves the long edge onto the
+/// circle, across `v2` and the crossing after it; the clip kept `v2` and returned the triangle
+/// under it (5e-29 sr) for the upper part instead of the hemisphere minus a sliver (partition
+/// error 2 pi). A vertex next to a snapped one, no higher and within four times its height of
+/// it, is now snapped too.
+#[test]
+fn fuzz_sphere_horizon_vertex_under_a_snapped_flat_edge() {
+    let unit = |x: f64, y: f64, z: f64| v(x, y, z).normalize();
+    let base = [
+        unit(-42.0, -1.0, 61.0),
+        unit(61.0, 61.0, 61.0),
+        unit(61.0, 61.0, 37.0),
+        unit(-1.0, 0.0, 0.0),
+    ];
+    let n = -DVec3::Z;
+    let at_height = |p: DVec3, h: f64| {
+        let flat = (p - n * p.dot(n)).normalize();
+        flat * (1.0f64 - h * h).sqrt() + n * h
+    };
+    let size: f64 = (0..4)
+        .map(|i| {
+            let (a, b) = (base[i], base[(i + 1) % 4]);
+            a.cross(b).length().atan2(a.dot(b))
+        })
+        .sum::<f64>()
+        / 4.0;
+    let eps = 1e-14 * (1.0 + 61.0 / 256.0);
+    for neighbour in [1e-13, 3e-13, 1e-12] {
+        let mut ups = Vec::new();
+        for h in [eps, -eps, 0.0, 2.0 * eps, 0.5 * eps] {
+            let mut ring = base.to_vec();
+            ring[2] = at_height(ring[2], neighbour * size);
+            ring[1] = at_height(ring[1], h * size);
+            let Ok(p) = SphericalPolygon::new(vec![ring]) else {
+                continue;
+            };
+            let what = format!("neighbour {neighbour:e}, h {h:e}");
+            assert_clips_partition(&p, n, 1e-11, &what);
+            let c = p.complement();
+            assert_clips_partition(&c, n, 1e-11, &what);
+            ups.push(c.clip_to_hemisphere(n).solid_angle());
+        }
+        // The upper part of the complement is the hemisphere but for slivers along the circle.
+        assert!(ups.len() >= 4);
+        for u in ups {
+            assert!((u - 2.0 * std::f64::consts::PI).abs() < 1e-11, "{u}");
+        }
+    }
 }

@@ -34,7 +34,9 @@ mod primitives;
 pub(crate) mod separation;
 pub(crate) mod silhouette;
 
-pub use silhouette::{DEFAULT_REGION_RADII, SilhouetteBsp, nonconvex_silhouette};
+pub use silhouette::{
+    DEFAULT_REGION_RADII, SilhouetteBsp, SilhouetteSampler, TriangleSource, nonconvex_silhouette,
+};
 
 pub use body::Body;
 pub use bvh::Bvh;

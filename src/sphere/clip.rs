@@ -8,10 +8,10 @@ use smallvec::SmallVec;
 
 use super::exact;
 use super::polygon::{
-    COINCIDENT_TOLERANCE, SphericalPolygon, Verts, close_ring, far_side_inside, is_sliver,
-    nearest_feature, regularized, ring_left_area, rings_contain,
+    COINCIDENT_TOLERANCE, SphericalPolygon, Verts, close_ring, far_side_inside, folds_back,
+    is_sliver, nearest_feature, regularized, ring_left_area, rings_contain,
 };
-use super::predicates::{normalize_any, orient};
+use super::predicates::{arcs_intersect, normalize_any, orient};
 use crate::GeomError;
 
 /// Vertices within this distance of the clipping great circle (`|n . v| <= HORIZON_TOLERANCE`)
@@ -148,6 +148,11 @@ struct Chain {
     end: usize,
     entry: Crossing,
     exit: Crossing,
+    /// The input's vertex before the chain's first kept vertex, and after its last: the chain's
+    /// first and last edges are the parts of the input's edges from and to them (exactly so
+    /// for an edge's crossing, up to the snapping for a vertex on the circle).
+    before: DVec3,
+    after: DVec3,
 }
 
 /// The polar frame of the clipping circle. `exact_u = n x e_k` for the coordinate axis `e_k`
@@ -386,9 +391,14 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             ring
         };
         let m = ring.len();
+        let sides: SmallVec<[Side; 12]> = if near {
+            classify_ring(ring, &s)
+        } else {
+            SmallVec::new()
+        };
         let side = |i: usize| {
             if near {
-                classify(ring, &s, i)
+                sides[i]
             } else if s[i] > 0.0 {
                 Side::Above
             } else {
@@ -443,7 +453,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
         };
         // Walk from a vertex not above so that every chain is complete within one pass.
         let first_out = (0..m).position(|i| side(i) != Side::Above).unwrap_or(0);
-        let mut open: Option<(usize, Crossing)> = None;
+        let mut open: Option<(usize, Crossing, DVec3)> = None;
         for k in 0..m {
             let i = (first_out + k) % m;
             let j = (i + 1) % m;
@@ -457,7 +467,7 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                     } else {
                         frame.edge_crossing(b, a, s[j], s[i])
                     };
-                    open = Some((scratch.len(), c));
+                    open = Some((scratch.len(), c, a));
                     scratch.push(c.point);
                     scratch.push(b);
                 }
@@ -470,12 +480,14 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
                         frame.edge_crossing(a, b, s[i], s[j])
                     };
                     scratch.push(c.point);
-                    if let Some((start, entry)) = open.take() {
+                    if let Some((start, entry, before)) = open.take() {
                         chains.push(Chain {
                             start,
                             end: scratch.len(),
                             entry,
                             exit: c,
+                            before,
+                            after: b,
                         });
                     }
                 }
@@ -519,6 +531,15 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
     if delicate {
         merge_inverted_crossings(&chains, &next, &frame, &mut scratch);
     }
+    let flipped = flipped_vertices(&chains, &scratch, &out_verts);
+    // A chain's first or last edge ends at a rounded point: its direction is known only to the
+    // point's rounding over the edge's length, and a spike of the input at the kept end (an
+    // angle validation accepts, just) can become one it rejects. Such results are regularized.
+    let folded = chains.iter().any(|ch| {
+        let (s, e) = (ch.start, ch.end);
+        folds_back(scratch[s], scratch[s + 1], scratch[s + 2])
+            || folds_back(scratch[e - 3], scratch[e - 2], scratch[e - 1])
+    });
     let mut visited: SmallVec<[bool; 4]> = SmallVec::from_elem(false, k);
     for first in 0..k {
         if visited[first] {
@@ -532,7 +553,27 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             }
             visited[c] = true;
             let ch = &chains[c];
-            out_verts.extend_from_slice(&scratch[ch.start..ch.end]);
+            if flipped.is_empty() {
+                out_verts.extend_from_slice(&scratch[ch.start..ch.end]);
+            } else {
+                // Vertices the shortened first or last edge would pass on the wrong side become
+                // vertices of it, in their order along it.
+                let on_edge = |exit: bool, out: &mut Verts| {
+                    let from = out[out.len() - 1];
+                    let mut xs: SmallVec<[DVec3; 2]> = flipped
+                        .iter()
+                        .filter(|f| f.0 == c && f.1 == exit)
+                        .map(|f| f.2)
+                        .collect();
+                    xs.sort_by(|x, y| (*x - from).length().total_cmp(&(*y - from).length()));
+                    out.extend_from_slice(&xs);
+                };
+                out_verts.push(scratch[ch.start]);
+                on_edge(false, &mut out_verts);
+                out_verts.extend_from_slice(&scratch[ch.start + 1..ch.end - 1]);
+                on_edge(true, &mut out_verts);
+                out_verts.push(scratch[ch.end - 1]);
+            }
             let (d, gap, from) = next[c];
             if d == usize::MAX {
                 break;
@@ -558,13 +599,69 @@ fn clip_polygon(poly: &SphericalPolygon, n: DVec3) -> SphericalPolygon {
             out_ends.pop();
         }
     }
-    if delicate {
+    if delicate || folded || !flipped.is_empty() {
         // Crossings a rounding apart can leave a spike of that width (the tip of a sharp
         // corner just above the circle) or its rounded points out of the exact order: the folds
         // validation rejects are cut, and the points they leave merged.
         return regularized(out_verts, out_ends, COINCIDENT_TOLERANCE).0;
     }
     finish(out_verts, out_ends)
+}
+
+/// Kept vertices of the input that a chain's shortened first or last edge passes on the wrong
+/// side of, or through: `(chain, whether the last edge, vertex)`.
+///
+/// The chain's first edge runs from the rounded crossing (or the vertex snapped onto the
+/// circle) to the first kept vertex, instead of along the input's edge from the vertex before:
+/// its great circle turns about the kept end by the crossing's rounding over the edge's length.
+/// A vertex of the input closer than that to the input's edge (exactly on its great circle,
+/// say, beyond the edge's end) can end up on the other side, or on the edge, and the result
+/// would cross itself there. Its side of the input's edge is exact, and the same as of the exact
+/// shortened edge (the crossing is a positive combination of the edge's ends), so the exact side
+/// of the output's edge is compared with it; a vertex within the moved edge's reach that differs
+/// (or lies on it) is put on the edge, where the boundary touches itself.
+fn flipped_vertices(
+    chains: &[Chain],
+    scratch: &[DVec3],
+    whole: &[DVec3],
+) -> alloc::vec::Vec<(usize, bool, DVec3)> {
+    let mut found = alloc::vec::Vec::new();
+    let kept = chains
+        .iter()
+        .flat_map(|ch| &scratch[ch.start + 1..ch.end - 1])
+        .chain(whole.iter());
+    for (ci, ch) in chains.iter().enumerate() {
+        for exit in [false, true] {
+            let (p, q, c, original) = if exit {
+                let p = scratch[ch.end - 2];
+                (p, scratch[ch.end - 1], &ch.exit, (p, ch.after))
+            } else {
+                let q = scratch[ch.start + 1];
+                (scratch[ch.start], q, &ch.entry, (ch.before, q))
+            };
+            let fixed = if exit { p } else { q };
+            let nrm = p.cross(q);
+            // The moved end is within its crossing's error bound (or the snapping distance) of
+            // the exact point; the edge's great circle moves by that times the distance from
+            // the fixed end over the edge's length.
+            let shift = c.err.min(1.0) + 4.0 * HORIZON_TOLERANCE;
+            let span = |x: DVec3| p.cross(x).dot(nrm) >= 0.0 && x.cross(q).dot(nrm) >= 0.0;
+            for &x in kept.clone() {
+                if x == p || x == q {
+                    continue;
+                }
+                let tol = shift * (x - fixed).length() + 1e-15 * nrm.length();
+                if x.dot(nrm).abs() > tol || !span(x) {
+                    continue;
+                }
+                let truth = orient(original.0, original.1, x);
+                if truth == 0 || orient(p, q, x) != truth {
+                    found.push((ci, exit, x));
+                }
+            }
+        }
+    }
+    found
 }
 
 /// Per chain, the entry its exit joins, the angle of the circle arc between them and the polar
@@ -721,6 +818,22 @@ fn merge_inverted_crossings(chains: &[Chain], next: &Joins, frame: &Frame, scrat
     let order = sorted_crossings(chains, frame);
     let m = order.len();
     let original: SmallVec<[DVec3; 8]> = (0..m).map(|i| scratch[at(i)]).collect();
+    // The edge at crossing i as rounded: from the entry point to the chain's first vertex, or
+    // from its last vertex to the exit point.
+    let first: SmallVec<[DVec3; 4]> = chains.iter().map(|c| scratch[c.start + 1]).collect();
+    let last: SmallVec<[DVec3; 4]> = chains.iter().map(|c| scratch[c.end - 2]).collect();
+    let edge = |i: usize, points: &[DVec3]| {
+        if i.is_multiple_of(2) {
+            (points[i], first[i / 2])
+        } else {
+            (last[i / 2], points[i])
+        }
+    };
+    // Edges sharing an end (a chain of one vertex) meet there; only others can cross.
+    let edges_cross = |a: usize, b: usize, points: &[DVec3]| {
+        let ((p, q), (r, t)) = (edge(a, points), edge(b, points));
+        p != r && p != t && q != r && q != t && arcs_intersect(p, q, r, t)
+    };
     for w in 0..m {
         let (a, b) = (order[w], order[(w + 1) % m]);
         let (ca, cb) = (crossing(chains, a), crossing(chains, b));
@@ -732,8 +845,13 @@ fn merge_inverted_crossings(chains: &[Chain], next: &Joins, frame: &Frame, scrat
             && frame.turn_sign(ca.feature, cb.feature) >= 0;
         let joined = a % 2 == 1 && b % 2 == 0 && next[a / 2].0 == b / 2 && next[a / 2].1 < PI;
         let (pa, pb) = (original[a], original[b]);
-        // b's rounded point not counter-clockwise of a's: out of the exact order, or equal.
-        if close && !joined && pa.cross(pb - pa).dot(frame.n) <= 0.0 {
+        // b's rounded point not counter-clockwise of a's: out of the exact order, or equal; or
+        // in order along the circle but across the other's edge (the rounding of a point is not
+        // only along the circle, and steep edges leave the circle a rounding apart).
+        if close
+            && !joined
+            && (pa.cross(pb - pa).dot(frame.n) <= 0.0 || edges_cross(a, b, &original))
+        {
             scratch[at(b)] = scratch[at(a)];
         }
     }
@@ -772,6 +890,39 @@ fn may_be_sliver(ring: &[DVec3], n: DVec3) -> bool {
 /// [`HORIZON_TOLERANCE`] or at the end of a flat edge ([`FLAT_SLOPE`]). Vertices this close to
 /// the circle have short edges ([`SNAP_CHORD2`]; the caller splits longer ones).
 #[inline]
+/// [`classify`] for every vertex of a ring, closed under snapping: a vertex next to a snapped
+/// one is snapped too when it lies within [`FLAT_SLOPE`] of their chord from the circle (the edge
+/// lies along the circle once the neighbour is on it; kept, the vertex would leave the snapped
+/// point at an angle below validation's `1e-12` rad resolution, where the circle arc joined
+/// there can run back over the edge: a fold), or when it is no higher than the neighbour and
+/// within four times the neighbour's height of it (in the band the neighbour's snap sweeps: the
+/// neighbour's other edges, moved onto the circle, would pass over it). Each such vertex is
+/// within `FLAT_SLOPE` times an edge, or a snapped neighbour's height, of the circle.
+fn classify_ring(ring: &[DVec3], s: &[f64]) -> SmallVec<[Side; 12]> {
+    let m = ring.len();
+    let mut sides: SmallVec<[Side; 12]> = (0..m).map(|i| classify(ring, s, i)).collect();
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for i in 0..m {
+            if sides[i] == Side::On || s[i].abs() > 2.0 * FLAT_SLOPE {
+                continue;
+            }
+            let flat_to = |j: usize| {
+                let d = (ring[j] - ring[i]).length();
+                sides[j] == Side::On
+                    && (s[i].abs() <= FLAT_SLOPE * d
+                        || (s[i].abs() <= s[j].abs() && d <= 4.0 * s[j].abs()))
+            };
+            if flat_to((i + m - 1) % m) || flat_to((i + 1) % m) {
+                sides[i] = Side::On;
+                changed = true;
+            }
+        }
+    }
+    sides
+}
+
 fn classify(ring: &[DVec3], s: &[f64], i: usize) -> Side {
     let x = s[i];
     // Chords are at most 2, so beyond this no edge can be flat: the common case.

@@ -71,7 +71,8 @@ pub struct SphericalPolygon {
 impl SphericalPolygon {
     /// Builds a polygon from rings of directions, validating them.
     ///
-    /// Each vertex may have any non-zero finite length and is normalized. Orientation is taken as
+    /// Each vertex may have any non-zero finite length and is normalized (one that is a unit
+    /// vector to within `4 eps` in squared length is kept as given). Orientation is taken as
     /// given (interior on the left). No rings is the empty region.
     ///
     /// # Errors
@@ -90,20 +91,33 @@ impl SphericalPolygon {
     /// - [`GeomError::ZeroArea`] for a ring whose vertices lie on one great circle to within
     ///   rounding (its smaller side is below `1e-12` times its squared perimeter);
     /// - [`GeomError::InconsistentOrientation`] when two rings bounding the same face disagree on
-    ///   which side is inside (for example two nested rings both counter-clockwise).
+    ///   which side is inside (for example two nested rings both counter-clockwise);
+    /// - [`GeomError::Undecidable`] when the rings are valid as given, but normalizing their
+    ///   vertices makes them cross (a vertex within rounding of another ring's edge).
     pub fn new(rings: Vec<Vec<DVec3>>) -> Result<Self, GeomError> {
         let mut poly = SphericalPolygon::empty();
         // The caller's vertices scaled by powers of two only (exact), for the exact predicates:
         // an exact degeneracy in the input (a vertex exactly on another edge, a spike) is no
         // longer exact once normalized, but the sign of det(a, b, c) survives positive scaling.
         let mut raw: Vec<DVec3> = Vec::new();
+        let mut renormalized = false;
         for (r, ring) in rings.iter().enumerate() {
             let start = poly.verts.len();
             for (i, &p) in ring.iter().enumerate() {
                 if !p.is_finite() {
                     return Err(GeomError::NonFinite { ring: r, vertex: i });
                 }
-                let u = normalize_any(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?;
+                // A vertex that is a unit vector to rounding (as normalize leaves it) is kept bit
+                // for bit: normalizing it again moves it by an ulp, which can put it on the other
+                // side of an edge passing within an ulp (a vertex exactly on another edge's great
+                // circle in the caller's coordinates, beyond its end), and the stored polygon
+                // would cross itself where the given one does not.
+                let u = if (p.length_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
+                    p
+                } else {
+                    renormalized = true;
+                    normalize_any(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?
+                };
                 poly.verts.push(u);
                 raw.push(scale_pow2(p));
             }
@@ -124,6 +138,16 @@ impl SphericalPolygon {
             poly.ends.push(poly.verts.len() as u32);
         }
         poly.check_simple(&raw)?;
+        if renormalized {
+            // The given rings are simple; the normalized ones, which are stored, must be too.
+            // They differ only for a vertex within rounding of another edge.
+            poly.check_simple(&poly.verts).map_err(|_| {
+                GeomError::Undecidable(
+                    "a vertex lies within rounding of another edge: the rings are simple as \
+                     given but cross once their vertices are normalized",
+                )
+            })?;
+        }
         poly.check_area()?;
         poly.check_consistent()?;
         Ok(poly)

@@ -62,8 +62,8 @@ pub fn assert_valid(p: &SphericalPolygon, what: &str) {
 /// grows with that factor.
 pub fn clip(p: &SphericalPolygon, n: DVec3) {
     let (up, down) = (p.clip_to_hemisphere(n), p.clip_to_hemisphere(-n));
-    assert_valid(&up, "clip(n)");
-    assert_valid(&down, "clip(-n)");
+    assert_valid(&up, &format!("clip(n) of\nP = {p:?}\nn = {n:?}\n"));
+    assert_valid(&down, &format!("clip(-n) of\nP = {p:?}\nn = {n:?}\n"));
     let bulge = p
         .rings()
         .flat_map(|r| (0..r.len()).map(move |k| 2.0 / (r[k] + r[(k + 1) % r.len()]).length()))
