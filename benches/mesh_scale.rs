@@ -324,7 +324,17 @@ fn main() {
             .ok()
             .and_then(|r| r.parse().ok())
             .unwrap_or(1);
+        let start = Instant::now();
         let s = with_env_method(scene(&name));
+        let built = start.elapsed().as_secs_f64();
+        let (bytes, tris) = s.visibility().bvh_bytes();
+        if tris > 0 {
+            println!(
+                "{name}: scene built in {built:.3} s; hierarchies {bytes} bytes over {tris} \
+                 triangles ({:.1} bytes per triangle)",
+                bytes as f64 / tris as f64
+            );
+        }
         let (pts, m) = (points(), material());
         let mut sum = DVec3::ZERO;
         for _ in 0..reps {

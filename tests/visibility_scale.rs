@@ -141,7 +141,13 @@ fn box_mesh(c: DVec3, h: DVec3, flip: bool) -> TriangleMesh {
 
 /// One random occluder and a name for messages.
 fn occluder(rng: &mut Rng) -> (&'static str, Body) {
-    match rng.below(10) {
+    let kind = rng.below(10);
+    occluder_kind(rng, kind)
+}
+
+/// An occluder of the given kind (see [`occluder`]).
+fn occluder_kind(rng: &mut Rng, kind: usize) -> (&'static str, Body) {
+    match kind {
         0 => ("soup", soup(rng).into()),
         1 => ("terrain", terrain(rng).into()),
         2 | 3 => {
@@ -503,4 +509,96 @@ fn bvh_visits_every_triangle_whose_box_passes() {
             }
         }
     }
+}
+
+/// Scenes of many mesh triangles shaded by the one-pass path against the Monte Carlo reference
+/// (exact ray-triangle visibility, the LTC BRDF so that both compute the same integral): a quad
+/// light over a 320-triangle bumpy sphere and an open soup, and a torus light over turned boxes
+/// merged into one closed mesh. Per point and channel `|analytic - mc| <= 4.5 sigma_hat + 1e-6`
+/// over 2048 samples (6.8e-6 per check for a normal deviate; 2 x 60 x 3 checks keep the chance
+/// of a false alarm in this test near 0.25%), a point that fails re-estimated once with 16
+/// times the samples on an independent stream (a sliver no sample of 2048 hits has
+/// `sigma_hat = 0`), and the mean z-score within `4 / sqrt(points)`.
+#[test]
+fn one_pass_agrees_with_monte_carlo() {
+    use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
+    let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
+    let mc = MonteCarlo::new(2048, ReferenceBrdf::Ltc);
+    let mc16 = MonteCarlo::new(16 * 2048, ReferenceBrdf::Ltc);
+    let mut rng = Rng::new(0x3C_5CA1E);
+    let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5);
+    let bumpy = placed(
+        &bumpy_sphere(2, 0.2, 5).unwrap(),
+        0.45,
+        0.0,
+        DVec3::new(0.0, 0.0, 1.5),
+        false,
+    );
+    let scenes = [
+        Scene::new(
+            vec![Light::new(quad.unwrap(), DVec3::ONE).unwrap()],
+            vec![bumpy.into(), soup(&mut rng).into()],
+        )
+        .unwrap(),
+        Scene::new(vec![light_torus()], vec![occluder_kind(&mut rng, 8).1]).unwrap(),
+    ];
+    let (mut zsum, mut zn, mut partial, mut gave_up) = (0.0, 0usize, 0usize, 0usize);
+    let mut failures = Vec::new();
+    for (k, scene) in scenes.iter().enumerate() {
+        let lit = Scene::new(scene.lights().to_vec(), vec![]).unwrap();
+        for i in 0..60 {
+            let x = DVec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), 0.0);
+            let v = view_above(&mut rng, DVec3::Z, 0.2);
+            let a = match scene.shade(x, DVec3::Z, v, &m) {
+                Ok(a) => a,
+                Err(e) if e.is_undecidable() => {
+                    gave_up += 1;
+                    continue;
+                }
+                Err(e) => panic!("{e:?}"),
+            };
+            let full = lit.shade(x, DVec3::Z, v, &m).unwrap();
+            if a.y > 1e-3 * full.y && a.y < 0.999 * full.y {
+                partial += 1;
+            }
+            let seed = (k * 1000 + i) as u64;
+            let e = mc.estimate(scene, x, DVec3::Z, v, &m, seed).unwrap();
+            let agrees = |e: &arealight::shade::Estimate, c: usize| {
+                (a[c] - e.mean[c]).abs() <= 4.5 * e.std_error[c] + 1e-6
+            };
+            if e.std_error.y > 0.0 {
+                zsum += (a.y - e.mean.y) / e.std_error.y;
+                zn += 1;
+            }
+            if (0..3).all(|c| agrees(&e, c)) {
+                continue;
+            }
+            let e2 = mc16.estimate(scene, x, DVec3::Z, v, &m, !seed).unwrap();
+            for c in (0..3).filter(|&c| !agrees(&e2, c)) {
+                failures.push(format!(
+                    "scene {k} point {i} {x} channel {c}: analytic {} mc {} +- {}, then {} +- {}",
+                    a[c], e.mean[c], e.std_error[c], e2.mean[c], e2.std_error[c]
+                ));
+            }
+        }
+    }
+    let zmean = zsum / zn.max(1) as f64;
+    println!("{zn} points, {partial} in a penumbra, {gave_up} gave up, mean z {zmean:.3}");
+    assert!(failures.is_empty(), "{failures:#?}");
+    assert!(gave_up <= 1, "{gave_up} give-ups in 120 points");
+    assert!(
+        zmean.abs() <= 4.0 / (zn as f64).sqrt(),
+        "mean z-score {zmean}: a bias"
+    );
+    assert!(partial >= 30, "only {partial} points in a penumbra");
+}
+
+/// The torus light of the Monte Carlo scenes (144 triangles), 2.5 above the ground.
+fn light_torus() -> Light {
+    let m = torus(0.6, 0.18, 12, 6).unwrap();
+    Light::new(
+        placed(&m, 1.0, 0.3, DVec3::new(0.0, 0.0, 2.5), false),
+        DVec3::ONE,
+    )
+    .unwrap()
 }

@@ -10,8 +10,8 @@
 //!
 //! Nodes are stored compactly, 32 bytes each: the box as six `f32` relative to the root box
 //! (coordinates `(p - origin) / scale`, rounded outwards, so the stored box always contains the
-//! exact one), and two `u32`. With about one node per two triangles and one `u32` per triangle
-//! for the leaf order, a tree costs about 20 bytes per triangle ([`Bvh::byte_size`]).
+//! exact one), and two `u32`. With leaves of two to four triangles and one `u32` per triangle
+//! for the leaf order, a tree costs 20 to 30 bytes per triangle ([`Bvh::byte_size`]).
 
 use alloc::vec::Vec;
 

@@ -85,8 +85,8 @@ pub fn above_horizon(x: DVec3, n: DVec3, light: BoundingSphere) -> bool {
 pub const SHAFT_MARGIN: f64 = 1e-12;
 
 /// A convex region of space, the part of the scene that may hide a light from a point: the
-/// points `p` with `n_k . (p - apex) >= d_k` for each of up to six planes `(n_k, d_k)`, `n_k`
-/// unit (the region holds the apex's neighbourhood only where every `d_k <= 0`).
+/// points `p` with `n_k . (p - apex) >= d_k` for each of a few planes `(n_k, d_k)` (at most 32),
+/// `n_k` unit.
 ///
 /// Built as the shaft from a shading point to a light's bounding sphere ([`Shaft::to_sphere`]:
 /// four planes circumscribing the cone, a far plane and the horizon), or from the planes of a
@@ -112,7 +112,7 @@ pub const SHAFT_MARGIN: f64 = 1e-12;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Shaft {
     apex: DVec3,
-    planes: SmallVec<[(DVec3, f64); 6]>,
+    planes: SmallVec<[(DVec3, f64); 10]>,
     /// `SHAFT_MARGIN * |apex|_1`: the part of every tolerance that does not depend on the box.
     apex_tol: f64,
 }
@@ -128,7 +128,7 @@ impl Shaft {
     /// conditions as [`may_occlude`] with planes instead of a bounding sphere per object.
     #[must_use]
     pub fn to_sphere(x: DVec3, n: DVec3, target: BoundingSphere) -> Shaft {
-        let mut planes: SmallVec<[(DVec3, f64); 6]> = SmallVec::new();
+        let mut planes: SmallVec<[(DVec3, f64); 10]> = SmallVec::new();
         planes.push((n, 0.0));
         let to = target.center - x;
         let d = to.length();
@@ -157,12 +157,16 @@ impl Shaft {
     /// The points above the tangent plane at `x` (unit normal `n`) in the cone from `x` on the
     /// inner side of every plane through `x` with the (unit, world) normals `sides`, no farther
     /// than `far` from `x` along the unit `axis`.
+    ///
+    /// Side planes past the 30th are left out (a larger region, so still conservative): the
+    /// masks of [`Shaft::classify_box`] have 32 bits.
     #[must_use]
     pub fn from_cone(x: DVec3, n: DVec3, sides: &[DVec3], axis: DVec3, far: f64) -> Shaft {
-        let mut planes: SmallVec<[(DVec3, f64); 6]> = SmallVec::new();
-        planes.push((n, 0.0));
+        // The side planes first: they reject most of what lies outside.
+        let mut planes: SmallVec<[(DVec3, f64); 10]> =
+            sides.iter().take(30).map(|&s| (s, 0.0)).collect();
         planes.push((-axis, -far));
-        planes.extend(sides.iter().map(|&s| (s, 0.0)));
+        planes.push((n, 0.0));
         Shaft {
             apex: x,
             planes,
@@ -183,6 +187,41 @@ impl Shaft {
             // The largest value of n . (p - apex) over the box.
             n.dot(rel) + n.abs().dot(h) >= d - (base + SHAFT_MARGIN * d.abs())
         })
+    }
+
+    /// The set of all planes, as a mask for [`Shaft::classify_box`].
+    #[must_use]
+    pub fn all_planes(&self) -> u32 {
+        (1u32 << self.planes.len()) - 1
+    }
+
+    /// [`Shaft::may_meet_box`] against the planes in `mask` (bit `k` for plane `k`): `None` when
+    /// the box lies outside one of them, else the planes of `mask` the box is not certainly
+    /// inside of (beyond the same margin). A box inside a smaller box needs testing only against
+    /// those: a hierarchy's traversal passes the mask down and tests fewer planes as it descends.
+    #[must_use]
+    #[inline]
+    pub fn classify_box(&self, lo: DVec3, hi: DVec3, mask: u32) -> Option<u32> {
+        let c = 0.5 * (lo + hi);
+        let h = 0.5 * (hi - lo);
+        let rel = c - self.apex;
+        let base = SHAFT_MARGIN * (rel.abs().element_sum() + h.element_sum()) + self.apex_tol;
+        let mut out = 0;
+        let mut m = mask;
+        while m != 0 {
+            let k = m.trailing_zeros();
+            m &= m - 1;
+            let (n, d) = self.planes[k as usize];
+            let (mid, spread) = (n.dot(rel), n.abs().dot(h));
+            let tol = base + SHAFT_MARGIN * d.abs();
+            if mid + spread < d - tol {
+                return None;
+            }
+            if mid - spread < d + tol {
+                out |= 1 << k;
+            }
+        }
+        Some(out)
     }
 
     /// Whether the triangle `tri` may meet the shaft: `false` only when its three corners lie
