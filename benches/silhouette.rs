@@ -14,7 +14,7 @@
 //!   silhouette elements and bytes are printed once (they do not depend on timing).
 //!
 //! Fixed inputs; results in BENCHMARKS.md (section `silhouette`). Run with
-//! `cargo bench --bench silhouette`.
+//! `cargo bench -p arealight-benches --bench silhouette`.
 
 use arealight::glam::{DMat3, DVec3};
 use arealight::internals::{TriangleRole, convex_silhouette, thesis_polyhedra, triangle_polygon};
