@@ -35,6 +35,7 @@ extern crate std;
 
 pub use glam;
 
+mod convert;
 mod error;
 pub mod ltc;
 pub(crate) mod math;
@@ -62,6 +63,7 @@ pub mod internals {
     pub use crate::visibility::cull::{above_horizon, may_occlude};
 }
 
+pub use convert::IntoDVec3;
 pub use error::GeomError;
 
 // The README's example is compiled and run as a doctest.

@@ -57,15 +57,22 @@
 //! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
+mod batch;
 pub(crate) mod demo;
 mod material;
 mod query;
 pub(crate) mod reference;
 mod scene;
+mod two_sided;
+mod validate;
 
 pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 pub use crate::visibility::{Blocker, Method};
+pub use batch::BatchResult;
+#[cfg(feature = "rayon")]
+pub use batch::PAR_MIN_RUN;
 pub use material::Material;
 pub use query::LightShading;
 pub use reference::{Estimate, MonteCarlo, ReferenceBrdf};
 pub use scene::{Light, Scene};
+pub use validate::{SceneIssue, SceneReport};

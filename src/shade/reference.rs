@@ -1,6 +1,7 @@
 //! A Monte Carlo estimator of the radiance [`Scene::shade`] computes, for tests and comparisons.
 //!
-//! Each light is sampled by solid angle over its front-facing triangles (Arvo's spherical
+//! Each light is sampled by solid angle over its front-facing triangles (both sides of a
+//! two-sided light's, [`super::Light::two_sided`]; Arvo's spherical
 //! triangle sampling, [`SphericalTriangle`]; thesis 003 section 6), a triangle chosen with
 //! probability proportional to its solid angle, so every sample has density `1 / Omega` with
 //! `Omega` the summed solid angle. Visibility is exact and brute force, the same opacity model as
@@ -223,8 +224,9 @@ impl MonteCarlo {
             for i in 0..mesh.triangle_count() {
                 let [a, b, c] = mesh.triangle(i);
                 let centroid = (a + b + c) / 3.0;
-                if mesh.triangle_normal(i).dot(x - centroid) <= 0.0 {
-                    continue; // back face: emits nothing towards x
+                let facing = mesh.triangle_normal(i).dot(x - centroid);
+                if facing == 0.0 || (facing < 0.0 && !light.is_two_sided()) {
+                    continue; // edge-on, or a back face: emits nothing towards x
                 }
                 if let Ok(t) = SphericalTriangle::new(a - x, b - x, c - x) {
                     total += t.solid_angle();
