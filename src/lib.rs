@@ -37,6 +37,8 @@ pub use glam;
 
 mod convert;
 mod error;
+#[cfg(any(feature = "obj", feature = "gltf"))]
+pub mod io;
 pub mod ltc;
 pub(crate) mod math;
 pub mod planar;
