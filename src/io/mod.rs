@@ -20,9 +20,10 @@
 //!   [`TriangleMesh`]. Triangles of zero area (within [`crate::solid::DEGENERATE_TRIANGLE`]) are
 //!   dropped and counted ([`SceneObject::dropped_triangles`]): they cover no solid angle.
 //! - **Bodies.** An object whose mesh (vertices welded where their coordinates are equal) is
-//!   closed and convex becomes a [`ConvexPolyhedron`] (one silhouette per shading point);
-//!   every other one a [`TriangleMesh`] (per triangle; a closed mesh light is shaded from its
-//!   non-convex silhouette).
+//!   closed and convex becomes a [`ConvexPolyhedron`] (one silhouette per shading point; tested
+//!   for meshes of up to [`CONVEX_TEST_MAX_TRIANGLES`] triangles); every other one a
+//!   [`TriangleMesh`] (per triangle; a closed mesh light is shaded from its non-convex
+//!   silhouette).
 //! - **Normals.** From the file where it has them (OBJ `vn`, glTF `NORMAL`); without them, each
 //!   vertex gets the area-weighted mean of the normals of the triangles that use it (flat
 //!   faces for a file that does not share vertices across an edge). They are for the
@@ -272,10 +273,16 @@ impl std::error::Error for SceneFileError {
     }
 }
 
-/// A body from a checked mesh: a convex polyhedron when the mesh is closed and convex, else
-/// the mesh.
+/// Closed meshes of more triangles than this are not tested for convexity when loaded (the test,
+/// [`ConvexPolyhedron::from_mesh`], checks every vertex against every face plane); they are used
+/// as meshes.
+pub const CONVEX_TEST_MAX_TRIANGLES: usize = 4096;
+
+/// A body from a checked mesh: a convex polyhedron when the mesh is closed and convex (tested up
+/// to [`CONVEX_TEST_MAX_TRIANGLES`]), else the mesh.
 fn body_of(mesh: TriangleMesh) -> Body {
     if mesh.is_closed()
+        && mesh.triangle_count() <= CONVEX_TEST_MAX_TRIANGLES
         && let Ok(p) = ConvexPolyhedron::from_mesh(&mesh)
     {
         return Body::Convex(p);

@@ -27,7 +27,8 @@ pub struct Light {
 }
 
 impl Light {
-    /// A light of the given geometry and RGB radiance.
+    /// A light of the given geometry and RGB radiance, emitting from the front side of its
+    /// triangles only (see "Which side emits" above; [`Light::two_sided`] for both sides).
     ///
     /// # Errors
     ///
