@@ -4,7 +4,7 @@
 //!
 //! ```sh
 //! cargo run --release --features obj,gltf --example scene_file
-//! cargo run --release --features obj,gltf --example scene_file -- scenes/cornell_box.obj --width 640 --height 640
+//! cargo run --release --features obj,gltf --example scene_file -- scenes/cornell_box.obj --width 640
 //! cargo run --release --features obj,gltf --example scene_file -- --help
 //! ```
 //!

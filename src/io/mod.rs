@@ -16,9 +16,10 @@
 //!   the side they faced). Names: OBJ `o` / `g` names; glTF node name, else mesh name, else
 //!   `mesh M primitive P`.
 //! - **Faces.** Polygons are fanned from their first corner (OBJ through tobj; glTF triangle
-//!   strips and fans are unrolled). Points and lines are skipped: they bound no area. Counter-clockwise is the front, as in both formats and in
-//!   [`TriangleMesh`]. Triangles of zero area (within [`crate::solid::DEGENERATE_TRIANGLE`]) are
-//!   dropped and counted ([`SceneObject::dropped_triangles`]): they cover no solid angle.
+//!   strips and fans are unrolled). Points and lines are skipped: they bound no area.
+//!   Counter-clockwise is the front, as in both formats and in [`TriangleMesh`]. Triangles of
+//!   zero area (within [`crate::solid::DEGENERATE_TRIANGLE`]) are dropped and counted
+//!   ([`SceneObject::dropped_triangles`]): they cover no solid angle.
 //! - **Bodies.** An object whose mesh (vertices welded where their coordinates are equal) is
 //!   closed and convex becomes a [`ConvexPolyhedron`] (one silhouette per shading point; tested
 //!   for meshes of up to [`CONVEX_TEST_MAX_TRIANGLES`] triangles); every other one a

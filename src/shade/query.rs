@@ -106,10 +106,11 @@ impl Scene {
     ///
     /// `view` points from the surface towards the viewer; `normal` and `view` need not be
     /// normalized. All three may be `f32` (glam's `Vec3`, `Vec3A`, `[f32; 3]`, see
-    /// [`IntoDVec3`]): they are widened exactly, and the computation is `f64`. For each light the visible region is computed in the shading frame
-    /// ([`Scene::visible_region`]), and integrated with Baum's formula for the diffuse lobe and,
-    /// after the LTC transform `M^-1` looked up for the view angle and roughness, for the GGX lobe
-    /// (HDHN16 eq. 2 / seed 000 eq. 2, Alg. 1 lines 13-16).
+    /// [`IntoDVec3`]): they are widened exactly, and the computation is `f64`. For each light
+    /// the visible region is computed in the shading frame ([`Scene::visible_region`]), and
+    /// integrated with Baum's formula for the diffuse lobe and, after the LTC transform `M^-1`
+    /// looked up for the view angle and roughness, for the GGX lobe (HDHN16 eq. 2 / seed 000
+    /// eq. 2, Alg. 1 lines 13-16).
     ///
     /// # Errors
     ///
