@@ -52,7 +52,7 @@
 //! default). Scene files (OBJ, glTF): `io::load` (features `obj`, `gltf`). Lights emit from the
 //! front of their triangles only (see [`shade::Light`]); [`shade::Light::two_sided`] makes a
 //! planar light emit from both sides, and [`shade::Scene::validate`] reports lights facing
-//! away from everything and overlapping light triangles.
+//! away from everything and overlapping coplanar lights.
 //!
 //! # What each path costs
 //!
@@ -146,7 +146,7 @@ pub mod internals {
     pub use crate::shade::demo::{Demo, DemoConfig, demo_scene};
     pub use crate::solid::fixtures::{bumpy_sphere, extruded_star, thesis_polyhedra, torus};
     pub use crate::solid::silhouette::{TriangleRole, convex_silhouette, triangle_polygon};
-    pub use crate::visibility::cull::{above_horizon, may_occlude};
+    pub use crate::visibility::cull::{SHAFT_MARGIN, Shaft, above_horizon, may_occlude};
 }
 
 pub use convert::IntoDVec3;

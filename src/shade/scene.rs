@@ -32,7 +32,10 @@ impl Light {
     ///
     /// # Errors
     ///
-    /// [`GeomError::OutOfRange`] for a negative or non-finite radiance component.
+    /// - [`GeomError::OutOfRange`] for a negative or non-finite radiance component;
+    /// - [`GeomError::OverlappingLightTriangles`] for a planar mesh whose triangles overlap
+    ///   (each would emit over the overlap: a planar light's triangles are integrated as
+    ///   disjoint pieces).
     pub fn new(body: impl Into<Body>, radiance: DVec3) -> Result<Self, GeomError> {
         for c in radiance.to_array() {
             if !(c >= 0.0 && c.is_finite()) {
@@ -43,8 +46,12 @@ impl Light {
                 });
             }
         }
+        let body = body.into();
+        if let Some((triangle, other)) = body.mesh().planar_overlap() {
+            return Err(GeomError::OverlappingLightTriangles { triangle, other });
+        }
         Ok(Light {
-            body: body.into(),
+            body,
             radiance,
             two_sided: false,
         })

@@ -26,17 +26,6 @@ pub enum SceneIssue {
         /// Index of the light.
         light: usize,
     },
-    /// Triangles `a` and `b` of the planar light `light` overlap. A planar light's triangles
-    /// are integrated one by one and their results added (their projections are assumed
-    /// disjoint), so the overlap emits twice. Remove the duplicate triangles.
-    OverlappingTriangles {
-        /// Index of the light.
-        light: usize,
-        /// Index of a triangle of its mesh.
-        a: usize,
-        /// Index of another triangle of its mesh, overlapping `a`.
-        b: usize,
-    },
     /// Planar lights `a` and `b` lie in one plane, face the same way and overlap: neither hides
     /// the other (nothing in a light's plane blocks it), so the overlap emits twice. Merge them
     /// or move one.
@@ -56,11 +45,6 @@ impl fmt::Display for SceneIssue {
                 "light {light} faces away from every occluder, other light and receiver point: \
                  it lights nothing (a quad(c, u, v) emits towards u x v; swap u and v, use \
                  TriangleMesh::flipped or Light::two_sided)"
-            ),
-            SceneIssue::OverlappingTriangles { light, a, b } => write!(
-                f,
-                "triangles {a} and {b} of planar light {light} overlap, so the overlap emits \
-                 twice; remove the duplicate"
             ),
             SceneIssue::OverlappingLights { a, b } => write!(
                 f,
@@ -110,14 +94,15 @@ impl Scene {
     ///   the renderer shades that are not on an occluder (a ground plane it draws itself; pass
     ///   `&[] as &[DVec3]` when there are none). A light with no such point at all is not
     ///   reported (nothing to reason about);
-    /// - overlapping triangles within a planar light, and coplanar planar lights facing the
-    ///   same way that overlap: both emit twice where they overlap.
+    /// - coplanar planar lights facing the same way that overlap: both emit where they overlap
+    ///   (nothing in a light's plane hides it), so the overlap emits twice. (Overlapping
+    ///   triangles within one planar light are rejected by [`Light::new`].)
     ///
     /// Decided with the facing predicate of the shading itself ([`face_side`]) and exact
     /// orientation tests in the light's plane. Costs up to (points x light triangles) facing
     /// tests per light (it stops at the first point that sees a front face, usually the first)
-    /// and (triangles squared) overlap tests per planar light: run it once per scene, not per
-    /// frame.
+    /// and (triangles squared) overlap tests per pair of coplanar lights: run it once per scene,
+    /// not per frame.
     ///
     /// # Examples
     ///
@@ -155,13 +140,6 @@ impl Scene {
             let mut points = others.chain(receivers.iter().copied()).peekable();
             if points.peek().is_some() && !lights_any(light, points) {
                 issues.push(SceneIssue::LightFacesAway { light: i });
-            }
-        }
-        for (i, light) in lights.iter().enumerate() {
-            if let Some(m) = planar_mesh(light)
-                && let Some((a, b)) = overlapping_pair(m, m)
-            {
-                issues.push(SceneIssue::OverlappingTriangles { light: i, a, b });
             }
         }
         for (i, a) in lights.iter().enumerate() {
@@ -203,25 +181,18 @@ fn coplanar_same_way(a: &TriangleMesh, b: &TriangleMesh) -> bool {
         && b.vertices().iter().all(|&v| face_side(a, 0, v) == Side::On)
 }
 
-/// A pair of triangles, one of `a` and one of `b` (two different ones when `a` and `b` are the
-/// same mesh), whose interiors overlap, both meshes lying in `a`'s plane. `None` if there is
-/// none.
+/// A pair of triangles, one of `a` and one of `b`, whose interiors overlap, both meshes lying in
+/// `a`'s plane. `None` if there is none.
 fn overlapping_pair(a: &TriangleMesh, b: &TriangleMesh) -> Option<(usize, usize)> {
-    let same = core::ptr::eq(a, b);
     let flat = Flattening::new(a.triangle_normal(0));
     let ta: Vec<[DVec2; 3]> = (0..a.triangle_count())
         .map(|t| flat.triangle(a.triangle(t)))
         .collect();
-    let tb: Vec<[DVec2; 3]> = if same {
-        ta.clone()
-    } else {
-        (0..b.triangle_count())
-            .map(|t| flat.triangle(b.triangle(t)))
-            .collect()
-    };
+    let tb: Vec<[DVec2; 3]> = (0..b.triangle_count())
+        .map(|t| flat.triangle(b.triangle(t)))
+        .collect();
     for (i, p) in ta.iter().enumerate() {
-        let start = if same { i + 1 } else { 0 };
-        for (k, q) in tb.iter().enumerate().skip(start) {
+        for (k, q) in tb.iter().enumerate() {
             if interiors_overlap(p, q) {
                 return Some((i, k));
             }

@@ -109,6 +109,34 @@ impl ClosedMesh {
         &self.mesh
     }
 
+    /// Whether `x` lies inside the solid, decided by the generalized winding number: the sum of
+    /// the signed solid angles of the triangles seen from `x` (Van Oosterom and Strackee 1983)
+    /// is `4 pi` inside a closed, outward-oriented surface and `0` outside; a point on the
+    /// surface gets about `2 pi` from the triangles it lies on and counts as outside. Rounding
+    /// moves the sum by far less than the `2 pi` margin except within rounding distance of the
+    /// surface, where either answer describes the same point.
+    ///
+    /// Why a light needs it: seen from inside, every ray leaves the solid through a back face
+    /// before it can meet a front one, so a closed light sends nothing to an interior point,
+    /// although the union of its front faces' projections is not empty when it is not convex.
+    #[must_use]
+    pub fn encloses(&self, x: DVec3) -> bool {
+        let b = self.mesh.bounding_sphere();
+        if (x - b.center).length_squared() > b.radius * b.radius {
+            return false;
+        }
+        let verts = self.mesh.vertices();
+        let mut total = 0.0;
+        for t in self.mesh.triangles() {
+            let [a, b, c] = t.map(|i| verts[i as usize] - x);
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            let det = a.dot((b - a).cross(c - a));
+            let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+            total += 2.0 * crate::math::atan2(det, den);
+        }
+        total > 2.0 * core::f64::consts::TAU * 0.75
+    }
+
     /// The mesh, giving up the validation.
     #[must_use]
     pub fn into_mesh(self) -> TriangleMesh {

@@ -257,11 +257,80 @@ impl TriangleMesh {
     }
 
     /// Whether every vertex lies in one plane and every triangle faces the same way (a flat
-    /// light such as a quad). The triangles of a planar mesh are assumed not to overlap, so their
-    /// projections from any point are disjoint.
+    /// light such as a quad). A planar light's triangles must not overlap, so that their
+    /// projections from any point are disjoint ([`Light::new`](crate::shade::Light::new) checks).
     #[must_use]
     pub fn is_planar(&self) -> bool {
         self.planar
+    }
+
+    /// For a planar mesh, the first pair of triangles (by index) whose interiors overlap, or
+    /// `None` (also for a non-planar mesh). Exact: the triangles are projected to the coordinate
+    /// plane their common normal is most nearly perpendicular to, which keeps the coordinates
+    /// as given, and two triangles have disjoint interiors iff an edge line of one has the other
+    /// on its closed outer side (separating axes of two convex polygons), decided by Shewchuk's
+    /// `orient2d`. Boxes are swept along the first coordinate, so the cost is about `n log n`
+    /// plus the pairs whose boxes overlap.
+    pub(crate) fn planar_overlap(&self) -> Option<(usize, usize)> {
+        if !self.planar {
+            return None;
+        }
+        let n = self.normals[0].abs();
+        let (i, j) = if n.x >= n.y && n.x >= n.z {
+            (1, 2)
+        } else if n.y >= n.z {
+            (2, 0)
+        } else {
+            (0, 1)
+        };
+        let p = |v: u32| {
+            let v = self.vertices[v as usize].to_array();
+            robust::Coord { x: v[i], y: v[j] }
+        };
+        // Counter-clockwise in the projection: the orientation every triangle shares.
+        let tris: Vec<[robust::Coord<f64>; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(p);
+                if robust::orient2d(a, b, c) < 0.0 {
+                    [a, c, b]
+                } else {
+                    [a, b, c]
+                }
+            })
+            .collect();
+        let span = |t: &[robust::Coord<f64>; 3]| {
+            let xs = t.map(|c| c.x);
+            (
+                xs.iter().copied().fold(f64::INFINITY, f64::min),
+                xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            )
+        };
+        let separated = |s: &[robust::Coord<f64>; 3], t: &[robust::Coord<f64>; 3]| {
+            (0..3).any(|k| {
+                let (a, b) = (s[k], s[(k + 1) % 3]);
+                t.iter().all(|&c| robust::orient2d(a, b, c) <= 0.0)
+            })
+        };
+        let mut order: Vec<usize> = (0..tris.len()).collect();
+        order.sort_by(|&a, &b| span(&tris[a]).0.total_cmp(&span(&tris[b]).0));
+        let mut found: Option<(usize, usize)> = None;
+        for (k, &a) in order.iter().enumerate() {
+            let hi = span(&tris[a]).1;
+            for &b in &order[k + 1..] {
+                if span(&tris[b]).0 >= hi {
+                    break;
+                }
+                if !separated(&tris[a], &tris[b]) && !separated(&tris[b], &tris[a]) {
+                    let pair = (a.min(b), a.max(b));
+                    if found.is_none_or(|f| pair < f) {
+                        found = Some(pair);
+                    }
+                }
+            }
+        }
+        found
     }
 
     /// Whether the mesh is a closed, consistently oriented surface: every directed edge `a -> b`

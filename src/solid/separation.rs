@@ -101,11 +101,28 @@ pub(crate) fn separating_plane(light: &TriangleMesh, blocker: &TriangleMesh) -> 
             offset: 0.5 * (lo_b + hi_a),
         }
     };
+    // An open blocker with a triangle lying in the contact plane of hulls that touch: along a
+    // ray into that triangle, the triangle and the light are met at the same point, which hides
+    // nothing (points of a blocker in a light face's plane are met no earlier than the light), yet
+    // subtracting the blocker's whole projection would remove it. Such a pair takes the
+    // face-by-face path, which cuts blockers to the open half-space in front of each face. A
+    // closed blocker in contact covers its contact face with the rest of its solid (a ray reaches
+    // that face from inside), so its whole projection is right.
+    let flat_contact = |n: DVec3| -> bool {
+        if blocker.is_closed() || gap(n) > tol {
+            return false;
+        }
+        let (lo_b, _) = extent(n);
+        blocker
+            .triangles()
+            .iter()
+            .any(|t| t.iter().all(|&i| n.dot(b[i as usize]) - lo_b <= tol))
+    };
     let x = min_norm_difference(&a, &b, scale);
     if let Some(n) = x.try_normalize().filter(|_| x.length() > 1e-9 * scale)
         && gap(n) >= -tol
     {
-        return Some(plane(n));
+        return (!flat_contact(n)).then(|| plane(n));
     }
     // Hulls touching or nearly so: the direction above is rounding noise. A face contact is
     // separated by the plane of either face.
@@ -125,7 +142,8 @@ pub(crate) fn separating_plane(light: &TriangleMesh, blocker: &TriangleMesh) -> 
             }
         }
     }
-    best.map(|(_, n)| plane(n))
+    best.filter(|&(_, n)| !flat_contact(n))
+        .map(|(_, n)| plane(n))
 }
 
 /// The point of the Minkowski difference `hull(b) - hull(a)` nearest the origin, by Wolfe's

@@ -14,10 +14,11 @@
 
 mod clip;
 pub(crate) mod cull;
+mod union;
 
 use alloc::vec::Vec;
 
-pub use clip::{ClipVisibility, Method};
+pub use clip::{BVH_MIN_TRIANGLES, ClipVisibility, Method};
 
 use crate::GeomError;
 use crate::solid::ShadingFrame;
