@@ -443,7 +443,12 @@ fn fuzz_nearly_antipodal_edge_moves_continuously() {
         r[0] = DVec3::new(v.x * f, v.y * f, h);
         let p = SphericalPolygon::new(vec![r.to_vec()]).unwrap();
         let value = clamped_cosine_integral_clip_free(&p);
-        assert_eq!(value, ltc_integral(&p, DMat3::IDENTITY).unwrap());
+        // The two entry points round differently by an ulp or two (vertex normalization).
+        let other = ltc_integral(&p, DMat3::IDENTITY).unwrap();
+        assert!(
+            (value - other).abs() <= 4.0 * f64::EPSILON * value.abs(),
+            "{value} {other}"
+        );
         (value, r)
     };
     let heights = [1e-9, 1e-12, 1e-15, 0.0, -1e-15, -1e-12, -1e-9];

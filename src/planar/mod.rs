@@ -103,4 +103,4 @@ pub use contour::Contour;
 pub use fill::FillRule;
 pub use predicates::MAX_COORD;
 pub use shape::Shape;
-pub(crate) use triangulate::constrained_delaunay;
+pub(crate) use triangulate::{Cdt, constrained_delaunay};

@@ -61,7 +61,7 @@ impl LightShading {
 /// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,
 /// [`crate::ltc::LtcLookup::specular_scale`]) for the frame's view angle and the material's
 /// roughness; `None` for a material without a specular lobe. One table lookup per shading point.
-type SpecularSetup = Option<(DMat3, DVec3)>;
+pub(super) type SpecularSetup = Option<(DMat3, DVec3)>;
 
 /// The shading frame of the entry points' arguments, widened at the boundary
 /// ([`IntoDVec3`]).
@@ -73,7 +73,10 @@ fn frame(
     ShadingFrame::new(point.into_dvec3(), normal.into_dvec3(), view.into_dvec3())
 }
 
-fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularSetup, GeomError> {
+pub(super) fn specular_setup(
+    frame: &ShadingFrame,
+    material: &Material,
+) -> Result<SpecularSetup, GeomError> {
     if !material.has_specular() {
         return Ok(None);
     }
@@ -89,7 +92,10 @@ fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularS
 
 /// The diffuse (clamped cosine over pi) and LTC integrals over region pieces already clipped to
 /// the upper hemisphere; the second is zero without a specular lobe.
-fn integrals(pieces: &[SphericalPolygon], spec: SpecularSetup) -> Result<(f64, f64), GeomError> {
+pub(super) fn integrals(
+    pieces: &[SphericalPolygon],
+    spec: SpecularSetup,
+) -> Result<(f64, f64), GeomError> {
     let (mut diffuse, mut specular) = (0.0, 0.0);
     for piece in pieces {
         diffuse += clamped_cosine_integral_upper(piece);

@@ -81,6 +81,10 @@ pub struct ClipVisibility<L> {
     /// [`BVH_MIN_TRIANGLES`] of them, for culling by shafts, and whether front faces alone
     /// cover what a closed mesh hides.
     accels: Vec<BlockerAccel>,
+    /// Per light and blocker slot, as `separations`: some vertex of the blocker lies in the
+    /// plane of one of the light's triangles (by [`face_side`]). Such a blocker is never
+    /// subtracted whole (see [`ClipVisibility::visible_region`], step 2).
+    touching: Vec<bool>,
 }
 
 /// Bodies with at least this many triangles get a [`Bvh`]; for fewer, testing every triangle
@@ -115,10 +119,25 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             .collect();
         let occluder_bounds = occluders.iter().map(Body::bounding_sphere).collect();
         let mut separations = Vec::with_capacity(lights.len() * (occluders.len() + lights.len()));
+        let mut touching = Vec::with_capacity(separations.capacity());
         for (i, light) in lights.iter().enumerate() {
             let lm = light.as_ref().mesh();
+            let touches = |m: &TriangleMesh| {
+                let b = m.bounding_sphere();
+                (0..lm.triangle_count()).any(|f| {
+                    // Only a blocker whose bounding sphere reaches the plane has vertices on it
+                    // (with a margin far above the facing tolerance).
+                    let n = lm.triangle_normal(f);
+                    let d = n.dot(b.center - lm.triangle(f)[0]).abs();
+                    d <= b.radius * (1.0 + 1e-6) + 1e-6 * lm.bounding_sphere().radius
+                        && m.vertices()
+                            .iter()
+                            .any(|&v| face_side(lm, f, v) == Side::On)
+                })
+            };
             for o in &occluders {
                 separations.push(separating_plane(lm, o.mesh()));
+                touching.push(touches(o.mesh()));
             }
             for (k, other) in lights.iter().enumerate() {
                 separations.push(if k == i {
@@ -126,6 +145,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 } else {
                     separating_plane(lm, other.as_ref().mesh())
                 });
+                touching.push(k != i && touches(other.as_ref().mesh()));
             }
         }
         let accels = occluders
@@ -149,6 +169,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             solids,
             separations,
             accels,
+            touching,
         }
     }
 
@@ -230,6 +251,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             })
     }
 
+    /// Whether blocker `b` has a vertex in the plane of a triangle of light `light`.
+    fn touches(&self, light: usize, b: Blocker) -> bool {
+        self.touching[light * self.blocker_count() + self.slot(b)]
+    }
+
     /// The geometry and bounding sphere of a blocker.
     fn blocker(&self, b: Blocker) -> (&Body, BoundingSphere) {
         match b {
@@ -300,10 +326,16 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ///    crosses the plane once, blocker first. It is then subtracted whole from the light's
     ///    region (seed 000 Alg. 1 lines 7-12), which costs one dot product per point beyond the
     ///    paper's plain subtraction. With `x` on the light's side it hides nothing (culled in
-    ///    step 1).
-    /// 3. A blocker that interpenetrates the light is tested against each front face's plane
-    ///    (its vertices, by the facing predicate [`face_side`]): entirely in every
-    ///    `H_f`, it is subtracted whole as in 2; in none, it is dropped.
+    ///    step 1). A blocker that touches the plane of a light triangle (a vertex on it by
+    ///    [`face_side`], e.g. a box hanging from a quad light) is not in the open `H_f` there:
+    ///    it goes to step 3.
+    /// 3. A blocker that interpenetrates or touches the light is tested against each front
+    ///    face's plane (its vertices, by the facing predicate [`face_side`]): entirely in
+    ///    every `H_f`, with no vertex on a face plane, it is subtracted whole as in 2; in none,
+    ///    it is dropped. Its points in a face's plane hide nothing of that face: subtracted
+    ///    whole, a face of the blocker lying in the light's plane would hide the directions
+    ///    through it from a point inside the blocker or on its surface, so such a blocker
+    ///    straddles (step 4).
     /// 4. Otherwise, and for open non-planar mesh lights, the light is handled face by face: each
     ///    front triangle's projection (seed 000 section 4.4) minus the blockers that are whole on
     ///    its side, minus each triangle of a straddling blocker cut by the face plane to its part
@@ -366,7 +398,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         let mut overlapping: SmallVec<[Blocker; 4]> = SmallVec::new();
         if blocked {
             for b in self.blockers_between(light, frame) {
-                if self.separation(light, b).is_some() {
+                if self.separation(light, b).is_some() && !self.touches(light, b) {
                     whole.push(b);
                 } else {
                     overlapping.push(b);
@@ -483,30 +515,22 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// facing predicate ([`face_side`]; vertices within its tolerance are on the plane).
     fn reach(&self, light: usize, b: Blocker, f: usize) -> Reach {
         let mesh = self.lights[light].as_ref().mesh();
-        let (mut front, mut behind) = (false, false);
+        let (mut front, mut behind, mut on) = (false, false, false);
         for &v in self.blocker(b).0.mesh().vertices() {
             match face_side(mesh, f, v) {
                 Side::Front => front = true,
                 Side::Behind => behind = true,
-                Side::On => {}
+                Side::On => on = true,
             }
         }
-        // A triangle of an open blocker lying in f's plane hides nothing of f (it is met no
-        // earlier than f), so the blocker is not whole on x's side: cut it face by face.
-        let body = self.blocker(b).0;
-        let flat_in_plane = || {
-            let bm = body.mesh();
-            !bm.is_closed()
-                && bm.triangles().iter().any(|t| {
-                    t.iter()
-                        .all(|&i| face_side(mesh, f, bm.vertices()[i as usize]) == Side::On)
-                })
-        };
-        match (front, behind) {
-            (true, false) if flat_in_plane() => Reach::Straddles,
-            (true, false) => Reach::Whole,
-            (false, _) => Reach::Nothing,
-            (true, true) => Reach::Straddles,
+        match (front, behind, on) {
+            (true, false, false) => Reach::Whole,
+            (false, _, _) => Reach::Nothing,
+            // Part of the blocker lies in the face's plane and hides nothing: subtracted whole,
+            // it would hide the directions through that part from a point inside the blocker
+            // or on its surface (seen from outside a closed blocker a ray enters it elsewhere
+            // first, but that is not known here).
+            (true, _, _) => Reach::Straddles,
         }
     }
 

@@ -19,16 +19,25 @@
 //!    corners `(u, v, w)` seen from `x` is positive iff `D(x) = det(U - x, V - x, W - x) > 0`
 //!    (`U`, `V`, `W` the points in space). For mesh vertices `D` is `orient3d(u, v, w, x)`, affine
 //!    in `x`, so it is positive on the closed cell iff it is positive at the cell's vertices.
-//!    For a crossing, `P - x = l (a_e - x) + (1 - l) (b_e - x)` with `0 <= l <= 1` whatever the
-//!    point `x` (the crossing lies on the segment), and `D` is linear in each column, so `D(x)`
-//!    is a convex combination of the affine functions `orient3d(w_1, w_2, w_3, x)` over every
+//!    For a crossing, `P - x = l (a_e - x) + (1 - l) (b_e - x)` with `0 < l < 1` (the crossing
+//!    lies inside the segment), and `D` is linear in each column, so `D(x)` is a combination
+//!    with positive weights of the affine functions `orient3d(w_1, w_2, w_3, x)` over every
 //!    choice of an endpoint `w_r` of each crossing corner's edge (the corner itself for a mesh
-//!    vertex): `D > 0` wherever all of them are. Either of the two edges that make a crossing
-//!    may be used, and the certificate tries both. Each affine function is checked with exact
-//!    `orient3d` at every vertex of the cell; it may vanish at one cell vertex that is one of
-//!    its own points `w_r` (a mesh vertex at a corner of the cell, where the viewpoint would be
-//!    on the surface), and an affine function that is positive at all vertices but that one is
-//!    positive on the rest of the cell.
+//!    vertex): `D > 0` wherever all of them are. A choice that repeats a point (the next
+//!    corner is the end of the crossing's own edge) gives a function that vanishes
+//!    identically and is dropped; at least one must remain. Either of the two edges that make
+//!    a crossing may be used, and the certificate tries both. (A crossing reaches an end of
+//!    its edge only on a plane through that end and the other edge, where the silhouette's
+//!    structure changes and the direct algorithm gives up.)
+//!
+//!    Each affine function is checked with exact `orient3d` at every vertex of the cell: it
+//!    must be non-negative there, and it may vanish only at one cell vertex that is one of its
+//!    own points `w_r` (a mesh vertex at a corner of the cell: the viewpoint would be on the
+//!    surface), or at cell vertices that all lie on one face plane of the mesh that splits the
+//!    cells there (the query sends points within the facing predicate's tolerance of a face
+//!    plane on its path to the direct algorithm). An affine function non-negative at the
+//!    vertices is positive on the cell but on the hull of its zero vertices, a part of the
+//!    cell's boundary holding no point the stored triangulation answers.
 //! 2. **the triangles have the rings as boundary:** over the directed edges of the triangles,
 //!    each directed ring edge counted `-1`, every edge is used as often in one direction as in
 //!    the other. Triangles with `D > 0` have no coincident or antipodal corners, and a ring edge
@@ -44,8 +53,9 @@
 //! crossing an arc changes both by the same amount. By 1 every triangle counts `+1`, so
 //! `k(x) >= 0` (read it outside `P`), and the solid angles satisfy `sum area(T) = area(P) +
 //! 4 pi k(x)`. Both areas are continuous in `x` on `C` (the corners move continuously, the
-//! crossings existing throughout the cell), so the integer `k` is constant on the connected
-//! cell, and by 3 it is `0`.
+//! crossings existing throughout the cell, and no triangle degenerates), so the integer `k` is
+//! constant on the cell (connected, also without the parts of its boundary excluded in 1), and
+//! by 3 it is `0`.
 //!
 //! Where a cell is cut further by tests of the order of crossings (quadric surfaces, see
 //! [`SilhouetteBsp`]), each part has its own structure and may be disconnected: its
@@ -96,6 +106,9 @@ const BUILD_FULL_MARGIN: f64 = 1e-6;
 /// Triangles closer than this to a hemisphere in solid angle fail the query's check, the margin
 /// `SphericalPolygon::triangulate` keeps for [`SphericalTriangle::sample`].
 const HEMISPHERE_MARGIN: f64 = 1e-6;
+
+/// Most corners (of a ring, or two bridged rings) the dynamic program is run on.
+const DP_MAX: usize = 96;
 
 /// How far (relative to the box) a cell vertex may lie from a mesh vertex it is snapped to.
 pub(crate) const SNAP_REL: f64 = 1e-9;
@@ -369,8 +382,9 @@ impl Orientation<'_> {
     }
 }
 
-/// A small open-addressing map from index triples (each below `2^21`) to booleans, for the
-/// per-leaf memos of the certificate.
+/// A small open-addressing map from index triples to booleans, for the per-leaf memos of the
+/// certificate. Triples with an index of `2^21` or more are not memoized (they would not fit
+/// the key).
 #[derive(Debug, Default)]
 struct Memo {
     /// `(key + 1, value)`; key 0 marks an empty slot.
@@ -392,8 +406,12 @@ impl Memo {
         i
     }
 
+    fn fits(t: [u32; 3]) -> bool {
+        t.iter().all(|&i| i < 1 << 21)
+    }
+
     fn get(&self, t: [u32; 3]) -> Option<bool> {
-        if self.slots.is_empty() {
+        if self.slots.is_empty() || !Self::fits(t) {
             return None;
         }
         let s = self.slots[self.slot(Self::key(t))];
@@ -401,6 +419,9 @@ impl Memo {
     }
 
     fn insert(&mut self, t: [u32; 3], v: bool) {
+        if !Self::fits(t) {
+            return;
+        }
         if 2 * (self.len + 1) > self.slots.len() {
             let size = (2 * self.slots.len()).max(64);
             let old = core::mem::replace(&mut self.slots, alloc::vec![(0, false); size]);
@@ -669,7 +690,9 @@ fn sequences(canon: &[u32], ends: &[u32], dirs: &[DVec3]) -> Vec<Vec<u32>> {
 /// sides are already triangulable.
 fn polygon_dp(seq: &[u32], mut allowed: impl FnMut([u32; 3]) -> bool) -> Option<Vec<[u32; 3]>> {
     let n = seq.len();
-    if n < 3 {
+    // The program takes up to n^3 tests of n steps each: beyond DP_MAX corners the other
+    // candidates must do.
+    if !(3..=DP_MAX).contains(&n) {
         return None;
     }
     // best[i * n + j]: the apex k of a triangulation of i..=j, or NONE.
