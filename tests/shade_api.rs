@@ -15,7 +15,8 @@ mod support;
 use arealight::glam::{DVec3, Vec3, Vec3A};
 use arealight::internals::{DemoConfig, demo_scene};
 use arealight::shade::{
-    ConvexPolyhedron, Light, Material, MonteCarlo, ReferenceBrdf, Scene, SceneIssue, TriangleMesh,
+    ConvexPolyhedron, Light, Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scene,
+    SceneIssue, TriangleMesh,
 };
 use arealight::{GeomError, IntoDVec3};
 use support::Rng;
@@ -294,6 +295,18 @@ fn a_two_sided_light_is_the_light_plus_its_turned_around_copy() {
         assert_eq!(t, f + b, "point {i}");
         lit_above += usize::from(b.x > 0.0);
         lit_below += usize::from(f.x > 0.0);
+        // The ratio estimator's analytic factor is the unshadowed value on both sides.
+        if i % 20 < 2 {
+            let r = RatioEstimator::new(16, ReferenceBrdf::Ltc)
+                .estimate_lights(&two, x, n, v, &glossy, i as u64)
+                .unwrap();
+            let u = two.shade_per_light(x, n, v, &glossy).unwrap()[0].unshadowed();
+            assert!(
+                (r[0].unshadowed - u).abs().max_element() <= 1e-12 * (1.0 + u.max_element()),
+                "point {i}: {} {u}",
+                r[0].unshadowed
+            );
+        }
         // The other light and the per-light split see the same two-sided light.
         let total = two.shade(x, n, v, &glossy).unwrap();
         let parts = two.shade_per_light(x, n, v, &glossy).unwrap();
