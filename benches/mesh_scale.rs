@@ -19,8 +19,8 @@
 //! normal `+z`, Lambert + GGX (alpha 0.4). Criterion times one pass over the 8 points; divide
 //! by 8 for the cost per point.
 //!
-//! Besides criterion (`cargo bench --bench mesh_scale`), the binary has two plain modes, for
-//! instruction counts and images:
+//! Besides criterion (`cargo bench -p arealight-benches --bench mesh_scale`), the binary has two
+//! plain modes, for instruction counts and images:
 //!
 //! - `MESH_SCALE_CASE=<scene> [MESH_SCALE_REPS=n] [MESH_SCALE_METHOD=silhouette|sequential|per-triangle]`:
 //!   builds the scene and shades the 8 points `n` times (default 1) with no criterion, so that

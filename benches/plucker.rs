@@ -22,8 +22,8 @@
 //! size are printed once to stderr. Results in BENCHMARKS.md (section `plucker`).
 //!
 //! ```sh
-//! cargo bench --bench plucker                      # all
-//! cargo bench --bench plucker -- 'boxes/.*/10092'  # one size
+//! cargo bench -p arealight-benches --bench plucker                      # all
+//! cargo bench -p arealight-benches --bench plucker -- 'boxes/.*/10092'  # one size
 //! ```
 //!
 //! On a loaded machine, count instructions of one pass instead (see `one_pass`).

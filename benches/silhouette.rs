@@ -22,7 +22,7 @@
 //!   queried silhouette triangulated at the point (`query` then `SphericalPolygon::triangulate`).
 //!
 //! Fixed inputs; results in BENCHMARKS.md (section `silhouette`). Run with
-//! `cargo bench --bench silhouette`.
+//! `cargo bench -p arealight-benches --bench silhouette`.
 
 use arealight::glam::{DMat3, DVec3};
 use arealight::internals::{TriangleRole, convex_silhouette, thesis_polyhedra, triangle_polygon};

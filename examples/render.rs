@@ -6,7 +6,7 @@
 //! the same comparison).
 //!
 //! ```sh
-//! cargo run --release --example render                 # defaults: 320 x 240, 2 threads
+//! cargo run --release --example render                 # defaults: 320 x 240, all cores
 //! cargo run --release --example render -- --help       # the flags
 //! ```
 //!
@@ -39,14 +39,18 @@
 //! - `--no-cache`: recompute the reference even when cached.
 //! - `--lights L`, `--occluders O`: how many of the scene's lights (quad, cylinder, cone) and
 //!   occluders (cube, icosphere, ellipsoid) to include, 0 to 3 each (default 3 and 3).
-//! - `--threads T`: worker threads (default 2).
-//! - `--out DIR`: where the images go (default: the current directory).
+//! - `--threads T`: worker threads (default 0: all cores; rayon's pool).
+//! - `--out DIR`: where the images go (default: `target/arealight-out/` in the repository, where
+//!   every example writes).
 //! - `--plucker`: also shade the analytic image through the lazy Pluecker-space backend (seed
 //!   002; trees reused per thread), and print its time and largest per-pixel difference from
 //!   the clipping backend's image.
 //! - `--time-factors F1,F2,...`: the budgets of the two stochastic methods as multiples of the
 //!   analytic time (default `1,10`: equal time, and ten times as long); their images are written
 //!   for the first.
+//!
+//! Work that takes longer than a second shows a progress line on stderr. The analytic pass
+//! shades all surface points with `Scene::par_shade_batch`.
 //!
 //! Writes `render.png` (analytic), `render_ratio.png` (ratio estimator, equal time),
 //! `render_mc.png` (Monte Carlo, equal time), `render_reference.png` and
@@ -59,11 +63,19 @@
 
 use arealight::glam::DVec3;
 use arealight::internals::{Demo, DemoConfig, demo_scene};
-use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf};
+use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scene};
 use arealight::visibility::{PluckerContext, PluckerVisibility};
+use rayon::prelude::*;
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::time::Instant;
+
+#[path = "common/progress.rs"]
+mod progress;
+use progress::Progress;
+
+/// Where the examples write their outputs.
+const OUT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/arealight-out");
 
 const HELP: &str = "\
 render: the seed paper's test scene, analytic vs ratio estimator vs Monte Carlo at equal time
@@ -76,8 +88,8 @@ USAGE: cargo run --release --example render -- [FLAGS]
   --no-cache       recompute the reference even if a cached one exists
   --lights L       number of lights 0..=3: quad, cylinder, truncated cone (default 3)
   --occluders O    number of occluders 0..=3: cube, icosphere, ellipsoid (default 3)
-  --threads T      worker threads (default 2)
-  --out DIR        output directory (default .)
+  --threads T      worker threads (default 0: all cores)
+  --out DIR        output directory (default target/arealight-out in the repository)
   --plucker        also shade with the Pluecker backend; print the largest difference
   --time-factors F budgets of ratio estimator and Monte Carlo as multiples of the analytic
                    time, comma-separated (default 1,10); images are written for the first
@@ -104,8 +116,8 @@ fn parse_args() -> Result<Args, String> {
         ref_spp: 1024,
         cache: true,
         cfg: DemoConfig::default(),
-        threads: 2,
-        out: PathBuf::from("."),
+        threads: 0,
+        out: PathBuf::from(OUT_DIR),
         time_factors: vec![1.0, 10.0],
         plucker: false,
     };
@@ -124,7 +136,7 @@ fn parse_args() -> Result<Args, String> {
             "--no-cache" => a.cache = false,
             "--lights" => a.cfg.lights = num(value("--lights")?, "--lights")?.min(3),
             "--occluders" => a.cfg.occluders = num(value("--occluders")?, "--occluders")?.min(3),
-            "--threads" => a.threads = num(value("--threads")?, "--threads")?.max(1),
+            "--threads" => a.threads = num(value("--threads")?, "--threads")?,
             "--out" => a.out = PathBuf::from(value("--out")?),
             "--plucker" => a.plucker = true,
             "--time-factors" => {
@@ -254,33 +266,92 @@ fn trace(demo: &Demo, o: DVec3, d: DVec3) -> Hit {
     hit
 }
 
-/// Renders with `f(pixel index, hit) -> radiance` on `threads` threads (rows interleaved).
+/// Renders with `f(pixel index, hit) -> radiance` on the current rayon pool (set up from
+/// `--threads` by `main`), a row per task, with a progress line for passes over a second.
 fn render(
     w: usize,
     h: usize,
-    threads: usize,
+    _threads: usize,
+    hits: &[Hit],
+    f: impl Fn(usize, &Hit) -> DVec3 + Sync,
+) -> Vec<DVec3> {
+    render_labeled("rendering", w, h, hits, f)
+}
+
+/// [`render`] with the progress line's label.
+fn render_labeled(
+    label: &str,
+    w: usize,
+    h: usize,
     hits: &[Hit],
     f: impl Fn(usize, &Hit) -> DVec3 + Sync,
 ) -> Vec<DVec3> {
     let mut img = vec![DVec3::ZERO; w * h];
-    let mut rows: Vec<Vec<(usize, &mut [DVec3])>> = (0..threads).map(|_| Vec::new()).collect();
-    for (y, row) in img.chunks_mut(w).enumerate() {
-        rows[y % threads].push((y, row));
-    }
-    std::thread::scope(|s| {
-        for mine in rows {
-            let f = &f;
-            s.spawn(move || {
-                for (y, row) in mine {
-                    for (x, px) in row.iter_mut().enumerate() {
-                        let i = y * w + x;
-                        *px = f(i, &hits[i]);
-                    }
-                }
-            });
+    let progress = Progress::new(label, h);
+    img.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            *px = f(i, &hits[i]);
         }
+        progress.add(1);
     });
+    progress.finish();
     img
+}
+
+/// The analytic image: every surface point shaded by `Scene::par_shade_batch`, in runs of
+/// rows so that the progress line moves; a point that fails is black and counted.
+fn shade_analytic(scene: &Scene, w: usize, hits: &[Hit]) -> (Vec<DVec3>, usize) {
+    let mut img: Vec<DVec3> = hits
+        .iter()
+        .map(|hit| match hit {
+            Hit::Emitter(l) => *l,
+            _ => DVec3::ZERO,
+        })
+        .collect();
+    let surface: Vec<(usize, &DVec3, &DVec3, &DVec3, Material)> = hits
+        .iter()
+        .enumerate()
+        .filter_map(|(i, hit)| match hit {
+            Hit::Surface(p, n, v, m) => Some((i, p, n, v, *m)),
+            _ => None,
+        })
+        .collect();
+    let progress = Progress::new("analytic", surface.len());
+    let mut failures = 0;
+    for run in surface.chunks(8 * w.max(1)) {
+        let points: Vec<&DVec3> = run.iter().map(|q| q.1).collect();
+        let normals: Vec<&DVec3> = run.iter().map(|q| q.2).collect();
+        let views: Vec<&DVec3> = run.iter().map(|q| q.3).collect();
+        let materials: Vec<Material> = run.iter().map(|q| q.4).collect();
+        let shaded = scene
+            .par_shade_batch(&points, &normals, &views, &materials)
+            .unwrap_or_default();
+        for (q, r) in run.iter().zip(shaded) {
+            match r {
+                Ok(rgb) => img[q.0] = rgb,
+                Err(_) => failures += 1,
+            }
+        }
+        progress.add(run.len());
+    }
+    progress.finish();
+    (img, failures)
+}
+
+/// Runs `f` on a rayon pool of `threads` workers (0: rayon's global pool, all cores).
+fn with_threads(
+    threads: usize,
+    f: impl FnOnce() -> Result<(), String> + Send,
+) -> Result<(), String> {
+    if threads == 0 {
+        return f();
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?
+        .install(f)
 }
 
 /// Part of the reference cache's file name: bump it whenever the scene, the camera or what the
@@ -334,7 +405,7 @@ fn main() {
             std::process::exit(2);
         }
     };
-    if let Err(e) = run(&args) {
+    if let Err(e) = with_threads(args.threads, || run(&args)) {
         eprintln!("render: {e}");
         std::process::exit(1);
     }
@@ -454,24 +525,9 @@ fn run(args: &Args) -> Result<(), String> {
 
 /// The analytic image, its time, and the number of pixels that gave up (shaded black).
 fn render_analytic(args: &Args, demo: &Demo, hits: &[Hit]) -> (Vec<DVec3>, f64, usize) {
-    let failures = std::sync::atomic::AtomicUsize::new(0);
     let t0 = Instant::now();
-    let img = render(
-        args.width,
-        args.height,
-        args.threads,
-        hits,
-        |_, hit| match hit {
-            Hit::Nothing => DVec3::ZERO,
-            Hit::Emitter(l) => *l,
-            Hit::Surface(p, n, v, m) => demo.scene.shade(*p, *n, *v, m).unwrap_or_else(|_| {
-                failures.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                DVec3::ZERO
-            }),
-        },
-    );
-    let t = t0.elapsed().as_secs_f64();
-    (img, t, failures.into_inner())
+    let (img, failures) = shade_analytic(&demo.scene, args.width, hits);
+    (img, t0.elapsed().as_secs_f64(), failures)
 }
 
 /// The reference image (Monte Carlo with the true BRDF, `--ref-spp` samples per light per
@@ -500,7 +556,7 @@ fn reference_image(args: &Args, demo: &Demo, hits: &[Hit]) -> Result<(Vec<DVec3>
     }
     let t = Instant::now();
     let mc = MonteCarlo::new(args.ref_spp, ReferenceBrdf::True);
-    let r = render(w, h, args.threads, hits, |i, hit| match hit {
+    let r = render_labeled("reference", w, h, hits, |i, hit| match hit {
         Hit::Nothing => DVec3::ZERO,
         Hit::Emitter(l) => *l,
         Hit::Surface(p, n, v, m) => mc
@@ -555,7 +611,8 @@ fn equal_time(
     let subset: Vec<&Hit> = hits.iter().step_by(stride).collect();
     let time_subset = |spp: u32| {
         let t0 = Instant::now();
-        let chunk = subset.len().div_ceil(args.threads);
+        // The workers of the pool `main` set up (all cores by default).
+        let chunk = subset.len().div_ceil(rayon::current_num_threads());
         std::thread::scope(|s| {
             for (k, part) in subset.chunks(chunk.max(1)).enumerate() {
                 s.spawn(move || {

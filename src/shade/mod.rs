@@ -61,17 +61,24 @@
 //! - \[HHM18\] E. Heitz, S. Hill, M. McGuire. *Combining analytic direct illumination and
 //!   stochastic shadows.* I3D 2018.
 
+mod batch;
 pub(crate) mod demo;
 mod material;
 mod query;
 pub mod ratio;
 pub(crate) mod reference;
 mod scene;
+mod two_sided;
+mod validate;
 
 pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 pub use crate::visibility::{Blocker, Method};
+pub use batch::BatchResult;
+#[cfg(feature = "rayon")]
+pub use batch::PAR_MIN_RUN;
 pub use material::Material;
 pub use query::LightShading;
 pub use ratio::{LightRatio, RatioEstimator};
 pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf};
 pub use scene::{Light, Scene};
+pub use validate::{SceneIssue, SceneReport};

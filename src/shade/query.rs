@@ -13,11 +13,11 @@ use glam::{DMat3, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::GeomError;
 use crate::ltc::{clamped_cosine_integral_upper, lookup, ltc_integral};
 use crate::solid::ShadingFrame;
 use crate::sphere::SphericalPolygon;
 use crate::visibility::Visibility;
+use crate::{GeomError, IntoDVec3};
 
 /// What a failed LTC lookup or integral reports: the frame's view and the material were
 /// validated, and the visible region is a valid polygon, so any error is a give-up.
@@ -63,6 +63,16 @@ impl LightShading {
 /// roughness; `None` for a material without a specular lobe. One table lookup per shading point.
 pub(super) type SpecularSetup = Option<(DMat3, DVec3)>;
 
+/// The shading frame of the entry points' arguments, widened at the boundary
+/// ([`IntoDVec3`]).
+fn frame(
+    point: impl IntoDVec3,
+    normal: impl IntoDVec3,
+    view: impl IntoDVec3,
+) -> Result<ShadingFrame, GeomError> {
+    ShadingFrame::new(point.into_dvec3(), normal.into_dvec3(), view.into_dvec3())
+}
+
 pub(super) fn specular_setup(
     frame: &ShadingFrame,
     material: &Material,
@@ -101,10 +111,12 @@ impl Scene {
     /// `normal` and material `material`: seed 000 Alg. 1 summed over the lights.
     ///
     /// `view` points from the surface towards the viewer; `normal` and `view` need not be
-    /// normalized. For each light the visible region is computed in the shading frame
-    /// ([`Scene::visible_region`]), and integrated with Baum's formula for the diffuse lobe and,
-    /// after the LTC transform `M^-1` looked up for the view angle and roughness, for the GGX lobe
-    /// (HDHN16 eq. 2 / seed 000 eq. 2, Alg. 1 lines 13-16).
+    /// normalized. All three may be `f32` (glam's `Vec3`, `Vec3A`, `[f32; 3]`, see
+    /// [`IntoDVec3`]): they are widened exactly, and the computation is `f64`. For each light
+    /// the visible region is computed in the shading frame ([`Scene::visible_region`]), and
+    /// integrated with Baum's formula for the diffuse lobe and, after the LTC transform `M^-1`
+    /// looked up for the view angle and roughness, for the GGX lobe (HDHN16 eq. 2 / seed 000
+    /// eq. 2, Alg. 1 lines 13-16).
     ///
     /// # Errors
     ///
@@ -122,12 +134,12 @@ impl Scene {
     /// No other error is returned: the scene and the material were validated when built.
     pub fn shade(
         &self,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
         for i in 0..self.lights().len() {
@@ -202,13 +214,13 @@ impl Scene {
     pub fn shade_light(
         &self,
         light: usize,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
         self.light(light)?;
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
         self.shade_light_in(light, &frame, material, spec)
     }
@@ -246,16 +258,16 @@ impl Scene {
     /// As [`Scene::shade`].
     pub fn shade_per_light(
         &self,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<Vec<LightShading>, GeomError> {
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        let vis = self.visibility();
         let mut out = Vec::with_capacity(self.lights().len());
         for (i, light) in self.lights().iter().enumerate() {
+            let vis = self.light_visibility(i, &frame);
             let shadowed = integrals(&vis.visible_region(i, &frame)?, spec)?;
             let unshadowed = integrals(&vis.unoccluded_region(i, &frame)?, spec)?;
             let rgb = light.radiance();
@@ -284,7 +296,8 @@ impl Scene {
     ) -> Result<DVec3, GeomError> {
         let light = &self.lights()[i];
         // The visible pieces are already clipped to the upper hemisphere.
-        let (diffuse, specular) = integrals(&self.visibility().visible_region(i, frame)?, spec)?;
+        let vis = self.light_visibility(i, frame);
+        let (diffuse, specular) = integrals(&vis.visible_region(i, frame)?, spec)?;
         let mut out = material.albedo() * diffuse;
         if let Some((_, scale)) = spec {
             out += scale * specular;

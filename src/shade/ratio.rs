@@ -182,13 +182,15 @@ impl RatioEstimator {
         let ps = PointSampler::new(scene, point, normal, view, material, self.brdf)?;
         let frame = ps.frame();
         let spec = specular_setup(frame, material)?;
-        let vis = scene.visibility();
         let mut rng = Pcg32::new(seed, 0x7a71);
         let n = self.samples_per_light.max(1);
         let mut domain = LightDomain::default();
         let mut out = Vec::with_capacity(scene.lights().len());
         for (li, light) in scene.lights().iter().enumerate() {
-            let pieces = vis.unoccluded_region(li, frame)?;
+            // Two-sided lights seen from behind live in the turned-around backend.
+            let pieces = scene
+                .light_visibility(li, frame)
+                .unoccluded_region(li, frame)?;
             // The analytic factor, as `Scene::shade_per_light` forms it.
             let (d, s) = integrals(&pieces, spec)?;
             let rgb = light.radiance();

@@ -2,7 +2,8 @@
 //! and the per-point sampling machinery it shares with the ratio estimator
 //! ([`super::RatioEstimator`]).
 //!
-//! Each light is sampled uniformly by solid angle ([`LightSampling`]): by default over the part
+//! Each light is sampled uniformly by solid angle ([`LightSampling`]; both sides of a two-sided
+//! light, [`super::Light::two_sided`]): by default over the part
 //! of the sphere of directions it covers with every other object removed (its silhouette,
 //! clipped to the upper hemisphere, without its self-occluded parts:
 //! [`Visibility::unoccluded_region`]), triangulated ([`SphericalPolygon::triangulate`]) and
@@ -353,7 +354,7 @@ impl<'a> PointSampler<'a> {
         if sampling == LightSampling::Silhouette
             && let Ok(pieces) = self
                 .scene
-                .visibility()
+                .light_visibility(light, &self.frame)
                 .unoccluded_region(light, &self.frame)
             && self.region_domain(light, &pieces, out).is_ok()
         {
@@ -379,7 +380,7 @@ impl<'a> PointSampler<'a> {
         // From inside a convex light no face is seen from the front (its silhouette would be
         // the whole sphere): nothing, as for the face sampling.
         if let Body::Convex(p) = self.scene.lights()[light].shape()
-            && !(0..p.mesh().triangle_count()).any(|i| self.front(p.mesh(), i))
+            && !(0..p.mesh().triangle_count()).any(|i| self.emits_towards(light, p.mesh(), i))
         {
             return Ok(());
         }
@@ -399,11 +400,14 @@ impl<'a> PointSampler<'a> {
         Ok(())
     }
 
-    /// Whether triangle `i` of `mesh` faces the shading point (its centroid's side).
-    fn front(&self, mesh: &TriangleMesh, i: usize) -> bool {
+    /// Whether triangle `i` of light `light`'s mesh `mesh` emits towards the shading point: it
+    /// faces the point (the point is on its centroid's front side), or the light is two-sided
+    /// ([`super::Light::two_sided`]) and the point is strictly behind it.
+    fn emits_towards(&self, light: usize, mesh: &TriangleMesh, i: usize) -> bool {
         let [a, b, c] = mesh.triangle(i);
         let centroid = (a + b + c) / 3.0;
-        mesh.triangle_normal(i).dot(self.frame.origin() - centroid) > 0.0
+        let facing = mesh.triangle_normal(i).dot(self.frame.origin() - centroid);
+        facing > 0.0 || (facing < 0.0 && self.scene.lights()[light].is_two_sided())
     }
 
     /// Fills `out` with the projections of light `light`'s front faces ([`LightSampling::Faces`]).
@@ -412,7 +416,7 @@ impl<'a> PointSampler<'a> {
         let x = self.frame.origin();
         let mesh = self.scene.lights()[light].shape().mesh();
         for i in 0..mesh.triangle_count() {
-            if !self.front(mesh, i) {
+            if !self.emits_towards(light, mesh, i) {
                 continue; // back face: emits nothing towards x
             }
             let [a, b, c] = mesh.triangle(i);
@@ -506,7 +510,7 @@ impl<'a> PointSampler<'a> {
         }
         let t_light = match t_light {
             Some(t) => t,
-            None => match entry_distance(x, w, body) {
+            None => match entry_distance(x, w, body, self.scene.lights()[light].is_two_sided()) {
                 Some(t) => t,
                 None => return Outcome::Miss,
             },
@@ -567,13 +571,14 @@ fn nearest_front_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<f64> {
 /// planar light, for a direction known to lie in its region: for a convex light the largest
 /// distance to a face plane the ray enters through (the entry point of an intersection of
 /// half-spaces; no edge test, so directions on the silhouette's rim still get their distance),
-/// for a planar one the distance to its plane from the front side.
-fn entry_distance(x: DVec3, w: DVec3, body: &Body) -> Option<f64> {
+/// for a planar one the distance to its plane from the front side (from either side for a
+/// two-sided light).
+fn entry_distance(x: DVec3, w: DVec3, body: &Body, two_sided: bool) -> Option<f64> {
     let mesh = body.mesh();
     let plane_t = |j: usize| {
         let n = mesh.triangle_normal(j);
         let den = n.dot(w);
-        (den < 0.0).then(|| n.dot(mesh.triangle(j)[0] - x) / den)
+        (den < 0.0 || (two_sided && den > 0.0)).then(|| n.dot(mesh.triangle(j)[0] - x) / den)
     };
     let t = match body {
         Body::Convex(_) => (0..mesh.triangle_count())

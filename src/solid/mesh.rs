@@ -346,6 +346,39 @@ impl TriangleMesh {
         self.closed
     }
 
+    /// The same surface facing the other way: each triangle's corners in reverse order (the
+    /// first corner kept), so every normal, and the side a light emits from, is turned around.
+    ///
+    /// Exact: the normals and plane offsets are the negated ones, bit for bit (what
+    /// [`TriangleMesh::new`] would compute for the reversed triangles), so the facing predicate
+    /// ([`crate::solid::face_side`]) gives exactly the opposite side for every point.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::solid::TriangleMesh;
+    /// let down = TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y, DVec3::X)?;
+    /// assert_eq!(down.triangle_normal(0), DVec3::NEG_Z);
+    /// assert_eq!(down.flipped().triangle_normal(0), DVec3::Z);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    #[must_use]
+    pub fn flipped(&self) -> TriangleMesh {
+        let triangles: Vec<[u32; 3]> = self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect();
+        let (edges, closed) = edge_adjacency(&triangles);
+        TriangleMesh {
+            vertices: self.vertices.clone(),
+            triangles,
+            normals: self.normals.iter().map(|n| -*n).collect(),
+            offsets: self.offsets.iter().map(|d| -d).collect(),
+            edges,
+            bounds: self.bounds,
+            planar: self.planar,
+            closed,
+        }
+    }
+
     /// The mesh of all triangles of `self` and `other` (no vertices are merged).
     ///
     /// # Errors

@@ -9,6 +9,9 @@
 //! reports how often anything fails (`cargo test --test sphere_robust_props census --
 //! --nocapture`; `SPHERE_CENSUS=N` cases per family, default 2000).
 
+// The crate's shared test helpers, from the package next door; this file lives in the
+// `compare` member because its planar reference is i_overlay.
+#[path = "../../tests/support/mod.rs"]
 mod support;
 
 use arealight::GeomError;

@@ -3,6 +3,8 @@
 //! (`tests/sphere_robust_props.rs`, `fuzz/fuzz_targets/sphere_*`), checked against a value
 //! computed independently (closed form, exact identity, or a reference clip written here).
 
+// This file lives in the `compare` member because some of its references are i_overlay's.
+
 use arealight::glam::DVec3;
 use arealight::sphere::SphericalPolygon;
 
