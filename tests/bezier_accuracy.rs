@@ -1,0 +1,229 @@
+//! Accuracy of the curved-light integrals (seed 004) against references that share no code
+//! with them: Green's theorem along the exact curves for the Lambert lobe, and a fine
+//! Sutherland-Hodgman polygonization (extrapolated) for the GGX lobe.
+//!
+//! The error report (error against `eps` and against the number of edges, next to the error
+//! estimate) is printed by
+//! `cargo test --release --test bezier_accuracy -- --ignored --nocapture report`.
+
+mod support;
+
+use arealight::glam::{DVec2, DVec3};
+use arealight::ltc::{
+    CurveSegment, Subdivision, curved_clamped_cosine_integral, ggx_curved_integral,
+};
+use support::bezier::{
+    Lobe, Plane, Seg2, blob, facing_origin, green_lambert, letter_d, polygon_reference,
+};
+
+/// A named configuration: segments in the shading frame (point at the origin, normal `+z`).
+struct Case {
+    name: &'static str,
+    segs: Vec<CurveSegment>,
+}
+
+fn p(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}
+
+/// A vertical plane at distance `d` along `x`, seen from the origin: in-plane `v` is height.
+fn wall(d: f64) -> Plane {
+    Plane {
+        o: DVec3::new(d, 0.0, 0.0),
+        e1: DVec3::Y,
+        e2: DVec3::Z,
+    }
+}
+
+/// The cases of issue 19: crossings of the horizon with 1, 2 and 3 roots in one cubic, a
+/// tangency, holes, tilted planes, a point close to the plane.
+fn cases() -> Vec<Case> {
+    let mut out = Vec::new();
+    // One root per crossing cubic: a blob centred a little above the horizon.
+    out.push(Case {
+        name: "blob, one root per crossing",
+        segs: facing_origin(&wall(2.0), &[blob(p(0.0, 0.4), &[1.0, 0.8, 1.1], 6, 0.3)]),
+    });
+    // Two roots in one cubic: its bottom dips below the horizon and comes back.
+    let two = vec![
+        Seg2::Cubic([p(-1.0, 0.3), p(-0.3, -0.5), p(0.3, -0.5), p(1.0, 0.3)]),
+        Seg2::Line(p(1.0, 0.3), p(1.0, 1.5)),
+        Seg2::Cubic([p(1.0, 1.5), p(0.5, 2.0), p(-0.5, 2.0), p(-1.0, 1.5)]),
+        Seg2::Line(p(-1.0, 1.5), p(-1.0, 0.3)),
+    ];
+    out.push(Case {
+        name: "two roots in one cubic",
+        segs: facing_origin(&wall(1.5), &[two]),
+    });
+    // Three roots in one cubic: an S-shaped bottom edge across the horizon.
+    let three = vec![
+        Seg2::Cubic([p(-1.0, -0.3), p(-0.2, 1.0), p(0.2, -1.0), p(1.0, 0.3)]),
+        Seg2::Line(p(1.0, 0.3), p(1.0, 1.2)),
+        Seg2::Line(p(1.0, 1.2), p(-1.0, 1.2)),
+        Seg2::Line(p(-1.0, 1.2), p(-1.0, -0.3)),
+    ];
+    out.push(Case {
+        name: "three roots in one cubic",
+        segs: facing_origin(&wall(1.2), &[three]),
+    });
+    // Tangent: the bottom cubic touches the horizon (a double root at t = 1/2).
+    let tangent = vec![
+        Seg2::Cubic([
+            p(-1.0, 0.5),
+            p(-0.4, -1.0 / 6.0),
+            p(0.4, -1.0 / 6.0),
+            p(1.0, 0.5),
+        ]),
+        Seg2::Line(p(1.0, 0.5), p(1.0, 1.5)),
+        Seg2::Line(p(1.0, 1.5), p(-1.0, 1.5)),
+        Seg2::Line(p(-1.0, 1.5), p(-1.0, 0.5)),
+    ];
+    out.push(Case {
+        name: "tangent to the horizon",
+        segs: facing_origin(&wall(1.0), &[tangent]),
+    });
+    // A letter with a hole, crossing the horizon through both loops.
+    out.push(Case {
+        name: "letter D with a hole, crossing",
+        segs: facing_origin(&wall(1.6), &[letter_d()[0].clone(), letter_d()[1].clone()]),
+    });
+    // The same above a floor point, tilted.
+    out.push(Case {
+        name: "letter D tilted overhead",
+        segs: facing_origin(
+            &Plane::new(DVec3::new(0.4, -0.3, 2.0), DVec3::new(0.3, -0.2, -1.0)),
+            &letter_d(),
+        ),
+    });
+    // Close to the plane: the light fills almost half the sphere.
+    out.push(Case {
+        name: "point 0.05 from a tilted plane",
+        segs: facing_origin(
+            &Plane::new(DVec3::new(0.02, 0.01, 0.04), DVec3::new(0.4, 0.2, 0.8)),
+            &[blob(p(0.3, 0.2), &[1.0, 1.3, 0.9, 1.2], 8, 0.1)],
+        ),
+    });
+    out
+}
+
+/// The GGX settings each case is checked with: near-normal, oblique and grazing views,
+/// rough to near-mirror.
+const GGX: [(f64, f64); 4] = [(0.9, 0.3), (0.5, 0.1), (0.1, 0.05), (0.02, 0.2)];
+
+fn lambert_ref(c: &Case) -> f64 {
+    green_lambert(&c.segs, 16, 24).clamp(0.0, 1.0)
+}
+
+#[test]
+fn references_agree_with_each_other() {
+    // Green's theorem and the extrapolated polygonization are independent: their agreement is
+    // what makes either a reference.
+    for c in cases() {
+        let g = lambert_ref(&c);
+        let (poly, spread) = polygon_reference(&c.segs, 4000, Lobe::Lambert);
+        assert!(
+            (g - poly).abs() <= 1e-9 + spread,
+            "{}: Green {g} vs polygon {poly} (spread {spread})",
+            c.name
+        );
+    }
+}
+
+#[test]
+fn lambert_converges_to_the_exact_region() {
+    for c in cases() {
+        let exact = lambert_ref(&c);
+        assert!(
+            exact > 1e-3,
+            "{}: a case that sees little light tests little",
+            c.name
+        );
+        let mut last = f64::INFINITY;
+        for eps in [1e-3, 1e-5, 1e-7, 1e-9, 1e-11] {
+            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::Adaptive { eps }).unwrap();
+            let err = (r.value - exact).abs();
+            let est = r.error_estimate.unwrap();
+            // The estimate is the leading term of the error: within a factor of a few of the
+            // truth, never far below it (rounding aside).
+            assert!(
+                err <= 3.0 * est + 1e-13,
+                "{} eps {eps}: error {err:e} above 3x estimate {est:e}",
+                c.name
+            );
+            last = err;
+        }
+        // Each accepted interval leaves out about eps / 3, and there are about eps^(-1/3) of
+        // them per curve: the error falls like eps^(2/3).
+        assert!(last < 1e-8, "{}: error {last:e} at eps 1e-11", c.name);
+    }
+}
+
+#[test]
+fn ggx_converges_to_the_fine_polygonization() {
+    for c in cases() {
+        for (cos_v, alpha) in GGX {
+            let (exact, spread) = polygon_reference(&c.segs, 50_000, Lobe::Ggx(cos_v, alpha, 1.0));
+            for eps in [1e-4, 1e-6, 1e-8, 1e-10] {
+                let r =
+                    ggx_curved_integral(&c.segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps })
+                        .unwrap();
+                let err = (r.value - exact).abs();
+                let est = r.error_estimate.unwrap();
+                assert!(
+                    err <= 3.0 * est + 1e-11 + spread,
+                    "{} cos {cos_v} alpha {alpha} eps {eps}: {} vs {exact}: error {err:e} above 3x estimate {est:e}",
+                    c.name,
+                    r.value
+                );
+            }
+        }
+    }
+}
+
+#[test]
+#[ignore = "prints the error report; run with --ignored --nocapture"]
+fn report() {
+    println!("Lambert: |error| and estimate against eps (edges in brackets)");
+    for c in cases() {
+        let exact = lambert_ref(&c);
+        print!("{:<34} I = {exact:.6}", c.name);
+        for eps in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10] {
+            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::Adaptive { eps }).unwrap();
+            print!(
+                " | {eps:.0e}: {:.1e}/{:.1e} [{}]",
+                (r.value - exact).abs(),
+                r.error_estimate.unwrap(),
+                r.edges
+            );
+        }
+        println!();
+        print!("{:<34} uniform", "");
+        for n in [2, 6, 18, 30, 100] {
+            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::Uniform { n }).unwrap();
+            print!(" | N {n}: {:.1e} [{}]", (r.value - exact).abs(), r.edges);
+        }
+        println!();
+    }
+    println!("GGX (f0 = 1): |error| and estimate against eps (edges in brackets)");
+    for c in cases() {
+        for (cos_v, alpha) in GGX {
+            let (exact, spread) = polygon_reference(&c.segs, 50_000, Lobe::Ggx(cos_v, alpha, 1.0));
+            print!(
+                "{:<34} cos {cos_v} a {alpha}: I = {exact:.6} (+-{spread:.0e})",
+                c.name
+            );
+            for eps in [0.1 * alpha * alpha, 1e-3, 1e-4, 1e-6, 1e-8] {
+                let r =
+                    ggx_curved_integral(&c.segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps })
+                        .unwrap();
+                print!(
+                    " | {eps:.0e}: {:.1e}/{:.1e} [{}]",
+                    (r.value - exact).abs(),
+                    r.error_estimate.unwrap(),
+                    r.edges
+                );
+            }
+            println!();
+        }
+    }
+}
