@@ -7,6 +7,9 @@
 //! - [`Scene::shade_per_light`]: every light's share, split into diffuse and specular lobes,
 //!   with its unshadowed value ([`LightShading`]), for denoising and ratio estimators.
 //! - [`Material`]: Lambert + GGX with Schlick's Fresnel.
+//! - Lights bounded by Bezier curves ([`BezierShape`], seed 004): in a scene, each point's
+//!   flattening goes through the same visibility as any light, so occluders cast shadows from
+//!   them; [`Light::shade_curved`] shades one unshadowed by the curved integrals directly.
 //! - [`MonteCarlo`]: an estimator of the same radiance (solid-angle sampling of the lights'
 //!   triangles, exact ray-triangle visibility), with its standard error, for tests and
 //!   comparisons.
@@ -57,14 +60,19 @@
 //! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
+mod curved;
+mod curved_reference;
 pub(crate) mod demo;
 mod material;
 mod query;
 pub(crate) mod reference;
 mod scene;
 
-pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
+pub use crate::solid::{
+    BezierSegment, BezierShape, Body, ConvexPolyhedron, ShadingFrame, TriangleMesh,
+};
 pub use crate::visibility::{Blocker, Method};
+pub use curved::{CurvedShading, DEFAULT_DIFFUSE_SUBDIVISION};
 pub use material::Material;
 pub use query::LightShading;
 pub use reference::{Estimate, MonteCarlo, ReferenceBrdf};

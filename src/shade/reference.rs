@@ -10,6 +10,9 @@
 //! before the sampled point on the light blocks the sample. The estimator returns its mean and
 //! standard error, so tests can state a confidence bound.
 //!
+//! Lights bounded by Bezier curves are sampled uniformly by area over the exact curved region
+//! (rejection from its bounding box), with the same visibility test.
+//!
 //! Only the outer (front) side of a light emits: a shading point inside a closed light sees none
 //! of its triangles from the front and gets nothing here, where the analytic silhouette path
 //! counts the whole sphere (the one configuration where the two differ; no scene meant for
@@ -105,11 +108,11 @@ pub struct MonteCarlo {
 
 /// Relative distance along a ray below which a hit counts as the ray's own start or end point:
 /// rays start on surfaces and end on the light, and both ends must not block themselves.
-const RAY_EPS: f64 = 1e-9;
+pub(super) const RAY_EPS: f64 = 1e-9;
 
 /// Möller–Trumbore ray-triangle intersection: the distance `t > 0` along `dir` (unit) from
 /// `orig` to the triangle, if the ray hits it.
-fn ray_triangle(orig: DVec3, dir: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
+pub(super) fn ray_triangle(orig: DVec3, dir: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
     let e1 = b - a;
     let e2 = c - a;
     let p = dir.cross(e2);
@@ -133,7 +136,7 @@ fn ray_triangle(orig: DVec3, dir: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
 }
 
 /// Whether the ray from `orig` along unit `dir` can meet the sphere `(c, r)` before `t_max`.
-fn ray_meets_sphere(orig: DVec3, dir: DVec3, c: DVec3, r: f64, t_max: f64) -> bool {
+pub(super) fn ray_meets_sphere(orig: DVec3, dir: DVec3, c: DVec3, r: f64, t_max: f64) -> bool {
     let oc = c - orig;
     let along = oc.dot(dir);
     let d2 = oc.length_squared() - along * along;
@@ -216,6 +219,20 @@ impl MonteCarlo {
         let mut tris: Vec<(SphericalTriangle, usize)> = Vec::new();
         let mut cdf: Vec<f64> = Vec::new();
         for (li, light) in scene.lights().iter().enumerate() {
+            if let Body::Bezier(shape) = light.shape() {
+                // Curved lights: sampled by area over the exact curves (not their flattening).
+                let (m, s2) = super::curved_reference::estimate(
+                    shape,
+                    &frame,
+                    n,
+                    &mut rng,
+                    &brdf,
+                    (&blockers, no + li),
+                );
+                mean += m * light.radiance();
+                var += s2 * light.radiance() * light.radiance();
+                continue;
+            }
             let mesh = light.shape().mesh();
             tris.clear();
             cdf.clear();

@@ -449,6 +449,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// hemisphere (seed 000 Alg. 1 lines 4-5), as pieces with disjoint interiors:
     ///
     /// - a convex light with [`Method::Silhouette`]: its silhouette, one piece;
+    /// - a Bezier-bounded light ([`crate::solid::BezierShape`]): its flattening within the
+    ///   shape's angular flatness as seen from the point ([`crate::solid::BezierShape::region`]),
+    ///   one piece;
     /// - a convex light with [`Method::PerTriangle`], or a planar mesh light: each front-facing
     ///   triangle, one piece each (seed 000 section 4.4). Their projections cannot overlap, so
     ///   their integrals add up exactly;
@@ -489,6 +492,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         };
         if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
             return Ok(one(upper_part(&convex_silhouette(p, frame)?)?));
+        }
+        if let Body::Bezier(b) = body {
+            // A flattening within the shape's angular flatness seen from the point (seed 004
+            // lights), with either method.
+            return Ok(one(upper_part(&b.region(frame)?)?));
         }
         if let (Some(solid), Method::Silhouette) = (&self.solids[light], self.method) {
             match nonconvex_silhouette(solid, frame) {

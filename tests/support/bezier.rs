@@ -10,6 +10,7 @@
 
 use arealight::glam::{DMat3, DVec2, DVec3};
 use arealight::ltc::{CurveSegment, lookup};
+use arealight::solid::{BezierSegment, BezierShape};
 use std::f64::consts::PI;
 
 use super::sphere::gauss_legendre01;
@@ -133,6 +134,26 @@ impl Plane {
         }
         out
     }
+}
+
+/// The outline as a validated [`BezierShape`] in the plane (emitting towards `e1 x e2`).
+pub fn shape(plane: &Plane, loops: &[Vec<Seg2>]) -> BezierShape {
+    let segs = plane.place(loops);
+    let mut out: Vec<Vec<BezierSegment>> = Vec::new();
+    let mut k = 0;
+    for l in loops {
+        out.push(
+            segs[k..k + l.len()]
+                .iter()
+                .map(|s| match *s {
+                    CurveSegment::Line(p) => BezierSegment::Line(p),
+                    CurveSegment::Cubic(p) => BezierSegment::Cubic(p),
+                })
+                .collect(),
+        );
+        k += l.len();
+    }
+    BezierShape::new(out).unwrap()
 }
 
 /// The segments oriented for the shading point at the origin: counter-clockwise seen from
