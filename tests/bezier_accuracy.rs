@@ -227,3 +227,98 @@ fn report() {
         }
     }
 }
+
+#[test]
+fn bad_input_is_an_error_naming_loop_and_segment() {
+    use arealight::GeomError;
+    let d = facing_origin(&wall(1.6), &letter_d());
+    let fine = Subdivision::Adaptive { eps: 1e-6 };
+    let at = |r: Result<_, GeomError>| match r {
+        Err(GeomError::InvalidCurve { ring, segment, .. }) => (ring, segment),
+        other => panic!("expected InvalidCurve, got {other:?}"),
+    };
+    // Loops: 3 segments each; the hole (reversed: cubic, cubic, line) starts at index 3.
+    let mut s = d.clone();
+    if let CurveSegment::Cubic(p) = &mut s[4] {
+        p[1].y = f64::NAN;
+    }
+    assert_eq!(at(curved_clamped_cosine_integral(&s, fine)), (1, 1));
+    let mut s = d.clone();
+    if let CurveSegment::Cubic(p) = &mut s[2] {
+        p[3].z += 1e-3; // the outer loop no longer closes
+    }
+    assert_eq!(at(curved_clamped_cosine_integral(&s, fine)), (0, 2));
+    let mut s = d.clone();
+    if let CurveSegment::Cubic(p) = &mut s[3] {
+        p[2].x += 1e-3; // off the plane x = 1.6
+    }
+    assert_eq!(at(curved_clamped_cosine_integral(&s, fine)), (1, 0));
+    for bad in [
+        Subdivision::Adaptive { eps: 0.0 },
+        Subdivision::Adaptive { eps: f64::NAN },
+        Subdivision::Uniform { n: 0 },
+    ] {
+        assert!(matches!(
+            curved_clamped_cosine_integral(&d, bad),
+            Err(GeomError::OutOfRange { .. })
+        ));
+    }
+    assert!(matches!(
+        arealight::ltc::curved_ltc_integral(&d, arealight::glam::DMat3::ZERO, fine),
+        Err(GeomError::Degenerate(_))
+    ));
+    assert!(ggx_curved_integral(&d, 0.5, 0.2, f64::NAN, fine).is_err());
+}
+
+/// Points on the light's plane, on its boundary, and a hair off it: finite values in [0, 1]
+/// (zero in the plane, where the light is seen edge-on).
+#[test]
+fn points_on_or_next_to_the_plane_give_finite_values() {
+    let d = letter_d();
+    for h in [0.0, 1e-15, 1e-12, 1e-9, 1e-6] {
+        for (name, segs) in [
+            // The shading point on the plane, inside the D's stem...
+            ("inside", facing_origin(&wall(h), &d)),
+            // ... inside, on a tilted plane (where a loop winding round the point would give
+            // the plane's tilt, not zero) ...
+            (
+                "inside, tilted",
+                facing_origin(
+                    &Plane {
+                        o: DVec3::new(0.0, 0.8, 0.0) + DVec3::new(0.6, 0.0, 0.8) * h,
+                        e1: DVec3::Y,
+                        e2: DVec3::new(-0.8, 0.0, 0.6),
+                    },
+                    &d,
+                ),
+            ),
+            // ... on its boundary (the stem's edge at u = -1 passes through the origin) ...
+            (
+                "on the edge",
+                facing_origin(
+                    &Plane {
+                        o: DVec3::new(h, 1.0, 0.0),
+                        e1: DVec3::Y,
+                        e2: DVec3::Z,
+                    },
+                    &d,
+                ),
+            ),
+        ] {
+            for sub in [
+                Subdivision::Adaptive { eps: 1e-6 },
+                Subdivision::Uniform { n: 8 },
+            ] {
+                let r = curved_clamped_cosine_integral(&segs, sub).unwrap();
+                assert!((0.0..=1.0).contains(&r.value), "{name} h {h}: {r:?}");
+                if h == 0.0 {
+                    assert_eq!(r.value, 0.0, "{name}: edge-on");
+                }
+                for (cos_v, alpha) in GGX {
+                    let g = ggx_curved_integral(&segs, cos_v, alpha, 1.0, sub).unwrap();
+                    assert!(g.value.is_finite() && g.value >= 0.0, "{name} h {h}: {g:?}");
+                }
+            }
+        }
+    }
+}
