@@ -22,6 +22,18 @@ impl Ray {
             len2: v.length_squared(),
         }
     }
+
+    /// The dot product of the two directions' vectors.
+    #[inline(always)]
+    pub(super) fn dot(self, other: Ray) -> f64 {
+        self.v.dot(other.v)
+    }
+
+    /// The squared length.
+    #[inline(always)]
+    pub(super) fn len2(self) -> f64 {
+        self.len2
+    }
 }
 
 /// Baum's edge term for the edge `a -> b`: `theta * (a x b)_z / |a x b|`, with the angle taken as
