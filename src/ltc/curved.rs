@@ -55,7 +55,8 @@
 //! accepted triangle. The error is therefore about `(1/3) sum |L_triangle|` over the accepted
 //! intervals, which is at most `eps / 3` per interval; [`CurvedIntegral::error_estimate`]
 //! returns that sum. On the tests' curves (letters, blobs, 1 to 3 horizon crossings, grazing
-//! views) the error stays within 0.7 to 1.4 times it. It is an estimate, not a bound: where the
+//! views) the error is at most 1.4 times it, and often far below where slivers of both signs
+//! cancel. It is an estimate, not a bound: where the
 //! parametrization is far from uniform within an interval (a cubic whose handles sit on an end
 //! point moves arbitrarily slowly there) the halves are not an eighth of their parent each, and
 //! the fuzz target found an error 5.4 times the estimate (at `eps = 1e-7`, a near-mirror lobe);
