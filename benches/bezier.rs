@@ -7,7 +7,7 @@
 //! the points (against `eps = 1e-12`); the adaptive threshold is then lowered by factors of 2
 //! from `1e-2` until its maximum error is no larger, and both are timed on the same points.
 //! The matching table (errors and edges) is printed once; results in BENCHMARKS.md (section
-//! `Bezier lights`). Run with `cargo bench --bench bezier`.
+//! `Bezier lights`). Run with `cargo bench -p arealight-benches --bench bezier`.
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::{CurveSegment, Subdivision, ggx_curved_integral, specular_eps};

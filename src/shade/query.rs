@@ -13,11 +13,11 @@ use glam::{DMat3, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::GeomError;
 use crate::ltc::{clamped_cosine_integral_upper, lookup, ltc_integral};
 use crate::solid::ShadingFrame;
 use crate::sphere::SphericalPolygon;
 use crate::visibility::Visibility;
+use crate::{GeomError, IntoDVec3};
 
 /// What a failed LTC lookup or integral reports: the frame's view and the material were
 /// validated, and the visible region is a valid polygon, so any error is a give-up.
@@ -61,9 +61,22 @@ impl LightShading {
 /// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,
 /// [`crate::ltc::LtcLookup::specular_scale`]) for the frame's view angle and the material's
 /// roughness; `None` for a material without a specular lobe. One table lookup per shading point.
-type SpecularSetup = Option<(DMat3, DVec3)>;
+pub(super) type SpecularSetup = Option<(DMat3, DVec3)>;
 
-fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularSetup, GeomError> {
+/// The shading frame of the entry points' arguments, widened at the boundary
+/// ([`IntoDVec3`]).
+fn frame(
+    point: impl IntoDVec3,
+    normal: impl IntoDVec3,
+    view: impl IntoDVec3,
+) -> Result<ShadingFrame, GeomError> {
+    ShadingFrame::new(point.into_dvec3(), normal.into_dvec3(), view.into_dvec3())
+}
+
+pub(super) fn specular_setup(
+    frame: &ShadingFrame,
+    material: &Material,
+) -> Result<SpecularSetup, GeomError> {
     if !material.has_specular() {
         return Ok(None);
     }
@@ -79,7 +92,10 @@ fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularS
 
 /// The diffuse (clamped cosine over pi) and LTC integrals over region pieces already clipped to
 /// the upper hemisphere; the second is zero without a specular lobe.
-fn integrals(pieces: &[SphericalPolygon], spec: SpecularSetup) -> Result<(f64, f64), GeomError> {
+pub(super) fn integrals(
+    pieces: &[SphericalPolygon],
+    spec: SpecularSetup,
+) -> Result<(f64, f64), GeomError> {
     let (mut diffuse, mut specular) = (0.0, 0.0);
     for piece in pieces {
         diffuse += clamped_cosine_integral_upper(piece);
@@ -95,10 +111,12 @@ impl Scene {
     /// `normal` and material `material`: seed 000 Alg. 1 summed over the lights.
     ///
     /// `view` points from the surface towards the viewer; `normal` and `view` need not be
-    /// normalized. For each light the visible region is computed in the shading frame
-    /// ([`Scene::visible_region`]), and integrated with Baum's formula for the diffuse lobe and,
-    /// after the LTC transform `M^-1` looked up for the view angle and roughness, for the GGX lobe
-    /// (HDHN16 eq. 2 / seed 000 eq. 2, Alg. 1 lines 13-16).
+    /// normalized. All three may be `f32` (glam's `Vec3`, `Vec3A`, `[f32; 3]`, see
+    /// [`IntoDVec3`]): they are widened exactly, and the computation is `f64`. For each light
+    /// the visible region is computed in the shading frame ([`Scene::visible_region`]), and
+    /// integrated with Baum's formula for the diffuse lobe and, after the LTC transform `M^-1`
+    /// looked up for the view angle and roughness, for the GGX lobe (HDHN16 eq. 2 / seed 000
+    /// eq. 2, Alg. 1 lines 13-16).
     ///
     /// # Errors
     ///
@@ -116,16 +134,74 @@ impl Scene {
     /// No other error is returned: the scene and the material were validated when built.
     pub fn shade(
         &self,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        let frame = frame(point, normal, view)?;
+        let mut total = DVec3::ZERO;
+        let spec = specular_setup(&frame, material)?;
+        for i in 0..self.lights().len() {
+            total += self.shade_light_in(i, &frame, material, spec)?;
+        }
+        Ok(total)
+    }
+
+    /// [`Scene::shade`] with the visible regions of another [`Visibility`] backend over the same
+    /// lights and occluders, e.g. a
+    /// [`PluckerVisibility`](crate::visibility::PluckerVisibility) built from
+    /// [`Scene::visibility`] (or one of its per-thread
+    /// [`PluckerVisibility::with_context`](crate::visibility::PluckerVisibility::with_context)
+    /// views, which reuse trees across calls). The integration is [`Scene::shade`]'s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
+    /// use arealight::visibility::PluckerVisibility;
+    /// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+    /// let cube = ConvexPolyhedron::cuboid(DVec3::new(0.3, 0.0, 1.5), DVec3::splat(0.25))?;
+    /// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![cube.into()])?;
+    /// let floor = Material::new(DVec3::splat(0.8), DVec3::splat(0.04), 0.5)?;
+    /// let (x, n, v) = (DVec3::ZERO, DVec3::Z, DVec3::new(0.3, 0.0, 1.0));
+    /// let clip = scene.shade(x, n, v, &floor)?;
+    /// assert_eq!(scene.shade_with(scene.visibility(), x, n, v, &floor)?, clip);
+    /// let plucker = PluckerVisibility::from_clip(scene.visibility().clone());
+    /// let lazy = scene.shade_with(&plucker, x, n, v, &floor)?;
+    /// assert!((lazy - clip).abs().max_element() <= 1e-12 * clip.max_element());
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`]; [`GeomError::OutOfRange`] when `vis` has another number of lights.
+    pub fn shade_with(
+        &self,
+        vis: &dyn Visibility,
         point: DVec3,
         normal: DVec3,
         view: DVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
+        if vis.light_count() != self.lights().len() {
+            return Err(GeomError::OutOfRange {
+                what: "light count of the visibility backend (the scene's)",
+                value: vis.light_count() as f64,
+                limit: self.lights().len() as f64,
+            });
+        }
         let frame = ShadingFrame::new(point, normal, view)?;
-        let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
-        for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, spec)?;
+        let mut total = DVec3::ZERO;
+        for (i, light) in self.lights().iter().enumerate() {
+            let (diffuse, specular) = integrals(&vis.visible_region(i, &frame)?, spec)?;
+            let mut out = material.albedo() * diffuse;
+            if let Some((_, scale)) = spec {
+                out += scale * specular;
+            }
+            total += out * light.radiance();
         }
         Ok(total)
     }
@@ -138,13 +214,13 @@ impl Scene {
     pub fn shade_light(
         &self,
         light: usize,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
         self.light(light)?;
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
         self.shade_light_in(light, &frame, material, spec)
     }
@@ -182,16 +258,16 @@ impl Scene {
     /// As [`Scene::shade`].
     pub fn shade_per_light(
         &self,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<Vec<LightShading>, GeomError> {
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        let vis = self.visibility();
         let mut out = Vec::with_capacity(self.lights().len());
         for (i, light) in self.lights().iter().enumerate() {
+            let vis = self.light_visibility(i, &frame);
             let shadowed = integrals(&vis.visible_region(i, &frame)?, spec)?;
             let unshadowed = integrals(&vis.unoccluded_region(i, &frame)?, spec)?;
             let rgb = light.radiance();
@@ -220,7 +296,8 @@ impl Scene {
     ) -> Result<DVec3, GeomError> {
         let light = &self.lights()[i];
         // The visible pieces are already clipped to the upper hemisphere.
-        let (diffuse, specular) = integrals(&self.visibility().visible_region(i, frame)?, spec)?;
+        let vis = self.light_visibility(i, frame);
+        let (diffuse, specular) = integrals(&vis.visible_region(i, frame)?, spec)?;
         let mut out = material.albedo() * diffuse;
         if let Some((_, scale)) = spec {
             out += scale * specular;

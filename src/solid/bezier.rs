@@ -503,6 +503,13 @@ impl BezierShape {
         self.plane_distance(x) > BEZIER_TOLERANCE * self.extent
     }
 
+    /// Whether the shading point `x` is behind the emitting side, by more than
+    /// [`BEZIER_TOLERANCE`] of the extent: what a two-sided light shows there is the back.
+    #[must_use]
+    pub fn faces_back(&self, x: DVec3) -> bool {
+        self.plane_distance(x) < -BEZIER_TOLERANCE * self.extent
+    }
+
     /// The flattening used for a point at distance at least `distance` from the shape: the
     /// coarsest kept level within `flatten_angle * distance` of the curves (the finest when
     /// none is).
@@ -889,7 +896,7 @@ fn triangulate(
         .map_err(|e| e.give_up("the triangulation of a curved light's flattening failed"))?;
     let scale = pts.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
     let mut kept: Vec<[u32; 3]> = Vec::new();
-    for [a, b, c] in tris {
+    for [a, b, c] in tris.tris {
         let (pa, pb, pc) = (pts[a], pts[b], pts[c]);
         let area2 = (pb - pa).perp_dot(pc - pa);
         if !(area2 > 1e-20 * scale * scale) {

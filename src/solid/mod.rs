@@ -10,6 +10,7 @@
 //! - [`BezierShape`]: a planar shape bounded by cubic Bezier curves and lines (seed 004's
 //!   free-form lights), validated, flattened per shading point.
 //! - [`Body`]: the geometry of one object of a scene.
+//! - [`Bvh`]: a bounding-volume hierarchy over a mesh's triangles, for culling.
 //! - [`ShadingFrame`]: the local frame of a shading point.
 //! - [`face_side`]: the one facing predicate (does a mesh triangle face a point), with its
 //!   tolerance [`FACE_TOLERANCE`].
@@ -26,6 +27,7 @@
 
 mod bezier;
 mod body;
+mod bvh;
 mod closed;
 mod convex;
 pub(crate) mod facing;
@@ -36,12 +38,15 @@ mod primitives;
 pub(crate) mod separation;
 pub(crate) mod silhouette;
 
-pub use silhouette::{DEFAULT_REGION_RADII, SilhouetteBsp, nonconvex_silhouette};
+pub use silhouette::{
+    DEFAULT_REGION_RADII, SilhouetteBsp, SilhouetteSampler, TriangleSource, nonconvex_silhouette,
+};
 
 pub use bezier::{
     BEZIER_TOLERANCE, BezierSegment, BezierShape, DEFAULT_FLATTEN_ANGLE, FINEST_FLATNESS,
 };
 pub use body::Body;
+pub use bvh::Bvh;
 pub use closed::ClosedMesh;
 pub use convex::ConvexPolyhedron;
 pub use facing::{FACE_TOLERANCE, Side, face_side};

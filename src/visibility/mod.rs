@@ -5,8 +5,9 @@
 //! - [`ClipVisibility`]: the exact rule `visible(f) = proj(f) - U_B proj(B n H_f)` evaluated with
 //!   spherical set operations (seed 000 Alg. 1, extended to blockers that interpenetrate or hide
 //!   lights); see [`ClipVisibility::visible_region`].
-//! - A second backend, the lazily built BSP of occluder equivalence classes in Pluecker space
-//!   (seed 002, Alg. 1), can implement the same trait.
+//! - [`PluckerVisibility`]: the same rule by the lazily built BSP of occluder equivalence
+//!   classes in Pluecker space (seed 002, Alg. 1), with trees reused across coherent queries
+//!   through a caller-owned [`PluckerContext`]; see [`plucker`].
 //!
 //! Blockers are named by [`Blocker`] (an occluder or another light), never by a bare index.
 //! Culling (seed 000 `GetBetween`, section 3.5) discards blockers that cannot lie between the
@@ -14,10 +15,13 @@
 
 mod clip;
 pub(crate) mod cull;
+pub mod plucker;
+mod union;
 
 use alloc::vec::Vec;
 
-pub use clip::{ClipVisibility, Method};
+pub use clip::{BVH_MIN_TRIANGLES, ClipVisibility, Method};
+pub use plucker::{PluckerContext, PluckerVisibility, WithContext};
 
 use crate::GeomError;
 use crate::solid::ShadingFrame;

@@ -10,6 +10,7 @@
 //! - [`bezier`]: curved outlines placed in 3D, Green's-theorem and polygonization references for
 //!   their integrals.
 //! - [`shade`]: shading points on meshes and the ground, views above a surface.
+//! - [`visibility`]: an exact ray arbiter between visible regions.
 #![allow(dead_code)]
 
 pub mod bezier;
@@ -18,6 +19,7 @@ pub mod planar;
 pub mod rng;
 pub mod shade;
 pub mod sphere;
+pub mod visibility;
 
 pub use rng::Rng;
 
