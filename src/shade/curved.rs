@@ -52,7 +52,9 @@ impl Light {
     ///
     /// This is the whole light, unclipped by other objects: what [`super::Scene::shade`] gives
     /// for the light when nothing lies between, up to the scene's flattening
-    /// ([`crate::solid::BezierShape::region`]).
+    /// ([`crate::solid::BezierShape::region`]). A two-sided light ([`Light::two_sided`]) seen
+    /// from behind gives its turned-around shape's value
+    /// ([`crate::solid::BezierShape::local_segments_behind`]).
     ///
     /// # Errors
     ///
@@ -74,7 +76,12 @@ impl Light {
             ));
         };
         let frame = ShadingFrame::new(point, normal, view)?;
-        let Some(local) = shape.local_segments(&frame) else {
+        let seen = match shape.local_segments(&frame) {
+            Some(s) => Some(s),
+            None if self.is_two_sided() => shape.local_segments_behind(&frame),
+            None => None,
+        };
+        let Some(local) = seen else {
             return Ok(CurvedShading::default());
         };
         let segs: alloc::vec::Vec<CurveSegment> = local.into_iter().map(Into::into).collect();

@@ -453,6 +453,73 @@ impl BezierShape {
         self.flatten_angle
     }
 
+    /// The same region emitting from its other side: every loop run backwards, the normal
+    /// negated, the flattenings and the mesh turned around ([`TriangleMesh::flipped`]), nothing
+    /// recomputed, so the region seen from behind is exactly the original's turned around
+    /// (what a two-sided light shows from behind its plane).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::solid::{BezierSegment, BezierShape};
+    /// let p = |x: f64, y: f64| DVec3::new(x, y, 2.0);
+    /// let tri = vec![
+    ///     BezierSegment::Line([p(0.0, 0.0), p(1.0, 0.0)]),
+    ///     BezierSegment::Cubic([p(1.0, 0.0), p(1.0, 0.5), p(0.5, 1.0), p(0.0, 1.0)]),
+    ///     BezierSegment::Line([p(0.0, 1.0), p(0.0, 0.0)]),
+    /// ];
+    /// let up = BezierShape::new(vec![tri])?;
+    /// let down = up.flipped();
+    /// assert_eq!(down.normal(), -up.normal());
+    /// assert_eq!(down.area(), up.area());
+    /// assert!(down.faces(DVec3::new(0.3, 0.3, 1.0)) && !up.faces(DVec3::new(0.3, 0.3, 1.0)));
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    #[must_use]
+    pub fn flipped(&self) -> BezierShape {
+        let loops = self
+            .loops
+            .iter()
+            .map(|l| l.iter().rev().map(BezierSegment::reversed).collect())
+            .collect();
+        let mut segment_bounds = Vec::with_capacity(self.segment_bounds.len());
+        let mut at = 0;
+        for l in &self.loops {
+            segment_bounds.extend(self.segment_bounds[at..at + l.len()].iter().rev());
+            at += l.len();
+        }
+        let levels = self
+            .levels
+            .iter()
+            .map(|l| Level {
+                flatness: l.flatness,
+                rings: l
+                    .rings
+                    .iter()
+                    .map(|r| r.iter().rev().copied().collect())
+                    .collect(),
+            })
+            .collect();
+        // e2 x e1 = -normal: the plane coordinates swap, and with them the box's.
+        BezierShape {
+            loops,
+            origin: self.origin,
+            e1: self.e2,
+            e2: self.e1,
+            normal: -self.normal,
+            area: self.area,
+            extent: self.extent,
+            bound: self.bound,
+            segment_bounds,
+            box_min: DVec2::new(self.box_min.y, self.box_min.x),
+            box_max: DVec2::new(self.box_max.y, self.box_max.x),
+            levels,
+            mesh: self.mesh.flipped(),
+            flatten_angle: self.flatten_angle,
+        }
+    }
+
     /// The validated loops (segment ends made identical).
     #[must_use]
     pub fn loops(&self) -> &[Vec<BezierSegment>] {
@@ -594,6 +661,27 @@ impl BezierShape {
             }
         }
         Some(out)
+    }
+
+    /// What [`BezierShape::local_segments`] gives for the turned-around shape
+    /// ([`BezierShape::flipped`], without building it): the segments in the frame's local
+    /// coordinates, oriented counter-clockwise seen from outside the sphere from behind the
+    /// plane; `None` unless the point is behind it ([`BezierShape::faces_back`]). For the back
+    /// of a two-sided light.
+    #[must_use]
+    pub fn local_segments_behind(&self, frame: &ShadingFrame) -> Option<Vec<BezierSegment>> {
+        if !self.faces_back(frame.origin()) {
+            return None;
+        }
+        // The turned-around shape runs each loop backwards, and local_segments runs it
+        // backwards again: the loops as stored.
+        Some(
+            self.loops
+                .iter()
+                .flatten()
+                .map(|s| s.map(|p| frame.to_local(p)))
+                .collect(),
+        )
     }
 
     /// Plane coordinates of `p` (relative to the first control point).
