@@ -583,7 +583,11 @@ fn equal_time(
         t0.elapsed().as_secs_f64() * stride as f64
     };
     let (t1, t4) = (time_subset(1), time_subset(4));
-    let per_sample = ((t4 - t1) / 3.0).max(1e-12);
+    // On a loaded machine `t4 - t1` can come out near zero or negative, which would ask for a
+    // million samples per pixel: the time per sample is taken as at least a sixteenth of the
+    // 4-sample pass (the full pass then overshoots the budget by 4x at worst, and the
+    // correction below re-runs it).
+    let per_sample = ((t4 - t1) / 3.0).max(t4 / 16.0).max(1e-12);
     let setup = (t1 - per_sample).max(0.0);
     let mut spp = ((budget - setup) / per_sample).round().clamp(1.0, 1e6) as u32;
     let full = |spp: u32| {
