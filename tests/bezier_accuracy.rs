@@ -459,6 +459,54 @@ fn fuzz_findings() {
             r.error_bound.unwrap()
         );
     }
+    // 4. A loop facing away from the point (integral 0), its plane 7e-5 from the point and 256
+    //    across: its 7-chord flattening crosses itself, so the uniform baseline integrates a
+    //    polygon with a lobe facing the point (the fuzz target's clip invariant, which assumed
+    //    the curves' simplicity for that polygon, failed by 6.6e-9). The curved integrals stay
+    //    within their bounds of the exact 0.
+    let at = placed(DVec3::new(-1.0, -1.0, -1.0), -7e-5);
+    let at = |x: f64, y: f64| at(x * 1024.0, y * 1024.0); // scale 4 over the default 2^-8
+    type Handles = ((f64, f64), [f64; 4]);
+    let pts: [Handles; 3] = [
+        ((63.0, -1.0), [-3.0, -1.0, -36.0, -1.0]),
+        ((-1.0, -1.0), [-1.0, -1.0, -1.0, 21.0]),
+        ((0.0, 0.0), [0.0, 64.0, -70.0, -70.0]),
+    ];
+    let segs: Vec<CurveSegment> = (0..3)
+        .map(|i| {
+            let ((x, y), h) = pts[i];
+            let ((x1, y1), _) = pts[(i + 1) % 3];
+            CurveSegment::Cubic([
+                at(x, y),
+                at(x + h[0] / 2.0, y + h[1] / 2.0),
+                at(x + h[2] / 2.0, y + h[3] / 2.0),
+                at(x1, y1),
+            ])
+        })
+        .collect();
+    let (cos_v, alpha) = (47802.0 / 65535.0, (47802.0f64 / 65535.0).powi(2));
+    let (lambert, lspread) = polygon_reference(&segs, 4000, Lobe::Lambert);
+    let (ggx, gspread) = polygon_reference(&segs, 4000, Lobe::Ggx(cos_v, alpha, 1.0));
+    let coarse = ggx_curved_integral(&segs, cos_v, alpha, 1.0, Subdivision::Uniform { n: 7 });
+    assert!(
+        lambert == 0.0 && ggx == 0.0 && coarse.as_ref().is_ok_and(|c| c.value > 1e-3),
+        "the finding: {lambert} {ggx} {coarse:?}"
+    );
+    for eps in [1e-4, 1e-10] {
+        let sub = Subdivision::Adaptive { eps };
+        let d = curved_clamped_cosine_integral(&segs, sub).unwrap();
+        let g = ggx_curved_integral(&segs, cos_v, alpha, 1.0, sub).unwrap();
+        assert!(
+            (d.value - lambert).abs() <= d.error_bound.unwrap() + lspread + rounding(d.edges),
+            "eps {eps}: lambert {} vs {lambert}",
+            d.value
+        );
+        assert!(
+            (g.value - ggx).abs() <= g.error_bound.unwrap() + gspread + rounding(g.edges),
+            "eps {eps}: ggx {} vs {ggx}",
+            g.value
+        );
+    }
     // 2. A bow-tie of lines (a loop crossing itself) whose lobes' areas cancel: the plane's
     //    normal must come from the points, not the vanishing total area (it returned 0 for
     //    0.0033).
