@@ -5,7 +5,8 @@
 //! `(0, -4, 2.5)`; the specular lobe only (GGX, `f0 = 1`), as the seed's timings. For each
 //! roughness, uniform subdivision with `N = 6, 18, 30` chords per cubic sets a maximum error over
 //! the points (against `eps = 1e-12`); the adaptive threshold is then lowered by factors of 2
-//! from `1e-2` until its maximum error is no larger, and both are timed on the same points.
+//! from `1e-2` until its maximum error is no larger, and both are timed on the same points
+//! (adaptive also with its proven error bound, `Subdivision::AdaptiveWithBound`).
 //! The matching table (errors and edges) is printed once; results in BENCHMARKS.md (section
 //! `Bezier lights`). Run with `cargo bench -p arealight-benches --bench bezier`.
 
@@ -149,13 +150,16 @@ fn bench(c: &mut Criterion) {
                 a_edges as f64 / pts.len() as f64
             );
             let adaptive = Subdivision::Adaptive { eps };
-            let t = min_times(&pts, alpha, &[uniform, adaptive], 300);
+            let bounded = Subdivision::AdaptiveWithBound { eps };
+            let t = min_times(&pts, alpha, &[uniform, adaptive, bounded], 300);
             println!(
                 "alpha {alpha}: N = {n}: minimum of 300 interleaved passes over the 48 points: \
-                 uniform {:.1} us, adaptive {:.1} us (ratio {:.2})",
+                 uniform {:.1} us, adaptive {:.1} us (ratio {:.2}), adaptive with its error \
+                 bound {:.1} us",
                 t[0] * 1e6,
                 t[1] * 1e6,
-                t[0] / t[1]
+                t[0] / t[1],
+                t[2] * 1e6
             );
             let id = format!("alpha{alpha}/N{n}");
             g.bench_with_input(BenchmarkId::new("uniform", &id), &uniform, |b, &s| {

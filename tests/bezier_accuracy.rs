@@ -179,7 +179,8 @@ fn lambert_converges_to_the_exact_region() {
         );
         let mut last = f64::INFINITY;
         for eps in [1e-2, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11] {
-            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::Adaptive { eps }).unwrap();
+            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::AdaptiveWithBound { eps })
+                .unwrap();
             let err = (r.value - exact).abs();
             let bound = r.error_bound.unwrap();
             assert!(
@@ -195,6 +196,40 @@ fn lambert_converges_to_the_exact_region() {
     }
 }
 
+/// Asking for the bound changes nothing else: the same intervals, the same value bit for bit,
+/// the same edge count; without it there is no bound.
+#[test]
+fn the_bound_leaves_the_value_unchanged() {
+    for c in cases() {
+        for eps in [1e-2, 1e-5, 1e-9] {
+            let (plain, bounded) = (
+                Subdivision::Adaptive { eps },
+                Subdivision::AdaptiveWithBound { eps },
+            );
+            let pairs = [
+                (
+                    curved_clamped_cosine_integral(&c.segs, plain).unwrap(),
+                    curved_clamped_cosine_integral(&c.segs, bounded).unwrap(),
+                ),
+                (
+                    ggx_curved_integral(&c.segs, 0.1, 0.05, 1.0, plain).unwrap(),
+                    ggx_curved_integral(&c.segs, 0.1, 0.05, 1.0, bounded).unwrap(),
+                ),
+            ];
+            for (p, b) in pairs {
+                assert!(
+                    p.value.to_bits() == b.value.to_bits()
+                        && p.edges == b.edges
+                        && p.error_bound.is_none()
+                        && b.error_bound.is_some_and(|e| e >= 0.0),
+                    "{} eps {eps}: {p:?} vs {b:?}",
+                    c.name
+                );
+            }
+        }
+    }
+}
+
 /// The bound is not uselessly loose: on a curve where no sliver cancels another (a convex
 /// blob above the horizon: every chord cuts off light) it is within a small factor of the
 /// error (about 4/3 from the hulls, times the cosine's variation over them), and it falls
@@ -207,7 +242,8 @@ fn bound_is_close_to_the_error_where_nothing_cancels() {
         segs: segs.clone(),
     });
     for eps in [1e-3, 1e-5, 1e-7, 1e-9] {
-        let r = curved_clamped_cosine_integral(&segs, Subdivision::Adaptive { eps }).unwrap();
+        let r =
+            curved_clamped_cosine_integral(&segs, Subdivision::AdaptiveWithBound { eps }).unwrap();
         // Every chord lies inside the convex region: the polygon has less light.
         let err = exact - r.value;
         let bound = r.error_bound.unwrap();
@@ -224,9 +260,14 @@ fn ggx_converges_to_the_fine_polygonization() {
         for (cos_v, alpha) in GGX {
             let (exact, spread) = polygon_reference(&c.segs, 50_000, Lobe::Ggx(cos_v, alpha, 1.0));
             for eps in [specular_eps(alpha), 1e-4, 1e-6, 1e-8, 1e-10] {
-                let r =
-                    ggx_curved_integral(&c.segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps })
-                        .unwrap();
+                let r = ggx_curved_integral(
+                    &c.segs,
+                    cos_v,
+                    alpha,
+                    1.0,
+                    Subdivision::AdaptiveWithBound { eps },
+                )
+                .unwrap();
                 let err = (r.value - exact).abs();
                 let bound = r.error_bound.unwrap();
                 assert!(
@@ -248,7 +289,8 @@ fn report() {
         let exact = lambert_ref(&c);
         print!("{:<34} I = {exact:.6}", c.name);
         for eps in [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10] {
-            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::Adaptive { eps }).unwrap();
+            let r = curved_clamped_cosine_integral(&c.segs, Subdivision::AdaptiveWithBound { eps })
+                .unwrap();
             print!(
                 " | {eps:.0e}: {:.1e}/{:.1e} [{}]",
                 (r.value - exact).abs(),
@@ -273,9 +315,14 @@ fn report() {
                 c.name
             );
             for eps in [0.1 * alpha * alpha, 1e-3, 1e-4, 1e-6, 1e-8] {
-                let r =
-                    ggx_curved_integral(&c.segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps })
-                        .unwrap();
+                let r = ggx_curved_integral(
+                    &c.segs,
+                    cos_v,
+                    alpha,
+                    1.0,
+                    Subdivision::AdaptiveWithBound { eps },
+                )
+                .unwrap();
                 print!(
                     " | {eps:.0e}: {:.1e}/{:.1e} [{}]",
                     (r.value - exact).abs(),
@@ -315,6 +362,7 @@ fn bad_input_is_an_error_naming_loop_and_segment() {
     assert_eq!(at(curved_clamped_cosine_integral(&s, fine)), (1, 0));
     for bad in [
         Subdivision::Adaptive { eps: 0.0 },
+        Subdivision::AdaptiveWithBound { eps: -1.0 },
         Subdivision::Adaptive { eps: f64::NAN },
         Subdivision::Uniform { n: 0 },
     ] {
@@ -417,8 +465,14 @@ fn fuzz_findings() {
     let (cos_v, alpha) = (15.0 / 65535.0, (7.0f64 / 65535.0).powi(2));
     let (exact, spread) = polygon_reference(&segs, 4000, Lobe::Ggx(cos_v, alpha, 1.0));
     for eps in [1e-4, 1e-7, 1e-10] {
-        let r =
-            ggx_curved_integral(&segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps }).unwrap();
+        let r = ggx_curved_integral(
+            &segs,
+            cos_v,
+            alpha,
+            1.0,
+            Subdivision::AdaptiveWithBound { eps },
+        )
+        .unwrap();
         assert!(
             (r.value - exact).abs() <= r.error_bound.unwrap() + spread + rounding(r.edges),
             "eps {eps}: {} vs {exact} (bound {:e})",
@@ -461,7 +515,14 @@ fn fuzz_findings() {
     let cos_v = 1.0 / 65535.0;
     let (exact, spread) = polygon_reference(&segs, 16_000, Lobe::Ggx(cos_v, 0.0, 1.0));
     for eps in [1e-6, 1e-10, 1e-13] {
-        let r = ggx_curved_integral(&segs, cos_v, 0.0, 1.0, Subdivision::Adaptive { eps }).unwrap();
+        let r = ggx_curved_integral(
+            &segs,
+            cos_v,
+            0.0,
+            1.0,
+            Subdivision::AdaptiveWithBound { eps },
+        )
+        .unwrap();
         assert!(
             (r.value - exact).abs() <= r.error_bound.unwrap() + spread + rounding(r.edges),
             "eps {eps}: {} vs {exact} (bound {:e})",
@@ -503,7 +564,7 @@ fn fuzz_findings() {
         "the finding: {lambert} {ggx} {coarse:?}"
     );
     for eps in [1e-4, 1e-10] {
-        let sub = Subdivision::Adaptive { eps };
+        let sub = Subdivision::AdaptiveWithBound { eps };
         let d = curved_clamped_cosine_integral(&segs, sub).unwrap();
         let g = ggx_curved_integral(&segs, cos_v, alpha, 1.0, sub).unwrap();
         assert!(
@@ -545,7 +606,7 @@ fn fuzz_findings() {
         .collect();
     let (cos_v, alpha) = (1.0 / 65535.0, 0.0);
     let (ggx, gspread) = polygon_reference(&segs, 4000, Lobe::Ggx(cos_v, alpha, 1.0));
-    let sub = Subdivision::Adaptive { eps: 1e-10 };
+    let sub = Subdivision::AdaptiveWithBound { eps: 1e-10 };
     let g = ggx_curved_integral(&segs, cos_v, alpha, 1.0, sub).unwrap();
     let cond = [-1e-14, 1e-14]
         .map(|dz| {

@@ -208,8 +208,8 @@ fuzz_target!(|case: Case| {
     let l = lookup(cos_v, alpha).unwrap();
     let scale = l.specular_scale(1.0);
     let subs = [
-        Subdivision::Adaptive { eps: 1e-10 },
-        Subdivision::Adaptive {
+        Subdivision::AdaptiveWithBound { eps: 1e-10 },
+        Subdivision::AdaptiveWithBound {
             eps: 0.1 * alpha * alpha + 1e-9,
         },
         Subdivision::Uniform { n: 7 },

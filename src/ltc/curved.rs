@@ -48,11 +48,12 @@
 //!
 //! # Accuracy: the error bound
 //!
-//! [`CurvedIntegral::error_bound`] is a proven bound on what the adaptive subdivision of seed
-//! 004 section 2.3 neglects (rounding aside, which ill-conditioned views amplify: see the
-//! field's documentation). The seed's test on an interval's
-//! triangle decides where to split, as in the seed; the bound is computed beside it, from the
-//! accepted intervals:
+//! With [`Subdivision::AdaptiveWithBound`], [`CurvedIntegral::error_bound`] is a proven bound
+//! on what the adaptive subdivision of seed 004 section 2.3 neglects (rounding aside, which
+//! ill-conditioned views amplify: see the field's documentation). The seed's test on an
+//! interval's triangle decides where to split, as in the seed and as with
+//! [`Subdivision::Adaptive`], whose value is the same bit for bit; the bound is computed beside
+//! it, from the accepted intervals:
 //!
 //! 1. **What is neglected.** Where an interval `[t0, t1]` is accepted, the polygon keeps its
 //!    midpoint, and each half `[t0, tm]`, `[tm, t1]` of the curve is replaced by its chord.
@@ -192,6 +193,16 @@ pub enum Subdivision {
         /// The threshold on a triangle's signed integral.
         eps: f64,
     },
+    /// [`Subdivision::Adaptive`] with a proven bound on its error
+    /// ([`CurvedIntegral::error_bound`]): the same intervals, so the same `value`, bit for
+    /// bit, and per accepted interval a closed-form bound on what its chords leave out (see
+    /// the module documentation, "Accuracy"). The bound makes the integral take about 1.5
+    /// times as long at the seed's thresholds (BENCHMARKS.md, "Bezier lights"), which is why it
+    /// is asked for separately.
+    AdaptiveWithBound {
+        /// The threshold on a triangle's signed integral.
+        eps: f64,
+    },
     /// The baseline of seed 004 section 3.3: every cubic replaced by `n` chords between
     /// uniformly spaced parameters, then clipped like a polygon. `n` from 1 to
     /// [`MAX_UNIFORM`].
@@ -235,7 +246,7 @@ pub struct CurvedIntegral {
     /// Number of chords summed (the edges of the polygon the curves were replaced by, horizon
     /// arcs included): the cost measure of seed 004 figure 5.
     pub edges: usize,
-    /// For [`Subdivision::Adaptive`]: a proven bound on `|value - exact|`, the exact value
+    /// For [`Subdivision::AdaptiveWithBound`]: a proven bound on `|value - exact|`, the exact value
     /// being the same integral over the region bounded by the exact curves (scaled like
     /// `value`). It is the sum, over the accepted intervals, of bounds on the integrals over
     /// the convex hulls of their halves' control points, which hold the slivers the chords
@@ -244,7 +255,7 @@ pub struct CurvedIntegral {
     /// horizon crossings) are rounded, which costs a few units in the last place per edge
     /// where the integral is well-conditioned and more where it is not (a near-mirror lobe at
     /// a grazing view whose peak sits on the light's horizon crossing: moving a light 800
-    /// across by `1e-14` moved its response by `3e-9`). `None` for [`Subdivision::Uniform`].
+    /// across by `1e-14` moved its response by `3e-9`). `None` for the other subdivisions.
     pub error_bound: Option<f64>,
 }
 
@@ -393,8 +404,8 @@ fn nothing(subdivision: Subdivision) -> CurvedIntegral {
         value: 0.0,
         edges: 0,
         error_bound: match subdivision {
-            Subdivision::Adaptive { .. } => Some(0.0),
-            Subdivision::Uniform { .. } => None,
+            Subdivision::AdaptiveWithBound { .. } => Some(0.0),
+            Subdivision::Adaptive { .. } | Subdivision::Uniform { .. } => None,
         },
     }
 }
@@ -403,17 +414,19 @@ fn nothing(subdivision: Subdivision) -> CurvedIntegral {
 fn flattening(subdivision: Subdivision) -> Option<usize> {
     match subdivision {
         Subdivision::Uniform { n } => Some(n),
-        Subdivision::Adaptive { .. } => None,
+        Subdivision::Adaptive { .. } | Subdivision::AdaptiveWithBound { .. } => None,
     }
 }
 
 fn check_subdivision(s: Subdivision) -> Result<(), GeomError> {
     match s {
-        Subdivision::Adaptive { eps } if !(eps > 0.0) => Err(GeomError::OutOfRange {
-            what: "subdivision threshold eps (positive)",
-            value: eps,
-            limit: f64::INFINITY,
-        }),
+        Subdivision::Adaptive { eps } | Subdivision::AdaptiveWithBound { eps } if !(eps > 0.0) => {
+            Err(GeomError::OutOfRange {
+                what: "subdivision threshold eps (positive)",
+                value: eps,
+                limit: f64::INFINITY,
+            })
+        }
         Subdivision::Uniform { n } if n == 0 || n > MAX_UNIFORM => Err(GeomError::OutOfRange {
             what: "uniform subdivision chords per curve (1 ..= MAX_UNIFORM)",
             value: n as f64,
@@ -772,17 +785,18 @@ impl Stage {
 
     /// Baum's sum over the clipped boundary, curves subdivided.
     fn integrate(&self, subdivision: Subdivision) -> CurvedIntegral {
-        let eps = match subdivision {
-            // The test compares edge-term sums, which are `2 pi` times integrals.
-            Subdivision::Adaptive { eps } => 2.0 * PI * eps,
-            Subdivision::Uniform { .. } => f64::INFINITY,
+        // The test compares edge-term sums, which are `2 pi` times integrals.
+        let (eps, bound) = match subdivision {
+            Subdivision::Adaptive { eps } => (Some(2.0 * PI * eps), false),
+            Subdivision::AdaptiveWithBound { eps } => (Some(2.0 * PI * eps), true),
+            Subdivision::Uniform { .. } => (None, false),
         };
         let mut acc = Accumulator::default();
         for p in &self.kept {
-            if p.cubic && matches!(subdivision, Subdivision::Adaptive { .. }) {
-                acc.adaptive(p, eps);
-            } else {
-                acc.chord(Ray::new(p.start), Ray::new(p.end));
+            match eps {
+                Some(eps) if p.cubic && bound => acc.adaptive::<true>(p, eps),
+                Some(eps) if p.cubic => acc.adaptive::<false>(p, eps),
+                _ => acc.chord(Ray::new(p.start), Ray::new(p.end)),
             }
         }
         for (x, e) in self.arcs() {
@@ -792,10 +806,7 @@ impl Stage {
         CurvedIntegral {
             value,
             edges: acc.edges,
-            error_bound: match subdivision {
-                Subdivision::Adaptive { .. } => Some(acc.bound),
-                Subdivision::Uniform { .. } => None,
-            },
+            error_bound: bound.then_some(acc.bound),
         }
     }
 }
@@ -829,9 +840,9 @@ impl Accumulator {
 
     /// Seed 004 Listing 1 on one kept part of a cubic: depth first, with an explicit stack of
     /// at most `INITIAL_INTERVALS + MAX_DEPTH` intervals (a split pops one and pushes two).
-    /// Every accepted interval adds the bound on its two slivers ([`sliver_bound`]) to
-    /// `self.bound`.
-    fn adaptive(&mut self, p: &Piece, eps: f64) {
+    /// With `BOUND`, every accepted interval adds the bound on its two slivers
+    /// ([`sliver_bound`]) to `self.bound`; the sum is the same either way.
+    fn adaptive<const BOUND: bool>(&mut self, p: &Piece, eps: f64) {
         const CAP: usize = INITIAL_INTERVALS + MAX_DEPTH as usize + 1;
         let empty = Interval {
             t0: 0.0,
@@ -907,9 +918,11 @@ impl Accumulator {
             } else {
                 self.sum += t01 + t12;
                 self.edges += 2;
-                let q = cps.unwrap_or_else(|| sub_curve(&p.cps, iv.t0, iv.t1));
-                let [left, right] = halves(&q);
-                self.bound += sliver_bound(&left) + sliver_bound(&right);
+                if BOUND {
+                    let q = cps.unwrap_or_else(|| sub_curve(&p.cps, iv.t0, iv.t1));
+                    let [left, right] = halves(&q);
+                    self.bound += sliver_bound(&left) + sliver_bound(&right);
+                }
             }
         }
     }
@@ -978,36 +991,50 @@ fn wide(q: &[DVec3; 4]) -> bool {
 /// the sub-curve and its chord can contribute (see the module documentation, "Accuracy").
 ///
 /// It is the hull's solid angle times the largest `z` of a unit direction in it, both bounded
-/// from above without a transcendental function:
+/// from above without a transcendental function, with `n_i` the unit directions of the points
+/// and `d_ij` their dot products:
 ///
 /// - Almost every point of the convex hull of four points in a plane lies in exactly two of the
 ///   four triangles of three of them (in convex position each diagonal splits the quadrilateral
 ///   in two; with one point inside the triangle of the others, that triangle and the three
 ///   around the inner point), so the hull's solid angle is half the sum of the four triangles'.
-///   A triangle's is `2 atan(|det| / den)` with `den = 1 + a.b + b.c + c.a` for unit `a, b, c`
-///   (Van Oosterom-Strackee, for `den > 0`, that is below `pi`), at most `2 |det| / den`.
-/// - Every direction of the hull is `p / |p|` with `p = sum mu_i n_i`, `mu_i >= 0`, `n_i` the
-///   unit directions of the points; for a unit `u` with `n_i . u > 0` for all `i`,
-///   `p_z / |p| <= p_z / (p . u) <= max_i n_iz / (n_i . u)` (a ratio of positive combinations
-///   is at most the largest ratio of its terms). With `u` along `sum n_i`, whose products with
-///   the `n_i` are the sums of rows of their dot products, the bound exceeds the largest `z` at
-///   a point by a factor of `1 + O(width^2)` for a hull `width` radians across.
+///   A triangle's is `2 atan(|det| / den)` with `den = 1 + d_ij + d_jk + d_ki` (Van
+///   Oosterom-Strackee, for `den > 0`, that is below `pi`), at most `2 |det| / den`; the
+///   smallest of the four `den` serves for all.
+/// - Every direction of the hull is `p / |p|` with `p = sum mu_i n_i`, `mu_i >= 0`; for a unit
+///   `u` with `n_i . u > 0` for all `i`, `p_z / |p| <= p_z / (p . u) <= max_i n_iz / (n_i . u)`
+///   (a ratio of positive combinations is at most the largest ratio of its terms), at most
+///   `max_i n_iz / min_i (n_i . u)`. With `u` along `sum n_i`, whose products with the `n_i`
+///   are the sums of rows of the `d_ij`, and `|sum n_i|^2` the sum of those.
 ///
-/// Where the directions are spread so far that either step fails (a triangle of `pi` or more,
-/// some `n_i . u <= 0`: possible only at the depth cap), the factor falls back to its trivial
-/// bound (`2 pi` for a triangle, 1 for `z`).
+/// Both smallest-of-four steps cost a factor of `1 + O(width^2)` for a hull `width` radians
+/// across, the cosine's bound one of `1 + O(width)` (its spread over the hull), and one
+/// division serves the whole bound. Where the directions are spread so far that a step fails
+/// (a triangle of `pi` or more, some `n_i . u <= 0`: possible only at the depth cap), its
+/// factor falls back to the trivial bound (`2 pi`, 1).
+#[inline(always)]
 fn sliver_bound(q: &[DVec3; 4]) -> f64 {
-    let unit = |v: DVec3| {
-        let l2 = v.length_squared();
-        if l2 > 1e-280 && l2 < 1e280 {
-            v * (1.0 / crate::math::sqrt(l2))
-        } else {
-            // Far from unit size, the squares would underflow or overflow.
+    let l2 = q.map(|v| v.length_squared());
+    let n = if l2.iter().all(|&v| v > 1e-130 && v < 1e130) {
+        // One division for the four: in this range neither the squares nor the product of the
+        // four lengths leave the normal floats.
+        let len = l2.map(crate::math::sqrt);
+        let (p01, p23) = (len[0] * len[1], len[2] * len[3]);
+        let inv = 1.0 / (p01 * p23);
+        let (i01, i23) = (inv * p23, inv * p01);
+        [
+            q[0] * (i01 * len[1]),
+            q[1] * (i01 * len[0]),
+            q[2] * (i23 * len[3]),
+            q[3] * (i23 * len[2]),
+        ]
+    } else {
+        q.map(|v| {
+            // Brought to unit size first.
             let s = v / v.abs().max_element();
             s * (1.0 / crate::math::sqrt(s.length_squared()))
-        }
+        })
     };
-    let n = q.map(unit);
     let top = n[0].z.max(n[1].z).max(n[2].z).max(n[3].z);
     if !(top > 0.0) {
         // All four at or below the horizon (p_z is a positive combination of theirs), or not a
@@ -1016,36 +1043,34 @@ fn sliver_bound(q: &[DVec3; 4]) -> f64 {
     }
     let (d01, d02, d03) = (n[0].dot(n[1]), n[0].dot(n[2]), n[0].dot(n[3]));
     let (d12, d13, d23) = (n[1].dot(n[2]), n[1].dot(n[3]), n[2].dot(n[3]));
-    // n_i . sum_j n_j, and |sum_j n_j|^2 as their sum.
+    // The cosine: n_i . sum_j n_j, and |sum_j n_j|^2 as their sum; `z <= z_num / z_den`.
     let r = [
         1.0 + d01 + d02 + d03,
         1.0 + d01 + d12 + d13,
         1.0 + d02 + d12 + d23,
         1.0 + d03 + d13 + d23,
     ];
-    let z_max = if r.iter().all(|&v| v > 0.0) {
-        let ratio = (n[0].z / r[0])
-            .max(n[1].z / r[1])
-            .max(n[2].z / r[2])
-            .max(n[3].z / r[3]);
-        (ratio * crate::math::sqrt(r[0] + r[1] + r[2] + r[3])).min(1.0)
+    let r_min = r[0].min(r[1]).min(r[2]).min(r[3]);
+    let z_num = top * crate::math::sqrt(r[0] + r[1] + r[2] + r[3]);
+    let (z_num, z_den) = if r_min > 0.0 && z_num < r_min {
+        (z_num, r_min)
     } else {
-        1.0
+        (1.0, 1.0)
     };
+    // The solid angle: `omega <= o_num / o_den`.
     let (c12, c13, c23) = (n[1].cross(n[2]), n[1].cross(n[3]), n[2].cross(n[3]));
-    let triangle = |det: f64, den: f64| {
-        if den > 0.0 {
-            (2.0 * det.abs() / den).min(2.0 * PI)
-        } else {
-            2.0 * PI
-        }
+    let dets =
+        n[0].dot(c12).abs() + n[0].dot(c13).abs() + n[0].dot(c23).abs() + n[1].dot(c23).abs();
+    let den_min = (1.0 + d01 + d12 + d02)
+        .min(1.0 + d01 + d13 + d03)
+        .min(1.0 + d02 + d23 + d03)
+        .min(1.0 + d12 + d23 + d13);
+    let (o_num, o_den) = if den_min > 0.0 {
+        (dets, den_min)
+    } else {
+        (2.0 * PI, 1.0)
     };
-    let omega = 0.5
-        * (triangle(n[0].dot(c12), 1.0 + d01 + d12 + d02)
-            + triangle(n[0].dot(c13), 1.0 + d01 + d13 + d03)
-            + triangle(n[0].dot(c23), 1.0 + d02 + d23 + d03)
-            + triangle(n[1].dot(c23), 1.0 + d12 + d23 + d13));
-    let b = omega * z_max / PI;
+    let b = (o_num * z_num) / (o_den * z_den * PI);
     if b <= 1.0 { b } else { 1.0 }
 }
 
