@@ -88,12 +88,13 @@
 //! The bound is not a function of `eps` alone: it is what the accepted intervals certify. For a
 //! curve that is locally a parabola, a half's hull is `8/9` of the triangle of its chord and
 //! end tangents, and its sliver `2/3` of it, so the bound is about `4/3` of the magnitude of the
-//! error where slivers do not cancel, and about `(8/9) |L_triangle|` per accepted interval
-//! (at most `8 eps / 9` there, times the cosine factor); where slivers of both signs cancel,
-//! or the hull reaches over the horizon, the error is further below it. The parametrization
-//! does not matter (a cubic whose handles sit on an end point moves arbitrarily slowly there):
-//! the hulls hold whatever the halves cover. BENCHMARKS.md ("Bezier lights") reports the error
-//! and the bound against `eps` on the tests' curves.
+//! error where slivers do not cancel; each half's tangent triangle is `1/8` of the interval's,
+//! whose inscribed triangle is half of it, so the bound is about `(4/9) |L_triangle|` per
+//! accepted interval (at most `4 eps / 9` there, times the cosine factor). Where slivers of
+//! both signs cancel, or the hull reaches over the horizon, the error is further below it.
+//! The parametrization does not matter (a cubic whose handles sit on an end point moves
+//! arbitrarily slowly there): the hulls hold whatever the halves cover. BENCHMARKS.md
+//! ("Bezier lights") reports the error and the bound against `eps` on the tests' curves.
 //!
 //! # References
 //!
