@@ -13,6 +13,7 @@ use super::order::order_directed_edges;
 use super::polygon::{SphericalPolygon, Verts, close_ring, regularized};
 use super::predicates::tangent_frame;
 use crate::GeomError;
+use crate::planar::predicates::vertices_inside_segment;
 use crate::planar::{BoolOp, Shape, boolean};
 
 /// Smallest cosine of the enclosing cap's radius for the single-projection path: projected
@@ -560,31 +561,9 @@ fn rings_apart(p: &SphericalPolygon, d: f64) -> bool {
 }
 
 /// Vertices of any contour lying exactly inside the segment `a-b` (not at its ends), in order
-/// from `a`. Exact: collinearity by `orient2d`, betweenness along the segment.
+/// from `a`.
 fn touching_vertices(contours: &[&[DVec2]], a: DVec2, b: DVec2) -> SmallVec<[DVec2; 2]> {
-    let mut hits: SmallVec<[(f64, DVec2); 2]> = SmallVec::new();
-    let d = b - a;
-    for c in contours {
-        for &p in c.iter() {
-            if p == a || p == b {
-                continue;
-            }
-            let o = robust::orient2d(
-                robust::Coord { x: a.x, y: a.y },
-                robust::Coord { x: b.x, y: b.y },
-                robust::Coord { x: p.x, y: p.y },
-            );
-            if o != 0.0 {
-                continue;
-            }
-            let t = (p - a).dot(d) / d.length_squared();
-            if t > 0.0 && t < 1.0 && !hits.iter().any(|h| h.1 == p) {
-                hits.push((t, p));
-            }
-        }
-    }
-    hits.sort_by(|x, y| x.0.total_cmp(&y.0));
-    hits.into_iter().map(|h| h.1).collect()
+    vertices_inside_segment(contours.iter().flat_map(|c| c.iter().copied()), a, b)
 }
 
 /// The operation on operands no narrow cap holds: solved per octant and merged.
