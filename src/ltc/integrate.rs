@@ -457,6 +457,76 @@ pub(crate) fn clamped_cosine_integral_upper(poly: &SphericalPolygon) -> f64 {
     upper_sum(poly, Exact)
 }
 
+/// [`clamped_cosine_integral_upper`] of one ring of directions of any positive length (not
+/// normalized: Baum's edge terms are invariant under positive scaling of each endpoint) whose
+/// region lies in the closed upper hemisphere, its interior on the left of each edge: the
+/// diffuse integral of a piece of the shading fast path (`crate::visibility`), the same sum as
+/// the polygon's up to rounding.
+pub(crate) fn upper_ring_integral(ring: &[DVec3]) -> f64 {
+    let Some(&last) = ring.last() else {
+        return 0.0;
+    };
+    let mut prev = Ray::new(last);
+    let mut sum = 0.0;
+    for &v in ring {
+        let cur = Ray::new(v);
+        sum += edge_term(prev, cur);
+        prev = cur;
+    }
+    integral_of_sum(sum)
+}
+
+/// [`ltc_integral`] of one ring of directions of any positive length whose region lies in the
+/// closed upper hemisphere (clipped at the shading horizon, as the LTC tables assume), interior
+/// on the left: the specular integral of a piece of the shading fast path.
+///
+/// The clip-free kernel ([`transformed_clip_free`], the same code as for a polygon) decides most
+/// rings; where it hands over (an image within rounding of the cosine's horizon, as the images
+/// of a piece's vertices on the shading horizon under a map that keeps the horizon), the images
+/// are clipped at the horizon by Sutherland–Hodgman in homogeneous coordinates (one plane, so
+/// exact for any simple ring in the sense of the boundary integral: the bridges it adds along the
+/// horizon run both ways and cancel) and Baum's sum is taken over the result. `None` only for a
+/// map that is singular, not finite or reverses orientation, which the LTC tables never give.
+pub(crate) fn ltc_ring_integral(ring: &[DVec3], m_inv: glam::DMat3) -> Option<f64> {
+    if let Some(v) = transformed_clip_free(ring, &m_inv, Exact) {
+        return Some(v);
+    }
+    clipped_ring_integral(ring, m_inv)
+}
+
+/// The exact path of [`ltc_ring_integral`], out of line.
+#[cold]
+#[inline(never)]
+fn clipped_ring_integral(ring: &[DVec3], m_inv: glam::DMat3) -> Option<f64> {
+    let m = crate::math::unit_scaled(m_inv)?;
+    if !(m.determinant() > 0.0) {
+        return None;
+    }
+    let mut up: smallvec::SmallVec<[DVec3; 32]> = smallvec::SmallVec::new();
+    let Some(&last) = ring.last() else {
+        return Some(0.0);
+    };
+    let mut prev = m * last;
+    for &v in ring {
+        let cur = m * v;
+        if prev.z >= 0.0 {
+            up.push(prev);
+        }
+        if (prev.z > 0.0 && cur.z < 0.0) || (prev.z < 0.0 && cur.z > 0.0) {
+            // A positive combination of the two with `z` exactly zero (the products commute).
+            let (a, b) = if prev.z > 0.0 {
+                (prev, cur)
+            } else {
+                (cur, prev)
+            };
+            let x = a * -b.z + b * a.z;
+            up.push(DVec3::new(x.x, x.y, 0.0));
+        }
+        prev = cur;
+    }
+    Some(upper_ring_integral(&up))
+}
+
 /// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform
 /// unit-radiance light filling the polygon onto a surface with normal `+z`, relative to a light
 /// filling the whole hemisphere. In `[0, 1]`.
@@ -520,9 +590,45 @@ fn clip_free_sum(
     edge: impl EdgeTerm,
 ) -> Option<f64> {
     match poly.single_ring() {
-        Some(ring) if ring.len() == 4 => quad_sum(ring, map, edge),
-        Some(ring) => single_ring_sum(ring, map, edge),
+        Some(ring) => ring_clip_free_sum(ring, map, edge),
         None => ring_sum(poly.rings(), map, edge),
+    }
+}
+
+/// [`clip_free_sum`] of one ring: quads through [`quad_sum`], other rings through
+/// [`single_ring_sum`].
+#[inline(always)]
+fn ring_clip_free_sum(
+    ring: &[DVec3],
+    map: impl Fn(DVec3) -> DVec3,
+    edge: impl EdgeTerm,
+) -> Option<f64> {
+    if ring.len() == 4 {
+        quad_sum(ring, map, edge)
+    } else {
+        single_ring_sum(ring, map, edge)
+    }
+}
+
+/// What the clip-free path integrates: the rings of a [`SphericalPolygon`], or one bare ring of
+/// directions of any positive length (the pieces of the shading fast path, which are never
+/// built as polygons). Generic, so that each caller's code is the kernel inlined for its input.
+trait ClipFreeInput {
+    /// The clip-free sum of the images of the vertices under `map` ([`clip_free_sum`]).
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64>;
+}
+
+impl ClipFreeInput for SphericalPolygon {
+    #[inline(always)]
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+        clip_free_sum(self, map, edge)
+    }
+}
+
+impl ClipFreeInput for [DVec3] {
+    #[inline(always)]
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+        ring_clip_free_sum(self, map, edge)
     }
 }
 
@@ -973,8 +1079,8 @@ fn integral_of_sum(sum: f64) -> f64 {
 /// The matrix is read entry by entry: a caller's freshly stored matrix read back with wide loads
 /// at other offsets stalls store-to-load forwarding, which cost more than the rest of a quad.
 #[inline(always)]
-fn transformed_clip_free(
-    poly: &SphericalPolygon,
+fn transformed_clip_free<P: ClipFreeInput + ?Sized>(
+    poly: &P,
     m: &glam::DMat3,
     edge: impl EdgeTerm,
 ) -> Option<f64> {
@@ -992,7 +1098,7 @@ fn transformed_clip_free(
             return general_clip_free(poly, m, edge);
         }
         let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, m11 * v.y, m20 * v.x + m22 * v.z);
-        clip_free_sum(poly, map, edge)
+        poly.clip_free(map, edge)
     } else {
         general_clip_free(poly, m, edge)
     }
@@ -1010,7 +1116,11 @@ const CLIP_FREE_RANGE: f64 = 1_073_741_824.0; // 2^30
 /// [`transformed_clip_free`] for a matrix of any form, out of line so that the common form's
 /// path reads no more of the matrix than it uses.
 #[inline(never)]
-fn general_clip_free(poly: &SphericalPolygon, m: &glam::DMat3, edge: impl EdgeTerm) -> Option<f64> {
+fn general_clip_free<P: ClipFreeInput + ?Sized>(
+    poly: &P,
+    m: &glam::DMat3,
+    edge: impl EdgeTerm,
+) -> Option<f64> {
     // Every quantity of the sum is invariant under positive scaling of the map, so it is scaled
     // to entries of at most 1; then a determinant of at least `1 / CLIP_FREE_RANGE` bounds the
     // images' lengths away from zero too. Worse conditioned maps go to the exact path, which
@@ -1019,7 +1129,7 @@ fn general_clip_free(poly: &SphericalPolygon, m: &glam::DMat3, edge: impl EdgeTe
     if !(m.determinant() >= 1.0 / CLIP_FREE_RANGE) {
         return None;
     }
-    clip_free_sum(poly, |v| m * v, edge)
+    poly.clip_free(|v| m * v, edge)
 }
 
 #[cfg(test)]

@@ -66,6 +66,6 @@ mod scene;
 pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 pub use crate::visibility::{Blocker, Method};
 pub use material::Material;
-pub use query::LightShading;
+pub use query::{LightShading, ShadeContext};
 pub use reference::{Estimate, MonteCarlo, ReferenceBrdf};
 pub use scene::{Light, Scene};

@@ -6,6 +6,12 @@
 //! integrates the visible region (seed 000 Alg. 1 lines 13-16): Baum's formula for the diffuse
 //! lobe and, after the LTC transform `M^-1` for the view angle and roughness, the same formula
 //! for the GGX lobe (HDHN16 eq. 2 / seed 000 eq. 2).
+//!
+//! The region comes from the visibility layer's fast path ([`ClipVisibility::visible_pieces`]:
+//! pieces cut by half-spaces, never built as spherical polygons, integrated as they are) where it
+//! applies, and from the spherical path ([`ClipVisibility::visible_region`]) elsewhere; the two
+//! agree to rounding (`tests/shade_speed.rs`). A [`ShadeContext`] holds the fast path's scratch
+//! storage: [`Scene::shade_with`] reuses the caller's, [`Scene::shade`] makes one on the stack.
 
 use alloc::vec::Vec;
 
@@ -14,10 +20,14 @@ use glam::{DMat3, DVec3};
 use super::material::Material;
 use super::scene::Scene;
 use crate::GeomError;
-use crate::ltc::{clamped_cosine_integral_upper, lookup, ltc_integral};
+use crate::ltc::{
+    clamped_cosine_integral_upper, lookup, ltc_integral, ltc_ring_integral, upper_ring_integral,
+};
 use crate::solid::ShadingFrame;
 use crate::sphere::SphericalPolygon;
-use crate::visibility::Visibility;
+#[cfg(doc)]
+use crate::visibility::ClipVisibility;
+use crate::visibility::{Pieces, Visibility};
 
 /// What a failed LTC lookup or integral reports: the frame's view and the material were
 /// validated, and the visible region is a valid polygon, so any error is a give-up.
@@ -77,6 +87,76 @@ fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularS
     Ok(Some((look.m_inv, scale)))
 }
 
+/// Scratch storage and counters of shading queries ([`Scene::shade_with`]): the visibility fast
+/// path's [`Pieces`], kept so that their buffers are reused from one query to the next.
+///
+/// Inline storage covers lights and blockers of up to 16 vertices, so neither a context kept by
+/// the caller nor the one [`Scene::shade`] makes on the stack allocates for them; larger inputs
+/// spill to the heap once per context. A context holds no results: any context serves any
+/// scene. One per thread (it is `Send`, and the scene is shared).
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::shade::{Light, Material, Scene, ShadeContext, TriangleMesh};
+/// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+/// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![])?;
+/// let white = Material::diffuse(DVec3::ONE)?;
+/// let mut ctx = ShadeContext::new();
+/// for k in 0..4 {
+///     let x = DVec3::new(0.1 * k as f64, 0.0, 0.0);
+///     let rgb = scene.shade_with(&mut ctx, x, DVec3::Z, DVec3::Z, &white)?;
+///     assert_eq!(rgb, scene.shade(x, DVec3::Z, DVec3::Z, &white)?);
+/// }
+/// // A quad light seen from the front: every query took the fast path.
+/// assert_eq!((ctx.fast_lights(), ctx.spherical_lights()), (4, 0));
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Debug, Default, Clone)]
+pub struct ShadeContext {
+    pieces: Pieces,
+    fast: u64,
+    spherical: u64,
+}
+
+impl ShadeContext {
+    /// A fresh context (no heap allocation).
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// How many (point, light) regions the queries through this context took from the fast path
+    /// ([`ClipVisibility::visible_pieces`]).
+    #[must_use]
+    pub fn fast_lights(&self) -> u64 {
+        self.fast
+    }
+
+    /// How many (point, light) regions took the spherical path
+    /// ([`ClipVisibility::visible_region`]), where the fast path does not apply.
+    #[must_use]
+    pub fn spherical_lights(&self) -> u64 {
+        self.spherical
+    }
+}
+
+/// The diffuse and LTC integrals of the fast path's pieces, as [`integrals`] of the same region
+/// (up to rounding); `None` only for an LTC map the ring integral declines (never one of the
+/// tables').
+fn piece_integrals(pieces: &Pieces, spec: SpecularSetup) -> Option<(f64, f64)> {
+    let (mut diffuse, mut specular) = (0.0, 0.0);
+    for (sign, ring) in pieces.loops() {
+        diffuse += sign * upper_ring_integral(ring);
+        if let Some((m_inv, _)) = spec {
+            specular += sign * ltc_ring_integral(ring, m_inv)?;
+        }
+    }
+    // The signed sum cancels where blockers overlap: a few ulps below zero is nothing.
+    Some((diffuse.max(0.0), specular.max(0.0)))
+}
+
 /// The diffuse (clamped cosine over pi) and LTC integrals over region pieces already clipped to
 /// the upper hemisphere; the second is zero without a specular lobe.
 fn integrals(pieces: &[SphericalPolygon], spec: SpecularSetup) -> Result<(f64, f64), GeomError> {
@@ -114,8 +194,39 @@ impl Scene {
     ///   reference, or a point moved by a tiny amount).
     ///
     /// No other error is returned: the scene and the material were validated when built.
+    ///
+    /// # Points on surfaces
+    ///
+    /// A point on an occluder's surface (or within the facing predicate's tolerance of one of its
+    /// face planes, [`crate::solid::FACE_TOLERANCE`]) gets a finite value: a convex occluder
+    /// covers the half-space behind the faces it lies on (a hemisphere seen from a point on a
+    /// face, a lune from an edge), so such a point sees the light only through the other side
+    /// of those face planes; a mesh occluder's triangles seen edge-on cover nothing. A point on
+    /// a planar light's plane sees none of that light (it is seen edge-on); a point on a convex
+    /// light sees the part of the sphere its silhouette path gives (see the
+    /// [module documentation](crate::shade)).
+    ///
+    /// Each call makes a [`ShadeContext`] on the stack; [`Scene::shade_with`] reuses one.
     pub fn shade(
         &self,
+        point: DVec3,
+        normal: DVec3,
+        view: DVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        self.shade_with(&mut ShadeContext::new(), point, normal, view, material)
+    }
+
+    /// [`Scene::shade`] with the caller's scratch storage: the same value, without setting up a
+    /// context per call, and with the context's counters of which path each light took. Keep one
+    /// [`ShadeContext`] per thread.
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`].
+    pub fn shade_with(
+        &self,
+        ctx: &mut ShadeContext,
         point: DVec3,
         normal: DVec3,
         view: DVec3,
@@ -125,7 +236,7 @@ impl Scene {
         let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
         for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, spec)?;
+            total += self.shade_light_in(i, &frame, material, spec, ctx)?;
         }
         Ok(total)
     }
@@ -146,7 +257,7 @@ impl Scene {
         self.light(light)?;
         let frame = ShadingFrame::new(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        self.shade_light_in(light, &frame, material, spec)
+        self.shade_light_in(light, &frame, material, spec, &mut ShadeContext::new())
     }
 
     /// Every light's share of [`Scene::shade`] at `point` (same arguments), split into the
@@ -189,11 +300,15 @@ impl Scene {
     ) -> Result<Vec<LightShading>, GeomError> {
         let frame = ShadingFrame::new(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        let vis = self.visibility();
+        let mut ctx = ShadeContext::new();
         let mut out = Vec::with_capacity(self.lights().len());
         for (i, light) in self.lights().iter().enumerate() {
-            let shadowed = integrals(&vis.visible_region(i, &frame)?, spec)?;
-            let unshadowed = integrals(&vis.unoccluded_region(i, &frame)?, spec)?;
+            let unshadowed = self.light_integrals(i, &frame, spec, false, &mut ctx)?;
+            let shadowed = self.light_integrals(i, &frame, spec, true, &mut ctx)?;
+            // The two regions may come from different paths (the fast path declines only where a
+            // blocker needs the spherical one), which agree to rounding: the visible part of a
+            // light never gives more than the whole.
+            let shadowed = (shadowed.0.min(unshadowed.0), shadowed.1.min(unshadowed.1));
             let rgb = light.radiance();
             let lobes = |(d, s): (f64, f64)| {
                 let specular = spec.map_or(DVec3::ZERO, |(_, scale)| scale * s * rgb);
@@ -211,16 +326,73 @@ impl Scene {
         Ok(out)
     }
 
+    /// The diffuse and LTC integrals of light `i`'s visible region (`blocked`) or of its region
+    /// with every other object removed: from the fast path where it applies, else from the
+    /// spherical path.
+    fn light_integrals(
+        &self,
+        i: usize,
+        frame: &ShadingFrame,
+        spec: SpecularSetup,
+        blocked: bool,
+        ctx: &mut ShadeContext,
+    ) -> Result<(f64, f64), GeomError> {
+        match self.fast_integrals(i, frame, spec, blocked, ctx)? {
+            Some(v) => Ok(v),
+            None => self.spherical_integrals(i, frame, spec, blocked, ctx),
+        }
+    }
+
+    /// [`Scene::light_integrals`] from the fast path, `None` where it does not apply.
+    fn fast_integrals(
+        &self,
+        i: usize,
+        frame: &ShadingFrame,
+        spec: SpecularSetup,
+        blocked: bool,
+        ctx: &mut ShadeContext,
+    ) -> Result<Option<(f64, f64)>, GeomError> {
+        if self
+            .visibility()
+            .visible_pieces(i, frame, blocked, &mut ctx.pieces)?
+            && let Some(v) = piece_integrals(&ctx.pieces, spec)
+        {
+            ctx.fast += 1;
+            return Ok(Some(v));
+        }
+        Ok(None)
+    }
+
+    /// [`Scene::light_integrals`] from the spherical path.
+    fn spherical_integrals(
+        &self,
+        i: usize,
+        frame: &ShadingFrame,
+        spec: SpecularSetup,
+        blocked: bool,
+        ctx: &mut ShadeContext,
+    ) -> Result<(f64, f64), GeomError> {
+        ctx.spherical += 1;
+        let vis = self.visibility();
+        // The spherical path's pieces are already clipped to the upper hemisphere.
+        let region = if blocked {
+            vis.visible_region(i, frame)?
+        } else {
+            vis.unoccluded_region(i, frame)?
+        };
+        integrals(&region, spec)
+    }
+
     fn shade_light_in(
         &self,
         i: usize,
         frame: &ShadingFrame,
         material: &Material,
         spec: SpecularSetup,
+        ctx: &mut ShadeContext,
     ) -> Result<DVec3, GeomError> {
         let light = &self.lights()[i];
-        // The visible pieces are already clipped to the upper hemisphere.
-        let (diffuse, specular) = integrals(&self.visibility().visible_region(i, frame)?, spec)?;
+        let (diffuse, specular) = self.light_integrals(i, frame, spec, true, ctx)?;
         let mut out = material.albedo() * diffuse;
         if let Some((_, scale)) = spec {
             out += scale * specular;

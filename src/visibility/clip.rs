@@ -57,9 +57,9 @@ pub enum Method {
 pub struct ClipVisibility<L> {
     lights: Vec<L>,
     occluders: Vec<Body>,
-    light_bounds: Vec<BoundingSphere>,
+    pub(super) light_bounds: Vec<BoundingSphere>,
     occluder_bounds: Vec<BoundingSphere>,
-    method: Method,
+    pub(super) method: Method,
     /// Per light: its mesh validated as a solid ([`ClosedMesh`]) when it is a closed,
     /// non-planar mesh light that bounds one (then its region is its non-convex silhouette).
     solids: Vec<Option<ClosedMesh>>,
@@ -68,6 +68,10 @@ pub struct ClipVisibility<L> {
     /// the two, or `None` when they overlap (the blocker interpenetrates the light, or is the
     /// light itself).
     separations: Vec<Option<Separation>>,
+    /// Per light: for a planar mesh light whose boundary has only outer loops (no holes), those
+    /// loops ([`TriangleMesh::boundary_loops`]): the region it covers seen from the front, for
+    /// the fast path ([`ClipVisibility::visible_pieces`]).
+    pub(super) outlines: Vec<Option<Vec<Vec<u32>>>>,
 }
 
 /// How a blocker acts on one front face of a light (or on all of them).
@@ -118,6 +122,13 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 _ => None,
             })
             .collect();
+        let outlines = lights
+            .iter()
+            .map(|l| match l.as_ref() {
+                Body::Mesh(m) if m.is_planar() => outer_loops(m),
+                _ => None,
+            })
+            .collect();
         ClipVisibility {
             lights,
             occluders,
@@ -126,6 +137,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             method: Method::Silhouette,
             solids,
             separations,
+            outlines,
         }
     }
 
@@ -155,7 +167,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// The body of light `i`, or [`GeomError::OutOfRange`] past the end.
-    fn light_body(&self, i: usize) -> Result<&Body, GeomError> {
+    pub(super) fn light_body(&self, i: usize) -> Result<&Body, GeomError> {
         self.lights
             .get(i)
             .map(AsRef::as_ref)
@@ -181,12 +193,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// The precomputed separating plane between light `light` and blocker `b`, if any.
-    fn separation(&self, light: usize, b: Blocker) -> Option<Separation> {
+    pub(super) fn separation(&self, light: usize, b: Blocker) -> Option<Separation> {
         self.separations[light * self.blocker_count() + self.slot(b)]
     }
 
     /// The geometry and bounding sphere of a blocker.
-    fn blocker(&self, b: Blocker) -> (&Body, BoundingSphere) {
+    pub(super) fn blocker(&self, b: Blocker) -> (&Body, BoundingSphere) {
         match b {
             Blocker::Occluder(k) => (&self.occluders[k], self.occluder_bounds[k]),
             Blocker::Light(k) => (self.lights[k].as_ref(), self.light_bounds[k]),
@@ -625,6 +637,23 @@ fn subtract_cut(
     Ok(piece)
 }
 
+/// The boundary loops of a planar mesh ([`TriangleMesh::boundary_loops`]) when every one is an
+/// outer loop, counter-clockwise about the mesh's normal (a positive vector area along it); `None`
+/// when one is a hole (or bounds no area), which the fast path does not take.
+fn outer_loops(m: &TriangleMesh) -> Option<Vec<Vec<u32>>> {
+    let loops = m.boundary_loops();
+    let n = m.triangle_normal(0);
+    let v = m.vertices();
+    let c = m.bounding_sphere().center;
+    let outer = |lp: &Vec<u32>| {
+        let area: DVec3 = (0..lp.len())
+            .map(|k| (v[lp[k] as usize] - c).cross(v[lp[(k + 1) % lp.len()] as usize] - c))
+            .sum();
+        area.dot(n) > 0.0
+    };
+    (!loops.is_empty() && loops.iter().all(outer)).then_some(loops)
+}
+
 /// What a clip that added part of the horizon outside its polygon reports (see [`upper_part`]).
 const CLIP_LEFT_POLYGON: &str =
     "the horizon clip of a region added a horizon arc outside the region within rounding";
@@ -699,7 +728,7 @@ fn upper_pieces(pieces: Vec<SphericalPolygon>) -> Result<Vec<SphericalPolygon>, 
 
 /// A sphere holding a triangle (about its centroid, padded by a relative ulp margin), for the
 /// per-triangle culling.
-fn triangle_bound(tri: [DVec3; 3]) -> BoundingSphere {
+pub(super) fn triangle_bound(tri: [DVec3; 3]) -> BoundingSphere {
     let c = (tri[0] + tri[1] + tri[2]) / 3.0;
     let r = tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max) * (1.0 + 1e-12);
     BoundingSphere {

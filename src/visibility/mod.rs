@@ -14,10 +14,12 @@
 
 mod clip;
 pub(crate) mod cull;
+mod pieces;
 
 use alloc::vec::Vec;
 
 pub use clip::{ClipVisibility, Method};
+pub use pieces::Pieces;
 
 use crate::GeomError;
 use crate::solid::ShadingFrame;

@@ -1,0 +1,347 @@
+//! The shading fast path (`ClipVisibility::visible_pieces`, loops cut by half-spaces and
+//! integrated as they are) against the spherical path (`Scene::visible_region`, spherical set
+//! operations), on random scenes: every (point, light) pair where both answer must agree to
+//! `1e-12` of the light's unoccluded value plus `1e-15` of its radiance, per channel.
+//!
+//! The reference value is recomputed here from the spherical path's region through the public
+//! integrals (`clamped_cosine_integral`, `ltc_integral` with the table's lookup), independently of
+//! the shading code; the fast value is `Scene::shade_light` (and `Scene::shade_with`, which must
+//! give the same bits). Why relative to the unoccluded value rather than to the value itself:
+//! the spherical path snaps projected vertices to `planar::SNAP_REL` (about `1.4e-14`) of the
+//! projected coordinates and drops slivers below `planar::SLIVER_REL`, and the fast path's
+//! signed sums cancel where blockers overlap, so both are exact to a few `1e-14` of the light's
+//! whole integral, not of an umbra's last sliver.
+//!
+//! The scenes are built where the fast path is delicate: lights cut by the horizon (tilted
+//! normals, quads reaching below the ground's level), points on or within `1e-9` of occluder
+//! face planes (cubes standing on the ground, points on the planes of their sides), occluders
+//! partly behind the point (through the ground), blockers that overlap each other in projection,
+//! mesh occluders (quads, seen from either side), lights that block other lights, glossy
+//! materials up to grazing views. The test also requires that the fast path answered for most
+//! pairs, so that it cannot pass by declining.
+//!
+//! `SHADE_SPEED_SCENES=N` runs `N` scenes instead of the default 120 (about 24 000 pairs).
+
+use arealight::glam::DVec3;
+use arealight::ltc::{clamped_cosine_integral, lookup, ltc_integral};
+use arealight::shade::{
+    Body, ConvexPolyhedron, Light, Material, Scene, ShadeContext, ShadingFrame, TriangleMesh,
+};
+use arealight::visibility::Pieces;
+use support::Rng;
+use support::shade::view_above;
+
+mod support;
+
+/// A random light: a quad (tilted, sometimes reaching below the ground's level) or a convex
+/// polyhedron, above the ground.
+fn random_light(rng: &mut Rng) -> Body {
+    let c = DVec3::new(
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+        rng.range(0.3, 3.0),
+    );
+    match rng.below(4) {
+        0 | 1 => {
+            // Facing down, tilted by up to about 80 degrees; sometimes large and low, so that
+            // ground points see it cut by their horizon.
+            let size = rng.range(0.1, 1.5);
+            let tilt = DVec3::new(rng.range(-0.9, 0.9), rng.range(-0.9, 0.9), 0.0);
+            let n = (-DVec3::Z + tilt * 2.0).normalize();
+            let (u, v) = n.any_orthonormal_pair();
+            let (su, sv) = (size * rng.range(0.3, 1.0), size * rng.range(0.3, 1.0));
+            // `quad(c, u, v)` faces `u x v`: swap to face `n`.
+            let (u, v) = if u.cross(v).dot(n) > 0.0 {
+                (u, v)
+            } else {
+                (v, u)
+            };
+            TriangleMesh::quad(c, u * su, v * sv).unwrap().into()
+        }
+        2 => ConvexPolyhedron::cuboid(
+            c,
+            DVec3::new(
+                rng.range(0.05, 0.5),
+                rng.range(0.05, 0.5),
+                rng.range(0.05, 0.5),
+            ),
+        )
+        .unwrap()
+        .into(),
+        _ => ConvexPolyhedron::icosphere(c, rng.range(0.05, 0.6), rng.below(2) as u32)
+            .unwrap()
+            .into(),
+    }
+}
+
+/// A random occluder between the ground and the light (or standing on the ground, or through
+/// it): a box, an icosphere or a quad sheet.
+fn random_occluder(rng: &mut Rng, light: DVec3) -> Body {
+    let ground = DVec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), 0.0);
+    let t = rng.range(0.15, 0.85);
+    let mut c = ground.lerp(light, t);
+    let h = DVec3::new(
+        rng.range(0.03, 0.4),
+        rng.range(0.03, 0.4),
+        rng.range(0.03, 0.4),
+    );
+    match rng.below(5) {
+        // Standing on the ground: the bottom face in the ground's plane.
+        0 => {
+            c.z = h.z;
+            ConvexPolyhedron::cuboid(c, h).unwrap().into()
+        }
+        // Through the ground: partly behind every ground point's horizon.
+        1 => {
+            c.z = rng.range(-0.2, 0.2);
+            ConvexPolyhedron::cuboid(c, h).unwrap().into()
+        }
+        2 => ConvexPolyhedron::icosphere(c, h.x, rng.below(2) as u32)
+            .unwrap()
+            .into(),
+        3 => {
+            let (u, v) = rng.dir().any_orthonormal_pair();
+            TriangleMesh::quad(c, u * h.x, v * h.y).unwrap().into()
+        }
+        _ => ConvexPolyhedron::cuboid(c, h).unwrap().into(),
+    }
+}
+
+/// A shading point and normal: mostly ground points, some on the plane of an occluder's face
+/// (or within `1e-9` of it), some with tilted normals that put the light across the horizon.
+fn random_point(rng: &mut Rng, scene: &Scene) -> (DVec3, DVec3) {
+    let mut x = DVec3::new(rng.range(-2.0, 2.0), rng.range(-2.0, 2.0), 0.0);
+    let mut n = DVec3::Z;
+    match rng.below(6) {
+        0 if !scene.occluders().is_empty() => {
+            // On or next to the plane of a face of an occluder.
+            let o = &scene.occluders()[rng.below(scene.occluders().len())];
+            let m = o.mesh();
+            let f = rng.below(m.triangle_count());
+            let (a, fnormal) = (m.triangle(f)[0], m.triangle_normal(f));
+            let off = [0.0, 1e-9, -1e-9, 1e-12][rng.below(4)];
+            let d = fnormal.dot(x - a) - off;
+            x -= fnormal * d;
+            if x.z < -0.5 || x.z > 3.0 {
+                x.z = 0.0;
+            }
+        }
+        1 => {
+            // A tilted surface: the horizon cuts the lights.
+            n = (DVec3::Z + DVec3::new(rng.range(-2.0, 2.0), rng.range(-2.0, 2.0), 0.0))
+                .normalize();
+            x.z = rng.range(0.0, 1.0);
+        }
+        _ => {}
+    }
+    (x, n)
+}
+
+fn random_scene(rng: &mut Rng) -> Scene {
+    let nl = if rng.below(5) == 0 { 2 } else { 1 };
+    let lights: Vec<Light> = (0..nl)
+        .map(|_| {
+            let rgb = DVec3::new(
+                rng.range(0.5, 2.0),
+                rng.range(0.5, 2.0),
+                rng.range(0.5, 2.0),
+            );
+            Light::new(random_light(rng), rgb).unwrap()
+        })
+        .collect();
+    let target = lights[0].shape().bounding_sphere().center;
+    let no = rng.below(4);
+    let occluders = (0..no).map(|_| random_occluder(rng, target)).collect();
+    Scene::new(lights, occluders).unwrap()
+}
+
+/// Light `i`'s radiance at the point from the spherical path's region, integrated here; and the
+/// same for its unoccluded region. `None` where the spherical path gives up.
+fn spherical(scene: &Scene, i: usize, f: &ShadingFrame, m: &Material) -> Option<(DVec3, DVec3)> {
+    let light = &scene.lights()[i];
+    let value = |pieces: Vec<arealight::sphere::SphericalPolygon>| -> Option<DVec3> {
+        let d: f64 = pieces.iter().map(clamped_cosine_integral).sum();
+        let mut out = m.albedo() * d;
+        if m.has_specular() {
+            let l = lookup(f.view().z, m.alpha()).ok()?;
+            let mut s = 0.0;
+            for p in &pieces {
+                s += ltc_integral(p, l.m_inv).ok()?;
+            }
+            let f0 = m.f0();
+            out += DVec3::new(
+                l.specular_scale(f0.x),
+                l.specular_scale(f0.y),
+                l.specular_scale(f0.z),
+            ) * s;
+        }
+        Some(out * light.radiance())
+    };
+    let vis = scene.visibility();
+    let shadowed = value(scene.visible_region(i, f).ok()?)?;
+    let unoccluded = value(arealight::visibility::Visibility::unoccluded_region(vis, i, f).ok()?)?;
+    Some((shadowed, unoccluded))
+}
+
+/// The absolute part of the tolerance, in units of the light's radiance (the integrals' own
+/// unit): `1e-12` of it is `1e-15`, a few ulps of a whole hemisphere's integral, which both paths
+/// round to in Baum's sums of long edges (a light a sliver above a tilted horizon has an integral
+/// of `1e-8` made of edge terms near 1).
+const ABS_FLOOR: f64 = 1e-3;
+
+#[test]
+fn fast_path_agrees_with_the_spherical_path() {
+    let scenes: usize = std::env::var("SHADE_SPEED_SCENES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(120);
+    let mut rng = Rng::new(15);
+    let materials = [
+        Material::diffuse(DVec3::new(0.8, 0.6, 0.4)).unwrap(),
+        Material::new(DVec3::splat(0.5), DVec3::new(0.04, 0.5, 0.9), 0.3).unwrap(),
+        Material::new(DVec3::splat(0.2), DVec3::splat(0.9), 0.02).unwrap(),
+    ];
+    let (mut pairs, mut fast, mut gave_up) = (0usize, 0usize, 0usize);
+    let mut worst: f64 = 0.0;
+    let mut failures = Vec::new();
+    let mut pieces = Pieces::new();
+    let mut ctx = ShadeContext::new();
+    for s in 0..scenes {
+        let scene = random_scene(&mut rng);
+        for _ in 0..100 {
+            let (x, n) = random_point(&mut rng, &scene);
+            let cos_min = [0.05, 0.3][rng.below(2)];
+            let v = view_above(&mut rng, n, cos_min);
+            let m = &materials[rng.below(materials.len())];
+            let f = ShadingFrame::new(x, n, v).unwrap();
+            // Each light's fast value, summed in the order `shade_with` sums them.
+            let mut total = Some(DVec3::ZERO);
+            for i in 0..scene.lights().len() {
+                pairs += 1;
+                let took = scene
+                    .visibility()
+                    .visible_pieces(i, &f, true, &mut pieces)
+                    .unwrap();
+                fast += usize::from(took);
+                let got = scene.shade_light(i, x, n, v, m);
+                total = match (&got, total) {
+                    (Ok(g), Some(t)) => Some(t + *g),
+                    _ => None,
+                };
+                let Some((want, unoccluded)) = spherical(&scene, i, &f, m) else {
+                    gave_up += 1;
+                    continue;
+                };
+                let got = got.unwrap_or_else(|e| {
+                    panic!("scene {s}: fast path failed where the spherical one answered: {e}")
+                });
+                let err = (got - want).abs().max_element();
+                let scale = unoccluded.max_element();
+                let radiance = scene.lights()[i].radiance().max_element();
+                let rel = err / (scale + ABS_FLOOR * radiance);
+                worst = worst.max(rel);
+                if err > 1e-12 * (scale + ABS_FLOOR * radiance) {
+                    failures.push(format!(
+                        "scene {s} light {i} x {x} n {n} v {v}: fast {got} spherical {want} \
+                         (unoccluded {unoccluded}, took fast path: {took})"
+                    ));
+                }
+            }
+            // The whole point through a reused context: the same bits as light by light.
+            if let Some(total) = total {
+                let all = scene.shade_with(&mut ctx, x, n, v, m).unwrap();
+                assert_eq!(
+                    all, total,
+                    "scene {s}: shade_with differs from its lights' sum"
+                );
+            }
+        }
+    }
+    eprintln!(
+        "{pairs} pairs, {fast} on the fast path, {gave_up} spherical give-ups, worst difference \
+         {worst:.2e} of the tolerance's scale (unoccluded value + 1e-3 radiance)"
+    );
+    assert!(
+        failures.is_empty(),
+        "{} of {pairs} pairs differ:\n{}",
+        failures.len(),
+        failures[..failures.len().min(20)].join("\n")
+    );
+    // The fast path must have done the work: most pairs are light and convex or quad occluders.
+    assert!(
+        fast * 10 >= pairs * 7,
+        "only {fast} of {pairs} pairs took the fast path"
+    );
+}
+
+/// Points within `1e-12` to `1e-9` of the planes of a box's side faces (and on them), under a
+/// quad light and a convex light: the box's silhouette from such a point leaves out the face
+/// seen within the facing tolerance of edge-on, which makes the silhouette turn back by a sliver
+/// (a reflex vertex). The fast path must decline there (its half-spaces would cut a wedge out
+/// along the extended edge, about `1e-10` of the light) or agree with the spherical path.
+#[test]
+fn points_next_to_occluder_face_planes() {
+    let boxed =
+        ConvexPolyhedron::cuboid(DVec3::new(-0.13, -0.9, 0.52), DVec3::new(0.2, 0.11, 0.22))
+            .unwrap();
+    let lights: [Body; 2] = [
+        TriangleMesh::quad(
+            DVec3::new(-0.26, 0.57, 2.97),
+            DVec3::new(0.19, 0.05, -0.29),
+            DVec3::new(-0.07, -0.45, -0.13),
+        )
+        .unwrap()
+        .into(),
+        ConvexPolyhedron::icosphere(DVec3::new(0.2, 0.3, 2.5), 0.4, 1)
+            .unwrap()
+            .into(),
+    ];
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
+    let mut rng = Rng::new(154);
+    let (mut pairs, mut fast) = (0, 0);
+    let mut failures = Vec::new();
+    let mut pieces = Pieces::new();
+    for light in lights {
+        let scene = Scene::new(
+            vec![Light::new(light, DVec3::ONE).unwrap()],
+            vec![boxed.clone().into()],
+        )
+        .unwrap();
+        let mesh = boxed.mesh();
+        for _ in 0..400 {
+            // A ground point moved onto (or next to) the plane of a side face.
+            let f = loop {
+                let f = rng.below(mesh.triangle_count());
+                if mesh.triangle_normal(f).z.abs() < 0.5 {
+                    break f;
+                }
+            };
+            let (a, nf) = (mesh.triangle(f)[0], mesh.triangle_normal(f));
+            let mut x = DVec3::new(rng.range(-1.0, 1.0), rng.range(-2.0, 0.5), 0.0);
+            let off = [0.0, 1e-12, -1e-12, 1e-10, 1e-9][rng.below(5)];
+            x -= nf * (nf.dot(x - a) - off);
+            let v = view_above(&mut rng, DVec3::Z, 0.2);
+            let frame = ShadingFrame::new(x, DVec3::Z, v).unwrap();
+            pairs += 1;
+            fast += usize::from(
+                scene
+                    .visibility()
+                    .visible_pieces(0, &frame, true, &mut pieces)
+                    .unwrap(),
+            );
+            let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) else {
+                continue;
+            };
+            let got = scene.shade(x, DVec3::Z, v, &m).unwrap();
+            let err = (got - want).abs().max_element();
+            if err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR) {
+                failures.push(format!("x {x} v {v}: fast {got} spherical {want}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(
+        fast * 2 >= pairs,
+        "only {fast} of {pairs} took the fast path"
+    );
+}
