@@ -257,9 +257,11 @@ fn fast_path_agrees_with_the_spherical_path() {
             }
         }
     }
+    let (traced, cut) = pieces.subtractions();
     eprintln!(
-        "{pairs} pairs, {fast} on the fast path, {gave_up} spherical give-ups, worst difference \
-         {worst:.2e} of the tolerance's scale (unoccluded value + 1e-3 radiance)"
+        "{pairs} pairs, {fast} on the fast path ({traced} subtractions traced, {cut} by \
+         inclusion-exclusion), {gave_up} spherical give-ups, worst difference {worst:.2e} of the \
+         tolerance's scale (unoccluded value + 1e-3 radiance)"
     );
     assert!(
         failures.is_empty(),
@@ -267,10 +269,15 @@ fn fast_path_agrees_with_the_spherical_path() {
         failures.len(),
         failures[..failures.len().min(20)].join("\n")
     );
-    // The fast path must have done the work: most pairs are light and convex or quad occluders.
+    // The fast path must have done the work: most pairs are light and convex or quad occluders,
+    // and both ways of subtracting a blocker ran often.
     assert!(
         fast * 10 >= pairs * 7,
         "only {fast} of {pairs} pairs took the fast path"
+    );
+    assert!(
+        traced * 100 >= pairs as u64 * 10 && cut * 100 >= pairs as u64,
+        "{traced} subtractions traced, {cut} by inclusion-exclusion"
     );
 }
 
@@ -339,6 +346,108 @@ fn points_next_to_occluder_face_planes() {
             }
         }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(
+        fast * 2 >= pairs,
+        "only {fast} of {pairs} took the fast path"
+    );
+}
+
+/// Blockers in exact contact in projection, where the boundary tracing must not decide: two
+/// boxes stacked on a shared face and two side by side, the same box twice, a box whose edges
+/// project onto the quad light's edges from points on symmetry lines (the light's edge at
+/// `x = 0.5`, height 2, the box's at `x = 0.25`, height 1, points at `x = 0`), and a roof of two
+/// quad sheets sharing an edge, at points on exact lines and on a grid of exactly representable
+/// coordinates.
+#[test]
+fn blockers_in_exact_contact() {
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5).unwrap();
+    let cube = |c: DVec3, h: DVec3| -> Body { ConvexPolyhedron::cuboid(c, h).unwrap().into() };
+    let roof = {
+        let v = vec![
+            DVec3::new(-0.3, -0.25, 1.0),
+            DVec3::new(0.3, -0.25, 1.0),
+            DVec3::new(0.3, 0.0, 1.25),
+            DVec3::new(-0.3, 0.0, 1.25),
+            DVec3::new(-0.3, 0.25, 1.0),
+            DVec3::new(0.3, 0.25, 1.0),
+        ];
+        let t = vec![[0, 1, 2], [0, 2, 3], [3, 2, 5], [3, 5, 4]];
+        Body::from(TriangleMesh::new(v, t).unwrap())
+    };
+    let scenes: Vec<Vec<Body>> = vec![
+        // Stacked on a shared face.
+        vec![
+            cube(DVec3::new(0.0, 0.0, 0.75), DVec3::splat(0.125)),
+            cube(DVec3::new(0.0, 0.0, 1.0), DVec3::splat(0.125)),
+        ],
+        // Side by side, sharing a face.
+        vec![
+            cube(DVec3::new(-0.125, 0.0, 1.0), DVec3::splat(0.125)),
+            cube(DVec3::new(0.125, 0.0, 1.0), DVec3::splat(0.125)),
+        ],
+        // The same box twice.
+        vec![
+            cube(DVec3::new(0.0, 0.125, 1.0), DVec3::splat(0.125)),
+            cube(DVec3::new(0.0, 0.125, 1.0), DVec3::splat(0.125)),
+        ],
+        // Edges at x = +-0.25, y = +-0.25, height 1: seen from the ground's axes they project
+        // onto the light's edges.
+        vec![cube(
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.25, 0.25, 0.125),
+        )],
+        vec![roof],
+    ];
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
+    let mut rng = Rng::new(99);
+    let (mut pairs, mut fast) = (0, 0);
+    let mut failures = Vec::new();
+    let mut pieces = Pieces::new();
+    for (k, occ) in scenes.into_iter().enumerate() {
+        let scene = Scene::new(vec![Light::new(quad.clone(), DVec3::ONE).unwrap()], occ).unwrap();
+        // Points on the axes and diagonals, and on a grid of multiples of 1/16.
+        let mut points: Vec<DVec3> = (0..64)
+            .map(|i| {
+                let t = i as f64 / 32.0 - 1.0;
+                [
+                    DVec3::new(t, 0.0, 0.0),
+                    DVec3::new(0.0, t, 0.0),
+                    DVec3::new(t, t, 0.0),
+                    DVec3::new(t, -t, 0.0),
+                ][i % 4]
+            })
+            .collect();
+        points.extend((0..64).map(|i| {
+            DVec3::new(
+                ((i % 8) as f64 - 4.0) / 16.0,
+                ((i / 8) as f64 - 4.0) / 16.0,
+                0.0,
+            )
+        }));
+        for x in points {
+            let v = view_above(&mut rng, DVec3::Z, 0.2);
+            let frame = ShadingFrame::new(x, DVec3::Z, v).unwrap();
+            pairs += 1;
+            fast += usize::from(
+                scene
+                    .visibility()
+                    .visible_pieces(0, &frame, true, &mut pieces)
+                    .unwrap(),
+            );
+            let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) else {
+                continue;
+            };
+            let got = scene.shade(x, DVec3::Z, v, &m).unwrap();
+            let err = (got - want).abs().max_element();
+            if err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR) {
+                failures.push(format!("scene {k} x {x}: fast {got} spherical {want}"));
+            }
+        }
+    }
+    let (traced, cut) = pieces.subtractions();
+    eprintln!("{pairs} pairs, {fast} fast, {traced} traced, {cut} by inclusion-exclusion");
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     assert!(
         fast * 2 >= pairs,

@@ -457,74 +457,110 @@ pub(crate) fn clamped_cosine_integral_upper(poly: &SphericalPolygon) -> f64 {
     upper_sum(poly, Exact)
 }
 
-/// [`clamped_cosine_integral_upper`] of one ring of directions of any positive length (not
-/// normalized: Baum's edge terms are invariant under positive scaling of each endpoint) whose
-/// region lies in the closed upper hemisphere, its interior on the left of each edge: the
-/// diffuse integral of a piece of the shading fast path (`crate::visibility`), the same sum as
-/// the polygon's up to rounding.
-pub(crate) fn upper_ring_integral(ring: &[DVec3]) -> f64 {
-    let Some(&last) = ring.last() else {
-        return 0.0;
-    };
-    let mut prev = Ray::new(last);
+/// [`clamped_cosine_integral_upper`] of a region given as a chain of rings of directions of any
+/// positive length (not normalized: Baum's edge terms are invariant under positive scaling of
+/// each endpoint) in the closed upper hemisphere: the sum of the rings' edge terms, whatever the
+/// rings' orientation or overlap, is the integral weighted by the chain's winding number, which
+/// for the shading fast path's regions (`crate::visibility::Pieces`) is the region's indicator.
+/// The diffuse integral of that path, the same sum as the polygon's up to rounding.
+pub(crate) fn upper_rings_integral<'a>(rings: impl Iterator<Item = &'a [DVec3]>) -> f64 {
     let mut sum = 0.0;
-    for &v in ring {
-        let cur = Ray::new(v);
-        sum += edge_term(prev, cur);
-        prev = cur;
+    for ring in rings {
+        let Some(&last) = ring.last() else {
+            continue;
+        };
+        let mut prev = Ray::new(last);
+        for &v in ring {
+            let cur = Ray::new(v);
+            sum += edge_term(prev, cur);
+            prev = cur;
+        }
     }
     integral_of_sum(sum)
 }
 
-/// [`ltc_integral`] of one ring of directions of any positive length whose region lies in the
-/// closed upper hemisphere (clipped at the shading horizon, as the LTC tables assume), interior
-/// on the left: the specular integral of a piece of the shading fast path.
+/// [`ltc_integral`] of a region given as a chain of rings (as for [`upper_rings_integral`]) in
+/// the closed upper hemisphere (clipped at the shading horizon, as the LTC tables assume): the
+/// specular integral of the shading fast path.
 ///
-/// The clip-free kernel ([`transformed_clip_free`], the same code as for a polygon) decides most
-/// rings; where it hands over (an image within rounding of the cosine's horizon, as the images
-/// of a piece's vertices on the shading horizon under a map that keeps the horizon), the images
-/// are clipped at the horizon by Sutherland–Hodgman in homogeneous coordinates (one plane, so
-/// exact for any simple ring in the sense of the boundary integral: the bridges it adds along the
-/// horizon run both ways and cancel) and Baum's sum is taken over the result. `None` only for a
-/// map that is singular, not finite or reverses orientation, which the LTC tables never give.
-pub(crate) fn ltc_ring_integral(ring: &[DVec3], m_inv: glam::DMat3) -> Option<f64> {
-    if let Some(v) = transformed_clip_free(ring, &m_inv, Exact) {
-        return Some(v);
-    }
-    clipped_ring_integral(ring, m_inv)
+/// The clip-free kernel ([`transformed_clip_free`], the same code as for a polygon: the quad and
+/// single-ring kernels for one ring, the general loop for several) decides most regions; where it
+/// hands over (an image within rounding of the cosine's horizon, as the images of a piece's
+/// vertices on the shading horizon under a map that keeps the horizon), each ring's images are
+/// clipped at the horizon by Sutherland–Hodgman in homogeneous coordinates and Baum's sum is
+/// taken over the result: one plane, so the clipped chain's winding number is the ring's times
+/// the half-space's indicator for any ring (the parts outside are closed into loops outside by
+/// the same bridges along the horizon). `None` only for a map that is singular, not finite or
+/// reverses orientation, which the LTC tables never give.
+pub(crate) fn ltc_rings_integral<'a, I>(rings: I, m_inv: glam::DMat3) -> Option<f64>
+where
+    I: Iterator<Item = &'a [DVec3]> + Clone,
+{
+    let mut one = rings.clone();
+    let v = match (one.next(), one.next()) {
+        (Some(ring), None) => transformed_clip_free(ring, &m_inv, Exact),
+        _ => transformed_clip_free(&RingChain(rings.clone()), &m_inv, Exact),
+    };
+    v.or_else(|| clipped_rings_integral(rings, m_inv))
 }
 
-/// The exact path of [`ltc_ring_integral`], out of line.
+/// Several rings integrated as one region by the clip-free path ([`ring_sum`]).
+struct RingChain<I>(I);
+
+impl<'a, I: Iterator<Item = &'a [DVec3]> + Clone> ClipFreeInput for RingChain<I> {
+    #[inline(always)]
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+        ring_sum(self.0.clone(), map, edge)
+    }
+}
+
+/// The exact path of [`ltc_rings_integral`], out of line.
 #[cold]
 #[inline(never)]
-fn clipped_ring_integral(ring: &[DVec3], m_inv: glam::DMat3) -> Option<f64> {
+fn clipped_rings_integral<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    m_inv: glam::DMat3,
+) -> Option<f64> {
     let m = crate::math::unit_scaled(m_inv)?;
     if !(m.determinant() > 0.0) {
         return None;
     }
+    let mut sum = 0.0;
     let mut up: smallvec::SmallVec<[DVec3; 32]> = smallvec::SmallVec::new();
-    let Some(&last) = ring.last() else {
-        return Some(0.0);
-    };
-    let mut prev = m * last;
-    for &v in ring {
-        let cur = m * v;
-        if prev.z >= 0.0 {
-            up.push(prev);
+    for ring in rings {
+        let Some(&last) = ring.last() else {
+            continue;
+        };
+        up.clear();
+        let mut prev = m * last;
+        for &v in ring {
+            let cur = m * v;
+            if prev.z >= 0.0 {
+                up.push(prev);
+            }
+            if (prev.z > 0.0 && cur.z < 0.0) || (prev.z < 0.0 && cur.z > 0.0) {
+                // A positive combination of the two with `z` exactly zero (the products
+                // commute).
+                let (a, b) = if prev.z > 0.0 {
+                    (prev, cur)
+                } else {
+                    (cur, prev)
+                };
+                let x = a * -b.z + b * a.z;
+                up.push(DVec3::new(x.x, x.y, 0.0));
+            }
+            prev = cur;
         }
-        if (prev.z > 0.0 && cur.z < 0.0) || (prev.z < 0.0 && cur.z > 0.0) {
-            // A positive combination of the two with `z` exactly zero (the products commute).
-            let (a, b) = if prev.z > 0.0 {
-                (prev, cur)
-            } else {
-                (cur, prev)
-            };
-            let x = a * -b.z + b * a.z;
-            up.push(DVec3::new(x.x, x.y, 0.0));
+        if let Some(&last) = up.last() {
+            let mut prev = Ray::new(last);
+            for &v in &up {
+                let cur = Ray::new(v);
+                sum += edge_term(prev, cur);
+                prev = cur;
+            }
         }
-        prev = cur;
     }
-    Some(upper_ring_integral(&up))
+    Some(integral_of_sum(sum))
 }
 
 /// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform

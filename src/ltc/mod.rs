@@ -55,5 +55,7 @@ pub use integrate::{
     clamped_cosine_integral_rational, edge_factor_rational, ggx_polygon_integral, ltc_integral,
     ltc_integral_rational,
 };
-pub(crate) use integrate::{clamped_cosine_integral_upper, ltc_ring_integral, upper_ring_integral};
+pub(crate) use integrate::{
+    clamped_cosine_integral_upper, ltc_rings_integral, upper_rings_integral,
+};
 pub use table::{LtcLookup, LtcTable, lookup};

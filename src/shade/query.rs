@@ -21,7 +21,7 @@ use super::material::Material;
 use super::scene::Scene;
 use crate::GeomError;
 use crate::ltc::{
-    clamped_cosine_integral_upper, lookup, ltc_integral, ltc_ring_integral, upper_ring_integral,
+    clamped_cosine_integral_upper, lookup, ltc_integral, ltc_rings_integral, upper_rings_integral,
 };
 use crate::solid::ShadingFrame;
 use crate::sphere::SphericalPolygon;
@@ -113,18 +113,30 @@ fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularS
 /// assert_eq!((ctx.fast_lights(), ctx.spherical_lights()), (4, 0));
 /// # Ok::<(), arealight::GeomError>(())
 /// ```
-#[derive(Debug, Default, Clone)]
+#[derive(Debug, Clone)]
 pub struct ShadeContext {
     pieces: Pieces,
     fast: u64,
     spherical: u64,
 }
 
+impl Default for ShadeContext {
+    #[inline(always)]
+    fn default() -> Self {
+        ShadeContext::new()
+    }
+}
+
 impl ShadeContext {
     /// A fresh context (no heap allocation).
     #[must_use]
+    #[inline(always)]
     pub fn new() -> Self {
-        Self::default()
+        ShadeContext {
+            pieces: Pieces::new(),
+            fast: 0,
+            spherical: 0,
+        }
     }
 
     /// How many (point, light) regions the queries through this context took from the fast path
@@ -146,15 +158,12 @@ impl ShadeContext {
 /// (up to rounding); `None` only for an LTC map the ring integral declines (never one of the
 /// tables').
 fn piece_integrals(pieces: &Pieces, spec: SpecularSetup) -> Option<(f64, f64)> {
-    let (mut diffuse, mut specular) = (0.0, 0.0);
-    for (sign, ring) in pieces.loops() {
-        diffuse += sign * upper_ring_integral(ring);
-        if let Some((m_inv, _)) = spec {
-            specular += sign * ltc_ring_integral(ring, m_inv)?;
-        }
-    }
-    // The signed sum cancels where blockers overlap: a few ulps below zero is nothing.
-    Some((diffuse.max(0.0), specular.max(0.0)))
+    let diffuse = upper_rings_integral(pieces.rings());
+    let specular = match spec {
+        Some((m_inv, _)) => ltc_rings_integral(pieces.rings(), m_inv)?,
+        None => 0.0,
+    };
+    Some((diffuse, specular))
 }
 
 /// The diffuse (clamped cosine over pi) and LTC integrals over region pieces already clipped to

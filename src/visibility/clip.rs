@@ -68,10 +68,9 @@ pub struct ClipVisibility<L> {
     /// the two, or `None` when they overlap (the blocker interpenetrates the light, or is the
     /// light itself).
     separations: Vec<Option<Separation>>,
-    /// Per light: for a planar mesh light whose boundary has only outer loops (no holes), those
-    /// loops ([`TriangleMesh::boundary_loops`]): the region it covers seen from the front, for
-    /// the fast path ([`ClipVisibility::visible_pieces`]).
-    pub(super) outlines: Vec<Option<Vec<Vec<u32>>>>,
+    /// Per planar mesh light: its [`Outline`], for the fast path
+    /// ([`ClipVisibility::visible_pieces`]).
+    pub(super) outlines: Vec<Option<Outline>>,
 }
 
 /// How a blocker acts on one front face of a light (or on all of them).
@@ -125,7 +124,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         let outlines = lights
             .iter()
             .map(|l| match l.as_ref() {
-                Body::Mesh(m) if m.is_planar() => outer_loops(m),
+                Body::Mesh(m) if m.is_planar() => Outline::of(m),
                 _ => None,
             })
             .collect();
@@ -180,7 +179,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
 
     /// Number of blocker slots per light: every occluder, then every light (the light itself
     /// among them, never returned by [`ClipVisibility::blockers_between`]).
-    fn blocker_count(&self) -> usize {
+    pub(super) fn blocker_count(&self) -> usize {
         self.occluders.len() + self.lights.len()
     }
 
@@ -637,21 +636,45 @@ fn subtract_cut(
     Ok(piece)
 }
 
-/// The boundary loops of a planar mesh ([`TriangleMesh::boundary_loops`]) when every one is an
-/// outer loop, counter-clockwise about the mesh's normal (a positive vector area along it); `None`
-/// when one is a hole (or bounds no area), which the fast path does not take.
-fn outer_loops(m: &TriangleMesh) -> Option<Vec<Vec<u32>>> {
-    let loops = m.boundary_loops();
-    let n = m.triangle_normal(0);
-    let v = m.vertices();
-    let c = m.bounding_sphere().center;
-    let outer = |lp: &Vec<u32>| {
-        let area: DVec3 = (0..lp.len())
-            .map(|k| (v[lp[k] as usize] - c).cross(v[lp[(k + 1) % lp.len()] as usize] - c))
-            .sum();
-        area.dot(n) > 0.0
-    };
-    (!loops.is_empty() && loops.iter().all(outer)).then_some(loops)
+/// The region a planar mesh light covers seen from its front, as the fast path takes it
+/// ([`ClipVisibility::visible_pieces`]): its boundary loops ([`TriangleMesh::boundary_loops`]),
+/// whose chain bounds exactly the union of its triangles, and whether they are one convex loop
+/// (every turn to the left about the mesh's normal, or straight), which stays one simple loop
+/// when the horizon cuts it.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Outline {
+    pub(super) loops: Vec<Vec<u32>>,
+    pub(super) convex: bool,
+}
+
+impl Outline {
+    /// The outline of planar mesh `m`; `None` for a mesh without boundary (which covers
+    /// nothing seen from either side, and which the fast path leaves alone).
+    fn of(m: &TriangleMesh) -> Option<Outline> {
+        let loops = m.boundary_loops();
+        if loops.is_empty() {
+            return None;
+        }
+        let n = m.triangle_normal(0);
+        let v = m.vertices();
+        let convex = loops.len() == 1 && {
+            let lp = &loops[0];
+            let k = lp.len();
+            let mut distinct = lp.clone();
+            distinct.sort_unstable();
+            distinct.dedup();
+            distinct.len() == k
+                && (0..k).all(|i| {
+                    let (a, b, c) = (
+                        v[lp[i] as usize],
+                        v[lp[(i + 1) % k] as usize],
+                        v[lp[(i + 2) % k] as usize],
+                    );
+                    (b - a).cross(c - b).dot(n) >= 0.0
+                })
+        };
+        Some(Outline { loops, convex })
+    }
 }
 
 /// What a clip that added part of the horizon outside its polygon reports (see [`upper_part`]).
