@@ -449,14 +449,22 @@ fn norm1(v: DVec3) -> f64 {
     v.x.abs() + v.y.abs() + v.z.abs()
 }
 
+/// `n` scaled to a 1-norm of 1 (a plane's normal: the half-space is the same, and the rounding
+/// bounds of the sides need no norm of it). `n` is not zero: the edges it comes from are checked
+/// to be apart.
+#[inline]
+fn unit1(n: DVec3) -> DVec3 {
+    n / norm1(n)
+}
+
 impl Pieces {
     /// `R - K` by boundary tracing (Greiner and Hormann 1998, the difference; the crossings by
     /// Cyrus–Beck clipping of each ring edge against `K`'s half-spaces), for simple disjoint
     /// rings. `false`, with the region unchanged, where a decision is within its rounding bound
     /// (times [`MARGIN`]) or the traversal does not close consistently.
     ///
-    /// Rounding bounds: a side `n . v` (`n` from [`edge_plane`]) is off by at most a few
-    /// `eps |n| |v|`; a chord parameter `t = sa / (sa - sb)` by at most
+    /// Rounding bounds: a side `n . v` (`n` from [`edge_plane`], scaled to `|n|_1 = 1` by
+    /// [`unit1`]) is off by at most a few `eps |v|`; a chord parameter `t = sa / (sa - sb)` by at most
     /// `eps |n| (|a| + |b|) / |sa - sb|` times a small constant; both are compared with
     /// [`MARGIN`] (64 `eps`) times the same products, with 1-norms for the lengths.
     fn trace_difference(&mut self) -> bool {
@@ -475,7 +483,7 @@ impl Pieces {
             let mut all = true;
             for &n in planes {
                 let s = n.dot(v);
-                if s.abs() <= MARGIN * norm1(n) * v1 {
+                if s.abs() <= MARGIN * v1 {
                     return false;
                 }
                 if s < 0.0 {
@@ -532,7 +540,9 @@ impl Pieces {
     fn order_along_k(&mut self) -> bool {
         let n = self.crossings.len();
         self.order.clear();
-        self.order.extend(0..n as u16);
+        for c in 0..n as u16 {
+            self.order.push(c);
+        }
         // Insertion sort: a handful of crossings.
         for i in 1..n {
             let mut k = i;
@@ -545,7 +555,7 @@ impl Pieces {
                     // Along the edge's great circle, counter-clockwise about its normal.
                     let nj = self.planes[cp.j as usize];
                     let d = cq.x.cross(cp.x).dot(nj);
-                    if d.abs() <= MARGIN * norm1(cp.x) * norm1(cq.x) * norm1(nj) {
+                    if d.abs() <= MARGIN * norm1(cp.x) * norm1(cq.x) {
                         return false;
                     }
                     d > 0.0
@@ -729,7 +739,7 @@ fn edge_crossings(
     let (mut t_out, mut e_out, mut j_out, mut second_out) = (1.0, 0.0, usize::MAX, f64::INFINITY);
     for (j, &n) in planes.iter().enumerate() {
         let (sa, sb) = (n.dot(pa), n.dot(pb));
-        let bound = MARGIN * norm1(n);
+        let bound = MARGIN;
         if sa.abs() <= bound * a1 || sb.abs() <= bound * b1 {
             return false;
         }
@@ -1009,7 +1019,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
             out.planes.clear();
             out.planes
-                .extend((0..3).map(|k| edge_plane(ring[k], ring[(k + 1) % 3])));
+                .extend((0..3).map(|k| unit1(edge_plane(ring[k], ring[(k + 1) % 3]))));
             out.kv.clear();
             out.kv.extend_from_slice(&ring);
             if !out.subtract() {
@@ -1153,39 +1163,35 @@ fn chain_contour(
     if contour.len() < 3 {
         return false;
     }
-    let mut push = |i: u32| {
-        let v = frame.to_local(verts[i as usize]) * scale;
-        dirs.push(v);
-        v.length_squared() > 0.0 && v.is_finite()
-    };
+    let n = contour.len();
+    dirs.reserve(n);
     if verts.len() > INLINE_VERTICES {
         let Some(ring) = chain_by_index(contour, verts.len()) else {
             return false;
         };
-        return ring.iter().all(|&i| push(i));
-    }
-    let mut next = [NONE; INLINE_VERTICES];
-    for &(a, b) in contour {
-        if next[a as usize] != NONE {
-            return false;
+        for &i in &ring {
+            dirs.push(frame.to_local(verts[i as usize]) * scale);
         }
-        next[a as usize] = b;
-    }
-    let start = contour[0].0;
-    let mut at = start;
-    for k in 0..contour.len() {
-        if !push(at) {
-            return false;
+    } else {
+        let mut next = [NONE; INLINE_VERTICES];
+        for &(a, b) in contour {
+            if next[a as usize] != NONE {
+                return false;
+            }
+            next[a as usize] = b;
         }
-        at = next[at as usize];
-        if at == NONE {
-            return false;
-        }
-        if at == start {
-            return k + 1 == contour.len();
+        let start = contour[0].0;
+        let mut at = start;
+        for k in 0..n {
+            dirs.push(frame.to_local(verts[at as usize]) * scale);
+            at = next[at as usize];
+            if at == NONE || (at == start) != (k + 1 == n) {
+                return false;
+            }
         }
     }
-    false
+    // A vertex at the point has no direction.
+    dirs.iter().all(|v| v.length_squared() > 0.0)
 }
 
 /// The half-spaces of the convex blocker `p`'s silhouette into `out.planes`, one per contour
@@ -1208,11 +1214,11 @@ fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -
     let mut prev = out.dirs[n - 1];
     for k in 0..n {
         let (cur, next) = (out.dirs[k], out.dirs[if k + 1 == n { 0 } else { k + 1 }]);
-        let bound = MARGIN * norm1(cur - prev) * norm1(next - cur) * norm1(cur);
-        if !(left_turn(prev, cur, next) > -bound) {
+        let turn = left_turn(prev, cur, next);
+        if !(turn > 0.0 || turn > -MARGIN * norm1(cur - prev) * norm1(next - cur) * norm1(cur)) {
             return false;
         }
-        out.planes.push(edge_plane(cur, next));
+        out.planes.push(unit1(edge_plane(cur, next)));
         out.kv.push(cur);
         prev = cur;
     }
