@@ -7,7 +7,9 @@
 use arealight::glam::DVec3;
 use arealight::internals::{DemoConfig, demo_scene};
 use arealight::ltc::{clamped_cosine_integral_clip_free, lookup, ltc_integral};
-use arealight::shade::{Body, ConvexPolyhedron, Light, Material, Method, Scene, TriangleMesh};
+use arealight::shade::{
+    Body, ConvexPolyhedron, Light, Material, Method, Scene, ShadeContext, TriangleMesh,
+};
 use arealight::solid::ShadingFrame;
 use arealight::sphere::SphericalPolygon;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -216,6 +218,19 @@ fn quad_light_points(c: &mut Criterion) {
                     let mut s = DVec3::ZERO;
                     for &(x, v) in &points {
                         s += scene.shade(black_box(x), DVec3::Z, v, m).unwrap();
+                    }
+                    s
+                })
+            });
+            // The same through a context kept across calls, as a renderer's thread keeps one.
+            let mut ctx = ShadeContext::new();
+            group.bench_function(format!("shade_with, {k} occluders, {name}"), |b| {
+                b.iter(|| {
+                    let mut s = DVec3::ZERO;
+                    for &(x, v) in &points {
+                        s += scene
+                            .shade_with(&mut ctx, black_box(x), DVec3::Z, v, m)
+                            .unwrap();
                     }
                     s
                 })

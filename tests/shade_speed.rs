@@ -454,3 +454,65 @@ fn blockers_in_exact_contact() {
         "only {fast} of {pairs} took the fast path"
     );
 }
+
+/// Points on an occluder's surface and in a planar light's plane get the spherical path's
+/// finite value (a point on a box's face: the box covers the half-space behind that face; a
+/// point in the light's plane sees none of it), and invalid arguments are errors naming the
+/// argument, through `shade_with` as through `shade`.
+#[test]
+fn points_on_surfaces_and_bad_input() {
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5).unwrap();
+    let boxed = ConvexPolyhedron::cuboid(DVec3::new(0.1, 0.0, 1.0), DVec3::splat(0.25)).unwrap();
+    let scene = Scene::new(
+        vec![Light::new(quad, DVec3::ONE).unwrap()],
+        vec![boxed.clone().into()],
+    )
+    .unwrap();
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
+    let mut ctx = ShadeContext::new();
+    let mut rng = Rng::new(7);
+    let mesh = boxed.mesh();
+    for k in 0..200 {
+        let (x, n) = if k % 4 == 3 {
+            // In the light's plane, facing up or down.
+            let x = DVec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 2.0);
+            (x, if k % 8 == 3 { DVec3::Z } else { -DVec3::Z })
+        } else {
+            support::shade::point_on_mesh(&mut rng, mesh)
+        };
+        let v = view_above(&mut rng, n, 0.2);
+        let got = scene.shade_with(&mut ctx, x, n, v, &m).unwrap();
+        assert!(got.is_finite() && got.min_element() >= 0.0, "{x}: {got}");
+        let frame = ShadingFrame::new(x, n, v).unwrap();
+        if let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) {
+            let err = (got - want).abs().max_element();
+            assert!(
+                err <= 1e-12 * (unoccluded.max_element() + ABS_FLOOR),
+                "{x}: {got} vs {want}"
+            );
+        }
+    }
+    let bad = [
+        (DVec3::NAN, DVec3::Z, DVec3::Z, "shading point"),
+        (
+            DVec3::ZERO,
+            DVec3::new(f64::INFINITY, 0.0, 0.0),
+            DVec3::Z,
+            "surface normal",
+        ),
+        (DVec3::ZERO, DVec3::ZERO, DVec3::Z, "surface normal"),
+        (DVec3::ZERO, DVec3::Z, DVec3::NAN, "view direction"),
+    ];
+    for (x, n, v, what) in bad {
+        for e in [
+            scene.shade_with(&mut ctx, x, n, v, &m).unwrap_err(),
+            scene.shade(x, n, v, &m).unwrap_err(),
+        ] {
+            assert!(
+                !e.is_undecidable() && e.to_string().contains(what),
+                "{what}: {e}"
+            );
+        }
+    }
+}
