@@ -224,12 +224,12 @@ fn quad_light_points(c: &mut Criterion) {
             });
             // The same through a context kept across calls, as a renderer's thread keeps one.
             let mut ctx = ShadeContext::new();
-            group.bench_function(format!("shade_with, {k} occluders, {name}"), |b| {
+            group.bench_function(format!("shade_in, {k} occluders, {name}"), |b| {
                 b.iter(|| {
                     let mut s = DVec3::ZERO;
                     for &(x, v) in &points {
                         s += scene
-                            .shade_with(&mut ctx, black_box(x), DVec3::Z, v, m)
+                            .shade_in(&mut ctx, black_box(x), DVec3::Z, v, m)
                             .unwrap();
                     }
                     s

@@ -12,15 +12,24 @@
 //!   in [-3, 3]^2, views 17 to 80 degrees off the normal, GGX alpha 0.3); times are per 32 points.
 //! - `silhouette/build/<polyhedron>` (table 7.4): `SilhouetteBsp::build`. Node counts, stored
 //!   silhouette elements and bytes are printed once (they do not depend on timing).
+//! - `silhouette/build triangulated/<polyhedron>` (table 7.4, "triangulated silhouettes"), for
+//!   the non-convex ones: `SilhouetteBsp::build_triangulated`, with the leaves that store a
+//!   certified triangulation, the stored triangles and bytes printed once.
+//!
+//! - `silhouette/triangles/<polyhedron>` (beside table 7.3's triangulated silhouettes), for the
+//!   non-convex ones: per shading point, the silhouette's triangles from the tree built with
+//!   triangulations (`query_triangles`, the stored ones evaluated and checked) against the
+//!   queried silhouette triangulated at the point (`query` then `SphericalPolygon::triangulate`).
 //!
 //! Fixed inputs; results in BENCHMARKS.md (section `silhouette`). Run with
-//! `cargo bench --bench silhouette`.
+//! `cargo bench -p arealight-benches --bench silhouette`.
 
 use arealight::glam::{DMat3, DVec3};
 use arealight::internals::{TriangleRole, convex_silhouette, thesis_polyhedra, triangle_polygon};
 use arealight::ltc::{clamped_cosine_integral_clip_free, lookup, ltc_integral};
 use arealight::solid::{
-    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, TriangleMesh, nonconvex_silhouette,
+    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, TriangleMesh, TriangleSource,
+    nonconvex_silhouette,
 };
 use arealight::sphere::SphericalPolygon;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
@@ -155,7 +164,66 @@ fn build(c: &mut Criterion) {
         });
     }
     g.finish();
+    let mut g = c.benchmark_group("silhouette/build triangulated");
+    g.sample_size(10);
+    g.measurement_time(Duration::from_secs(3));
+    for (name, mesh) in thesis_polyhedra().unwrap().into_iter().skip(5) {
+        let solid = ClosedMesh::new(mesh).unwrap();
+        let bsp = SilhouetteBsp::build_triangulated(&solid).unwrap();
+        let (stored, rings) = bsp.triangulated_leaf_count();
+        eprintln!(
+            "{name} triangulated: {} nodes, {stored} of {rings} leaves with rings store a \
+             triangulation, {} triangles, {} bytes",
+            bsp.node_count(),
+            bsp.stored_triangle_count(),
+            bsp.byte_size()
+        );
+        g.bench_with_input(BenchmarkId::from_parameter(name), &solid, |b, s| {
+            b.iter(|| SilhouetteBsp::build_triangulated(black_box(s)).unwrap())
+        });
+    }
+    g.finish();
 }
 
-criterion_group!(benches, shading, build);
+fn triangles(c: &mut Criterion) {
+    let frames = frames();
+    for (name, mesh) in thesis_polyhedra().unwrap().into_iter().skip(5) {
+        let solid = ClosedMesh::new(mesh).unwrap();
+        let bsp = SilhouetteBsp::build_triangulated(&solid).unwrap();
+        let mut out = Vec::new();
+        let stored = frames
+            .iter()
+            .filter(|(f, _)| bsp.query_triangles(f, &mut out).unwrap() == TriangleSource::Stored)
+            .count();
+        eprintln!(
+            "{name}: {stored} of {} points use stored triangles",
+            frames.len()
+        );
+        let mut g = c.benchmark_group(format!("silhouette/triangles/{name}"));
+        g.measurement_time(Duration::from_secs(2));
+        g.bench_function("stored", |b| {
+            b.iter(|| {
+                let mut sum = 0.0;
+                for (f, _) in &frames {
+                    bsp.query_triangles(black_box(f), &mut out).unwrap();
+                    sum += out.iter().map(|t| t.solid_angle()).sum::<f64>();
+                }
+                sum
+            })
+        });
+        g.bench_function("per point", |b| {
+            b.iter(|| {
+                let mut sum = 0.0;
+                for (f, _) in &frames {
+                    let tris = bsp.query(black_box(f)).unwrap().triangulate().unwrap();
+                    sum += tris.iter().map(|t| t.solid_angle()).sum::<f64>();
+                }
+                sum
+            })
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, shading, build, triangles);
 criterion_main!(benches);

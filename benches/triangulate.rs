@@ -59,7 +59,7 @@ fn triangulate(c: &mut Criterion) {
             |b, p| b.iter(|| black_box(p).triangulate().unwrap()),
         );
     }
-    // A band around the equator: no open hemisphere holds it, so it is cut by coordinate planes.
+    // A band around the equator: no open hemisphere holds it (the stereographic chart).
     let ring = |z: f64| -> Vec<DVec3> {
         (0..16)
             .map(|i| {
@@ -71,7 +71,7 @@ fn triangulate(c: &mut Criterion) {
     let mut top = ring(0.2);
     top.reverse();
     let band = SphericalPolygon::new(vec![ring(-0.2), top]).unwrap();
-    g.bench_function("band of 2 x 16 (cuts)", |b| {
+    g.bench_function("band of 2 x 16 (stereographic)", |b| {
         b.iter(|| black_box(&band).triangulate().unwrap())
     });
     g.finish();

@@ -1,19 +1,35 @@
 //! Renders the seed paper's test scene (000, Fig. 4: a ground plane lit by a quad, a cylinder and a
 //! truncated-cone light, with a cube, an icosphere and an ellipsoid standing on it) with the
-//! analytic method, and the same scene with Monte Carlo at equal time, and measures both against a
-//! high-sample Monte Carlo reference with the true GGX BRDF.
+//! analytic method, and the same scene with the ratio estimator (\[HHM18\]: analytic unshadowed
+//! times a sampled shadow ratio) and with plain Monte Carlo at equal time, and measures all three
+//! against a high-sample Monte Carlo reference with the true GGX BRDF (seed 000 figure 6 makes
+//! the same comparison).
 //!
 //! ```sh
-//! cargo run --release --example render                 # defaults: 320 x 240, 2 threads
+//! cargo run --release --example render                 # defaults: 320 x 240, all cores
 //! cargo run --release --example render -- --help       # the flags
 //! ```
 //!
-//! Prints one line per method, analytic first:
+//! Prints a table, analytic first:
 //!
 //! ```text
-//! analytic: time 1.23 s, MAE 0.0012, RMSE 0.0034
-//! monte-carlo: time 1.25 s, MAE 0.0100, RMSE 0.0300 (7 samples per light per pixel)
+//! | method | time (s) | samples per light per pixel | MAE | RMSE |
+//! |---|---|---|---|---|
+//! | analytic | 1.23 | - | 0.0012 | 0.0034 |
+//! | ratio estimator (1x time) | 1.25 | 5 | 0.0050 | 0.0200 |
+//! | monte carlo (1x time) | 1.25 | 7 | 0.0100 | 0.0300 |
+//! | ratio estimator (10x time) | 12.6 | 61 | 0.0015 | 0.0060 |
+//! | monte carlo (10x time) | 12.4 | 80 | 0.0030 | 0.0090 |
 //! ```
+//!
+//! Equal time: each stochastic method's cost per pixel is modelled as a setup (frame, light
+//! regions and their triangulations, for the ratio estimator the analytic unshadowed integrals)
+//! plus a cost per sample, both measured on every 16th pixel at 1 and 4 samples per light; the
+//! image is then rendered with the number of samples that fits the budget (rendered once more,
+//! rescaled, when its time misses the budget by more than 20%), and its own time is reported (at
+//! least one sample, so a method may take longer than the budget).
+//! Both stochastic methods sample each light's triangulated silhouette and use the true BRDF;
+//! neither is denoised.
 //!
 //! Flags:
 //!
@@ -23,22 +39,46 @@
 //! - `--no-cache`: recompute the reference even when cached.
 //! - `--lights L`, `--occluders O`: how many of the scene's lights (quad, cylinder, cone) and
 //!   occluders (cube, icosphere, ellipsoid) to include, 0 to 3 each (default 3 and 3).
-//! - `--threads T`: worker threads (default 2).
-//! - `--out DIR`: where the images go (default: the current directory).
+//! - `--threads T`: worker threads (default 0: all cores; rayon's pool).
+//! - `--out DIR`: where the images go (default: `target/arealight-out/` in the repository, where
+//!   every example writes).
+//! - `--plucker`: also shade the analytic image through the lazy Pluecker-space backend (seed
+//!   002; trees reused per thread), and print its time and largest per-pixel difference from
+//!   the clipping backend's image.
+//! - `--time-factors F1,F2,...`: the budgets of the two stochastic methods as multiples of the
+//!   analytic time (default `1,10`: equal time, and ten times as long); their images are written
+//!   for the first.
 //!
-//! Writes `render.png` (analytic), `render_mc.png` (Monte Carlo, equal time),
-//! `render_reference.png` and `render_side_by_side.png` (the three, left to right).
-//! Linear radiance is tone mapped with `1 - exp(-4 x)` and encoded as sRGB; the errors are
-//! measured on linear radiance over all pixels and channels.
+//! Work that takes longer than a second shows a progress line on stderr. The analytic pass
+//! shades all surface points with `Scene::par_shade_batch`.
+//!
+//! Writes `render.png` (analytic), `render_ratio.png` (ratio estimator, equal time),
+//! `render_mc.png` (Monte Carlo, equal time), `render_reference.png` and
+//! `render_side_by_side.png` (the four, left to right). Linear radiance is tone mapped with
+//! `1 - exp(-4 x)` and encoded as sRGB; the errors are measured on linear radiance over all
+//! pixels and channels.
+//!
+//! \[HHM18\] E. Heitz, S. Hill, M. McGuire. *Combining analytic direct illumination and
+//! stochastic shadows.* I3D 2018.
 
 use arealight::glam::DVec3;
 use arealight::internals::{Demo, DemoConfig, demo_scene};
-use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
+use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scene};
+use arealight::visibility::{PluckerContext, PluckerVisibility};
+use rayon::prelude::*;
+use std::cell::RefCell;
 use std::path::PathBuf;
 use std::time::Instant;
 
+#[path = "common/progress.rs"]
+mod progress;
+use progress::Progress;
+
+/// Where the examples write their outputs.
+const OUT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/arealight-out");
+
 const HELP: &str = "\
-render: the seed paper's test scene, analytic vs Monte Carlo at equal time
+render: the seed paper's test scene, analytic vs ratio estimator vs Monte Carlo at equal time
 
 USAGE: cargo run --release --example render -- [FLAGS]
 
@@ -48,8 +88,11 @@ USAGE: cargo run --release --example render -- [FLAGS]
   --no-cache       recompute the reference even if a cached one exists
   --lights L       number of lights 0..=3: quad, cylinder, truncated cone (default 3)
   --occluders O    number of occluders 0..=3: cube, icosphere, ellipsoid (default 3)
-  --threads T      worker threads (default 2)
-  --out DIR        output directory (default .)
+  --threads T      worker threads (default 0: all cores)
+  --out DIR        output directory (default target/arealight-out in the repository)
+  --plucker        also shade with the Pluecker backend; print the largest difference
+  --time-factors F budgets of ratio estimator and Monte Carlo as multiples of the analytic
+                   time, comma-separated (default 1,10); images are written for the first
   --help           this text
 ";
 
@@ -61,6 +104,9 @@ struct Args {
     cfg: DemoConfig,
     threads: usize,
     out: PathBuf,
+    /// Budgets of the stochastic methods, in multiples of the analytic time.
+    time_factors: Vec<f64>,
+    plucker: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -70,8 +116,10 @@ fn parse_args() -> Result<Args, String> {
         ref_spp: 1024,
         cache: true,
         cfg: DemoConfig::default(),
-        threads: 2,
-        out: PathBuf::from("."),
+        threads: 0,
+        out: PathBuf::from(OUT_DIR),
+        time_factors: vec![1.0, 10.0],
+        plucker: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {
@@ -88,8 +136,21 @@ fn parse_args() -> Result<Args, String> {
             "--no-cache" => a.cache = false,
             "--lights" => a.cfg.lights = num(value("--lights")?, "--lights")?.min(3),
             "--occluders" => a.cfg.occluders = num(value("--occluders")?, "--occluders")?.min(3),
-            "--threads" => a.threads = num(value("--threads")?, "--threads")?.max(1),
+            "--threads" => a.threads = num(value("--threads")?, "--threads")?,
             "--out" => a.out = PathBuf::from(value("--out")?),
+            "--plucker" => a.plucker = true,
+            "--time-factors" => {
+                a.time_factors = value("--time-factors")?
+                    .split(',')
+                    .map(|t| match t.trim().parse::<f64>() {
+                        Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+                        _ => Err(format!("--time-factors: bad factor {t:?}")),
+                    })
+                    .collect::<Result<_, _>>()?;
+                if a.time_factors.is_empty() {
+                    return Err("--time-factors needs at least one factor".into());
+                }
+            }
             other => return Err(format!("unknown flag {other}\n\n{HELP}")),
         }
     }
@@ -205,33 +266,92 @@ fn trace(demo: &Demo, o: DVec3, d: DVec3) -> Hit {
     hit
 }
 
-/// Renders with `f(pixel index, hit) -> radiance` on `threads` threads (rows interleaved).
+/// Renders with `f(pixel index, hit) -> radiance` on the current rayon pool (set up from
+/// `--threads` by `main`), a row per task, with a progress line for passes over a second.
 fn render(
     w: usize,
     h: usize,
-    threads: usize,
+    _threads: usize,
+    hits: &[Hit],
+    f: impl Fn(usize, &Hit) -> DVec3 + Sync,
+) -> Vec<DVec3> {
+    render_labeled("rendering", w, h, hits, f)
+}
+
+/// [`render`] with the progress line's label.
+fn render_labeled(
+    label: &str,
+    w: usize,
+    h: usize,
     hits: &[Hit],
     f: impl Fn(usize, &Hit) -> DVec3 + Sync,
 ) -> Vec<DVec3> {
     let mut img = vec![DVec3::ZERO; w * h];
-    let mut rows: Vec<Vec<(usize, &mut [DVec3])>> = (0..threads).map(|_| Vec::new()).collect();
-    for (y, row) in img.chunks_mut(w).enumerate() {
-        rows[y % threads].push((y, row));
-    }
-    std::thread::scope(|s| {
-        for mine in rows {
-            let f = &f;
-            s.spawn(move || {
-                for (y, row) in mine {
-                    for (x, px) in row.iter_mut().enumerate() {
-                        let i = y * w + x;
-                        *px = f(i, &hits[i]);
-                    }
-                }
-            });
+    let progress = Progress::new(label, h);
+    img.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, px) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            *px = f(i, &hits[i]);
         }
+        progress.add(1);
     });
+    progress.finish();
     img
+}
+
+/// The analytic image: every surface point shaded by `Scene::par_shade_batch`, in runs of
+/// rows so that the progress line moves; a point that fails is black and counted.
+fn shade_analytic(scene: &Scene, w: usize, hits: &[Hit]) -> (Vec<DVec3>, usize) {
+    let mut img: Vec<DVec3> = hits
+        .iter()
+        .map(|hit| match hit {
+            Hit::Emitter(l) => *l,
+            _ => DVec3::ZERO,
+        })
+        .collect();
+    let surface: Vec<(usize, &DVec3, &DVec3, &DVec3, Material)> = hits
+        .iter()
+        .enumerate()
+        .filter_map(|(i, hit)| match hit {
+            Hit::Surface(p, n, v, m) => Some((i, p, n, v, *m)),
+            _ => None,
+        })
+        .collect();
+    let progress = Progress::new("analytic", surface.len());
+    let mut failures = 0;
+    for run in surface.chunks(8 * w.max(1)) {
+        let points: Vec<&DVec3> = run.iter().map(|q| q.1).collect();
+        let normals: Vec<&DVec3> = run.iter().map(|q| q.2).collect();
+        let views: Vec<&DVec3> = run.iter().map(|q| q.3).collect();
+        let materials: Vec<Material> = run.iter().map(|q| q.4).collect();
+        let shaded = scene
+            .par_shade_batch(&points, &normals, &views, &materials)
+            .unwrap_or_default();
+        for (q, r) in run.iter().zip(shaded) {
+            match r {
+                Ok(rgb) => img[q.0] = rgb,
+                Err(_) => failures += 1,
+            }
+        }
+        progress.add(run.len());
+    }
+    progress.finish();
+    (img, failures)
+}
+
+/// Runs `f` on a rayon pool of `threads` workers (0: rayon's global pool, all cores).
+fn with_threads(
+    threads: usize,
+    f: impl FnOnce() -> Result<(), String> + Send,
+) -> Result<(), String> {
+    if threads == 0 {
+        return f();
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?
+        .install(f)
 }
 
 /// Part of the reference cache's file name: bump it whenever the scene, the camera or what the
@@ -285,14 +405,14 @@ fn main() {
             std::process::exit(2);
         }
     };
-    if let Err(e) = run(&args) {
+    if let Err(e) = with_threads(args.threads, || run(&args)) {
         eprintln!("render: {e}");
         std::process::exit(1);
     }
 }
 
 fn run(args: &Args) -> Result<(), String> {
-    let (w, h, threads) = (args.width, args.height, args.threads);
+    let (w, h) = (args.width, args.height);
     let demo = demo_scene(args.cfg).map_err(|e| e.to_string())?;
     let cam = Camera::new(DVec3::new(0.3, -4.6, 4.8), DVec3::new(0.0, 0.3, 0.6), 52.0);
     std::fs::create_dir_all(&args.out).map_err(|e| e.to_string())?;
@@ -304,21 +424,116 @@ fn run(args: &Args) -> Result<(), String> {
             trace(&demo, cam.eye, cam.ray(x, y, w, h))
         })
         .collect();
-    let failures = std::sync::atomic::AtomicUsize::new(0);
 
-    // Analytic.
+    let (analytic, t_analytic, failures) = render_analytic(args, &demo, &hits);
+    if args.plucker {
+        thread_local!(static CTX: RefCell<Option<PluckerContext>> = const { RefCell::new(None) });
+        let pl = PluckerVisibility::from_clip(demo.scene.visibility().clone());
+        let t = Instant::now();
+        let img = render(w, h, args.threads, &hits, |_, hit| match hit {
+            Hit::Surface(p, n, v, m) => CTX.with_borrow_mut(|c| {
+                let ctx = c.get_or_insert_with(|| PluckerContext::new(0.1).unwrap());
+                let vis = pl.with_context(ctx);
+                demo.scene
+                    .shade_with(&vis, *p, *n, *v, m)
+                    .unwrap_or(DVec3::NAN)
+            }),
+            Hit::Nothing => DVec3::ZERO,
+            Hit::Emitter(l) => *l,
+        });
+        let d = img
+            .iter()
+            .zip(&analytic)
+            .map(|(a, b)| (*a - *b).abs().max_element());
+        let (max, failed) = d.fold((0.0f64, 0), |(m, f), x| {
+            (m.max(x), f + usize::from(x.is_nan()))
+        });
+        let secs = t.elapsed().as_secs_f64();
+        println!("plucker: time {secs:.2} s, max difference per pixel {max:.1e}, {failed} failed");
+    }
+    let (reference, ref_note) = reference_image(args, &demo, &hits)?;
+    let ratio_shader = |spp: u32, i: usize, p, n, v, m: &Material| {
+        let seed = 0xBEEF_0000_0000 ^ i as u64;
+        RatioEstimator::new(spp, ReferenceBrdf::True)
+            .estimate(&demo.scene, p, n, v, m, seed)
+            .map(|e| e.mean)
+            .unwrap_or_else(|_| {
+                // No analytic factor where the unoccluded region gives up: plain Monte Carlo.
+                MonteCarlo::new(spp, ReferenceBrdf::True)
+                    .estimate(&demo.scene, p, n, v, m, seed)
+                    .map(|e| e.mean)
+                    .unwrap_or(DVec3::ZERO)
+            })
+    };
+    let mc_shader = |spp: u32, i: usize, p, n, v, m: &Material| {
+        MonteCarlo::new(spp, ReferenceBrdf::True)
+            .estimate(&demo.scene, p, n, v, m, 0xCAFE_0000_0000 ^ i as u64)
+            .map(|e| e.mean)
+            .unwrap_or(DVec3::ZERO)
+    };
+    let mut rows = vec![Row::new(
+        "analytic".into(),
+        t_analytic,
+        None,
+        &analytic,
+        &reference,
+    )];
+    // The images at the first time factor are kept.
+    let mut kept: Vec<Timed> = Vec::new();
+    for (k, &factor) in args.time_factors.iter().enumerate() {
+        let budget = factor * t_analytic;
+        for (name, timed) in [
+            (
+                "ratio estimator",
+                equal_time(args, &hits, budget, ratio_shader),
+            ),
+            ("monte carlo", equal_time(args, &hits, budget, mc_shader)),
+        ] {
+            let name = format!("{name} ({factor}x time)");
+            rows.push(Row::new(
+                name,
+                timed.time,
+                Some(timed.spp),
+                &timed.img,
+                &reference,
+            ));
+            if k == 0 {
+                kept.push(timed);
+            }
+        }
+    }
+    print_table(&rows);
+    println!("{ref_note}");
+    let nan = kept
+        .iter()
+        .map(|t| &t.img)
+        .chain([&analytic])
+        .flat_map(|img| img.iter())
+        .filter(|p| !p.is_finite())
+        .count();
+    if failures > 0 || nan > 0 {
+        println!("warning: {failures} pixels failed to shade, {nan} non-finite pixels");
+    }
+    let mut images = vec![("render.png", &analytic)];
+    if let [ratio, mc] = &kept[..] {
+        images.push(("render_ratio.png", &ratio.img));
+        images.push(("render_mc.png", &mc.img));
+    }
+    images.push(("render_reference.png", &reference));
+    write_images(args, &images)
+}
+
+/// The analytic image, its time, and the number of pixels that gave up (shaded black).
+fn render_analytic(args: &Args, demo: &Demo, hits: &[Hit]) -> (Vec<DVec3>, f64, usize) {
     let t0 = Instant::now();
-    let analytic = render(w, h, threads, &hits, |_, hit| match hit {
-        Hit::Nothing => DVec3::ZERO,
-        Hit::Emitter(l) => *l,
-        Hit::Surface(p, n, v, m) => demo.scene.shade(*p, *n, *v, m).unwrap_or_else(|_| {
-            failures.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            DVec3::ZERO
-        }),
-    });
-    let t_analytic = t0.elapsed().as_secs_f64();
+    let (img, failures) = shade_analytic(&demo.scene, args.width, hits);
+    (img, t0.elapsed().as_secs_f64(), failures)
+}
 
-    // Reference: Monte Carlo with the true BRDF, cached.
+/// The reference image (Monte Carlo with the true BRDF, `--ref-spp` samples per light per
+/// pixel), from the cache when present, and a line saying where it came from.
+fn reference_image(args: &Args, demo: &Demo, hits: &[Hit]) -> Result<(Vec<DVec3>, String), String> {
+    let (w, h) = (args.width, args.height);
     let cache = args.out.join(format!(
         "render_reference_{SCENE_VERSION}_{w}x{h}_{}l{}o_{}.bin",
         args.cfg.lights, args.cfg.occluders, args.ref_spp
@@ -336,94 +551,167 @@ fn run(args: &Args) -> Result<(), String> {
                 })
                 .collect()
         });
-    let ref_note;
-    let reference = match cached {
-        Some(r) => {
-            ref_note = format!("reference: cached {}", cache.display());
-            r
-        }
-        None => {
-            let t = Instant::now();
-            let mc = MonteCarlo::new(args.ref_spp, ReferenceBrdf::True);
-            let r = render(w, h, threads, &hits, |i, hit| match hit {
-                Hit::Nothing => DVec3::ZERO,
-                Hit::Emitter(l) => *l,
-                Hit::Surface(p, n, v, m) => mc
-                    .estimate(&demo.scene, *p, *n, *v, m, 0xF00D_0000 + i as u64)
-                    .map(|e| e.mean)
-                    .unwrap_or(DVec3::ZERO),
-            });
-            let bytes: Vec<u8> = r
-                .iter()
-                .flat_map(|p| [p.x, p.y, p.z])
-                .flat_map(f64::to_le_bytes)
-                .collect();
-            std::fs::write(&cache, bytes).map_err(|e| e.to_string())?;
-            ref_note = format!(
-                "reference: computed in {:.1} s ({} samples per light per pixel), cached in {}",
-                t.elapsed().as_secs_f64(),
-                args.ref_spp,
-                cache.display()
-            );
-            r
+    if let Some(r) = cached {
+        return Ok((r, format!("reference: cached {}", cache.display())));
+    }
+    let t = Instant::now();
+    let mc = MonteCarlo::new(args.ref_spp, ReferenceBrdf::True);
+    let r = render_labeled("reference", w, h, hits, |i, hit| match hit {
+        Hit::Nothing => DVec3::ZERO,
+        Hit::Emitter(l) => *l,
+        Hit::Surface(p, n, v, m) => mc
+            .estimate(&demo.scene, *p, *n, *v, m, 0xF00D_0000 + i as u64)
+            .map(|e| e.mean)
+            .unwrap_or(DVec3::ZERO),
+    });
+    let bytes: Vec<u8> = r
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .flat_map(f64::to_le_bytes)
+        .collect();
+    std::fs::write(&cache, bytes).map_err(|e| e.to_string())?;
+    let note = format!(
+        "reference: computed in {:.1} s ({} samples per light per pixel), cached in {}",
+        t.elapsed().as_secs_f64(),
+        args.ref_spp,
+        cache.display()
+    );
+    Ok((r, note))
+}
+
+/// An image rendered by a stochastic method at about a given time.
+struct Timed {
+    img: Vec<DVec3>,
+    time: f64,
+    /// Samples per light per pixel.
+    spp: u32,
+}
+
+/// A shading function `f(spp, pixel, point, normal, view, material)` of a stochastic method.
+type Shader<'a> = dyn Fn(u32, usize, DVec3, DVec3, DVec3, &Material) -> DVec3 + Sync + 'a;
+
+/// Renders with `f` at the number of samples per light per pixel whose time comes closest to
+/// `budget` seconds: the cost per pixel is modelled as `a + b spp` (a per-point setup: frames,
+/// light regions, their triangulations; `b` per sample), measured on every 16th pixel at 1 and
+/// 4 samples, then the full image is rendered and timed (twice when the first misses the budget
+/// by more than 20%: the second with the samples rescaled by the first's measured cost).
+fn equal_time(
+    args: &Args,
+    hits: &[Hit],
+    budget: f64,
+    f: impl Fn(u32, usize, DVec3, DVec3, DVec3, &Material) -> DVec3 + Sync,
+) -> Timed {
+    let f: &Shader = &f;
+    let shade = |spp: u32, i: usize, hit: &Hit| match hit {
+        Hit::Nothing => DVec3::ZERO,
+        Hit::Emitter(l) => *l,
+        Hit::Surface(p, n, v, m) => f(spp, i, *p, *n, *v, m),
+    };
+    let stride = 16;
+    let subset: Vec<&Hit> = hits.iter().step_by(stride).collect();
+    let time_subset = |spp: u32| {
+        let t0 = Instant::now();
+        // The workers of the pool `main` set up (all cores by default).
+        let chunk = subset.len().div_ceil(rayon::current_num_threads());
+        std::thread::scope(|s| {
+            for (k, part) in subset.chunks(chunk.max(1)).enumerate() {
+                s.spawn(move || {
+                    for (j, hit) in part.iter().enumerate() {
+                        std::hint::black_box(shade(spp, (k * chunk + j) * stride, hit));
+                    }
+                });
+            }
+        });
+        t0.elapsed().as_secs_f64() * stride as f64
+    };
+    let (t1, t4) = (time_subset(1), time_subset(4));
+    let per_sample = ((t4 - t1) / 3.0).max(1e-12);
+    let setup = (t1 - per_sample).max(0.0);
+    let mut spp = ((budget - setup) / per_sample).round().clamp(1.0, 1e6) as u32;
+    let full = |spp: u32| {
+        let t0 = Instant::now();
+        let img = render(args.width, args.height, args.threads, hits, |i, hit| {
+            shade(spp, i, hit)
+        });
+        Timed {
+            img,
+            time: t0.elapsed().as_secs_f64(),
+            spp,
         }
     };
-
-    // Monte Carlo with the true BRDF at equal time: passes of one sample per light per pixel while
-    // another pass ends closer to the analytic time than stopping now (at least one pass, so with
-    // a fast analytic path Monte Carlo may get more time, never less than half a pass).
-    let t0 = Instant::now();
-    let mut acc = vec![DVec3::ZERO; w * h];
-    let mut passes = 0u64;
-    let one = MonteCarlo::new(1, ReferenceBrdf::True);
-    while passes == 0 || t0.elapsed().as_secs_f64() * (1.0 + 0.5 / passes as f64) < t_analytic {
-        let pass = render(w, h, threads, &hits, |i, hit| match hit {
-            Hit::Nothing => DVec3::ZERO,
-            Hit::Emitter(l) => *l,
-            Hit::Surface(p, n, v, m) => one
-                .estimate(&demo.scene, *p, *n, *v, m, (passes << 32) ^ i as u64)
-                .map(|e| e.mean)
-                .unwrap_or(DVec3::ZERO),
-        });
-        for (a, p) in acc.iter_mut().zip(pass) {
-            *a += p;
+    let mut timed = full(spp);
+    // The subset's timing misses load changes on a shared machine: one correction, by the
+    // measured time per sample of the full image.
+    if (timed.time / budget - 1.0).abs() > 0.2 {
+        let setup = setup * (timed.time / (setup + per_sample * f64::from(spp)));
+        let per = ((timed.time - setup) / f64::from(spp)).max(1e-12);
+        let better = ((budget - setup) / per).round().clamp(1.0, 1e6) as u32;
+        if better != spp {
+            spp = better;
+            timed = full(spp);
         }
-        passes += 1;
     }
-    let t_mc = t0.elapsed().as_secs_f64();
-    let mc: Vec<DVec3> = acc.iter().map(|a| *a / passes as f64).collect();
+    timed
+}
 
-    let nan = analytic
-        .iter()
-        .chain(&mc)
-        .filter(|p| !p.is_finite())
-        .count();
-    let (mae_a, rmse_a) = errors(&analytic, &reference);
-    let (mae_m, rmse_m) = errors(&mc, &reference);
-    println!("analytic: time {t_analytic:.2} s, MAE {mae_a:.4}, RMSE {rmse_a:.4}");
-    println!(
-        "monte-carlo: time {t_mc:.2} s, MAE {mae_m:.4}, RMSE {rmse_m:.4} ({passes} samples per light per pixel)"
-    );
-    println!("{ref_note}");
-    let fails = failures.load(std::sync::atomic::Ordering::Relaxed);
-    if fails > 0 || nan > 0 {
-        println!("warning: {fails} pixels failed to shade, {nan} non-finite pixels");
+/// One line of the comparison table.
+struct Row {
+    name: String,
+    time: f64,
+    spp: Option<u32>,
+    mae: f64,
+    rmse: f64,
+}
+
+impl Row {
+    fn new(name: String, time: f64, spp: Option<u32>, img: &[DVec3], reference: &[DVec3]) -> Row {
+        let (mae, rmse) = errors(img, reference);
+        Row {
+            name,
+            time,
+            spp,
+            mae,
+            rmse,
+        }
     }
+}
 
-    let (ba, bm, br) = (to_bytes(&analytic), to_bytes(&mc), to_bytes(&reference));
-    write_png(&args.out.join("render.png"), w, h, &ba)?;
-    write_png(&args.out.join("render_mc.png"), w, h, &bm)?;
-    write_png(&args.out.join("render_reference.png"), w, h, &br)?;
-    let mut side = Vec::with_capacity(3 * ba.len());
+fn print_table(rows: &[Row]) {
+    println!("| method | time (s) | samples per light per pixel | MAE | RMSE |");
+    println!("|---|---|---|---|---|");
+    for r in rows {
+        let spp = r.spp.map_or("-".to_string(), |s| s.to_string());
+        println!(
+            "| {} | {:.2} | {spp} | {:.4} | {:.4} |",
+            r.name, r.time, r.mae, r.rmse
+        );
+    }
+}
+
+/// Writes each image as a PNG, and all of them left to right in `render_side_by_side.png`.
+fn write_images(args: &Args, images: &[(&str, &Vec<DVec3>)]) -> Result<(), String> {
+    let (w, h) = (args.width, args.height);
+    let bytes: Vec<Vec<u8>> = images.iter().map(|(_, img)| to_bytes(img)).collect();
+    for ((name, _), b) in images.iter().zip(&bytes) {
+        write_png(&args.out.join(name), w, h, b)?;
+    }
+    let mut side = Vec::with_capacity(images.len() * bytes[0].len());
     for y in 0..h {
-        for img in [&ba, &bm, &br] {
-            side.extend_from_slice(&img[3 * w * y..3 * w * (y + 1)]);
+        for b in &bytes {
+            side.extend_from_slice(&b[3 * w * y..3 * w * (y + 1)]);
         }
     }
-    write_png(&args.out.join("render_side_by_side.png"), 3 * w, h, &side)?;
+    write_png(
+        &args.out.join("render_side_by_side.png"),
+        images.len() * w,
+        h,
+        &side,
+    )?;
+    let names: Vec<&str> = images.iter().map(|(n, _)| *n).collect();
     println!(
-        "images: {} (analytic | monte-carlo | reference in render_side_by_side.png)",
-        args.out.join("render.png").display()
+        "images in {}: {} (left to right in render_side_by_side.png)",
+        args.out.display(),
+        names.join(", ")
     );
     Ok(())
 }

@@ -161,6 +161,14 @@ pub enum GeomError {
         /// Index of the vertex in front of it.
         vertex: usize,
     },
+    /// (shade) Two triangles of a planar mesh light overlap: their projections are integrated
+    /// as disjoint pieces, so the overlap would be counted twice.
+    OverlappingLightTriangles {
+        /// Index of the first triangle.
+        triangle: usize,
+        /// Index of the second triangle.
+        other: usize,
+    },
     /// (solid) A mesh that must bound a solid has two triangles that cross, overlap or touch
     /// anywhere but along an edge or at a vertex they share as neighbours on the surface.
     SelfIntersectingMesh {
@@ -276,6 +284,11 @@ impl fmt::Display for GeomError {
                 "triangle {triangle} has an edge not shared by exactly one other triangle running \
                  the opposite way; a convex polyhedron or a solid must be a closed, consistently \
                  oriented mesh"
+            ),
+            GeomError::OverlappingLightTriangles { triangle, other } => write!(
+                f,
+                "triangles {triangle} and {other} of a planar light overlap, so their overlap \
+                 would emit twice; remove it, or make them two lights if that is meant"
             ),
             GeomError::SelfIntersectingMesh { triangle, other } => write!(
                 f,

@@ -73,8 +73,7 @@ fn vertex_at_edge_midpoint_union() {
     assert!((i.area() - 5.0 / 6.0).abs() < 1e-12, "{i:?}");
     assert!((u.area() - 137.0 / 12.0).abs() < 1e-12, "{u:?}");
     assert_eq!(u.contour_list().iter().filter(|c| c.is_hole()).count(), 1);
-    let sd = sym_diff_vs_ioverlay(&a, &b, BoolOp::Union, &u);
-    assert!(sd <= 1e-9 * (a.area() + b.area()), "{sd}: {u:?}");
+    // Against i_overlay: compare/tests/planar_regressions.rs.
 }
 
 /// Two copies of one vertex a few ulps apart within one operand (Issue 3, item 2). These are the
@@ -130,8 +129,5 @@ fn difference_with_nearly_shared_edge() {
     );
     let [i, _, d, _] = check_all(&a, &b, 1e-12).unwrap();
     assert!(d.area() > 0.0 && i.area() > 0.0);
-    for (r, op) in [(&i, BoolOp::Intersection), (&d, BoolOp::Difference)] {
-        let sd = sym_diff_vs_ioverlay(&a, &b, op, r);
-        assert!(sd <= 1e-9 * (a.area() + b.area()), "{sd}: {r:?}");
-    }
+    // Against i_overlay: compare/tests/planar_regressions.rs.
 }

@@ -6,8 +6,8 @@ use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::internals::{TriangleRole, convex_silhouette, may_occlude, triangle_polygon};
 use arealight::shade::{
-    Body, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
-    ShadingFrame, TriangleMesh,
+    Body, ConvexPolyhedron, Light, LightSampling, Material, Method, MonteCarlo, ReferenceBrdf,
+    Scene, ShadingFrame, TriangleMesh,
 };
 use arealight::solid::{BoundingSphere, Side, face_side};
 use support::Rng;
@@ -113,7 +113,8 @@ fn box_mesh(c: DVec3, h: DVec3) -> TriangleMesh {
 fn check_scene(scene: &Scene, seed: u64, points: usize) -> (usize, usize) {
     let mut rng = Rng::new(seed * 100 + 7);
     let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
-    let mc = MonteCarlo::new(4096, ReferenceBrdf::Ltc);
+    // Face sampling: independent of the light regions under test.
+    let mc = MonteCarlo::new(4096, ReferenceBrdf::Ltc).with_sampling(LightSampling::Faces);
     let (mut ok, mut errors) = (0, 0);
     for i in 0..points {
         let x = ground_point(&mut rng, 2.0);

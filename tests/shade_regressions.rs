@@ -4,7 +4,8 @@
 
 use arealight::glam::DVec3;
 use arealight::shade::{
-    ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene, TriangleMesh,
+    ConvexPolyhedron, Light, LightSampling, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
+    TriangleMesh,
 };
 
 /// The fuzz target's grid: integers over 8.
@@ -199,7 +200,9 @@ fn cylinder_through_a_cuboid_light_shaded_next_to_the_light() {
     let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
     assert_bounded_or_undecidable(&scene, x, n, v, &m);
     if let Ok(a) = scene.shade(x, n, v, &m) {
+        // Face sampling: independent of the light regions under test.
         let e = MonteCarlo::new(1 << 15, ReferenceBrdf::Ltc)
+            .with_sampling(LightSampling::Faces)
             .estimate(&scene, x, n, v, &m, 5)
             .unwrap();
         for c in 0..3 {
@@ -278,7 +281,9 @@ fn sheet_light_seen_from_inside_a_small_icosphere_it_cuts() {
     assert_bounded_or_undecidable(&scene, x, n, v, &m);
     let diffuse = Material::diffuse(DVec3::ONE).unwrap();
     if let Ok(a) = scene.shade(x, n, v, &diffuse) {
+        // Face sampling: independent of the light regions under test.
         let e = MonteCarlo::new(1 << 14, ReferenceBrdf::Ltc)
+            .with_sampling(LightSampling::Faces)
             .estimate(&scene, x, n, v, &diffuse, 3)
             .unwrap();
         assert!(

@@ -5,7 +5,7 @@
 //!
 //! The reference value is recomputed here from the spherical path's region through the public
 //! integrals (`clamped_cosine_integral`, `ltc_integral` with the table's lookup), independently of
-//! the shading code; the fast value is `Scene::shade_light` (and `Scene::shade_with`, which must
+//! the shading code; the fast value is `Scene::shade_light` (and `Scene::shade_in`, which must
 //! give the same bits). Why relative to the unoccluded value rather than to the value itself:
 //! the spherical path snaps projected vertices to `planar::SNAP_REL` (about `1.4e-14`) of the
 //! projected coordinates and drops slivers below `planar::SLIVER_REL`, and the fast path's
@@ -214,7 +214,7 @@ fn fast_path_agrees_with_the_spherical_path() {
             let v = view_above(&mut rng, n, cos_min);
             let m = &materials[rng.below(materials.len())];
             let f = ShadingFrame::new(x, n, v).unwrap();
-            // Each light's fast value, summed in the order `shade_with` sums them.
+            // Each light's fast value, summed in the order `shade_in` sums them.
             let mut total = Some(DVec3::ZERO);
             for i in 0..scene.lights().len() {
                 pairs += 1;
@@ -249,10 +249,10 @@ fn fast_path_agrees_with_the_spherical_path() {
             }
             // The whole point through a reused context: the same bits as light by light.
             if let Some(total) = total {
-                let all = scene.shade_with(&mut ctx, x, n, v, m).unwrap();
+                let all = scene.shade_in(&mut ctx, x, n, v, m).unwrap();
                 assert_eq!(
                     all, total,
-                    "scene {s}: shade_with differs from its lights' sum"
+                    "scene {s}: shade_in differs from its lights' sum"
                 );
             }
         }
@@ -458,7 +458,7 @@ fn blockers_in_exact_contact() {
 /// Points on an occluder's surface and in a planar light's plane get the spherical path's
 /// finite value (a point on a box's face: the box covers the half-space behind that face; a
 /// point in the light's plane sees none of it), and invalid arguments are errors naming the
-/// argument, through `shade_with` as through `shade`.
+/// argument, through `shade_in` as through `shade`.
 #[test]
 fn points_on_surfaces_and_bad_input() {
     let quad =
@@ -482,7 +482,7 @@ fn points_on_surfaces_and_bad_input() {
             support::shade::point_on_mesh(&mut rng, mesh)
         };
         let v = view_above(&mut rng, n, 0.2);
-        let got = scene.shade_with(&mut ctx, x, n, v, &m).unwrap();
+        let got = scene.shade_in(&mut ctx, x, n, v, &m).unwrap();
         assert!(got.is_finite() && got.min_element() >= 0.0, "{x}: {got}");
         let frame = ShadingFrame::new(x, n, v).unwrap();
         if let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) {
@@ -506,7 +506,7 @@ fn points_on_surfaces_and_bad_input() {
     ];
     for (x, n, v, what) in bad {
         for e in [
-            scene.shade_with(&mut ctx, x, n, v, &m).unwrap_err(),
+            scene.shade_in(&mut ctx, x, n, v, &m).unwrap_err(),
             scene.shade(x, n, v, &m).unwrap_err(),
         ] {
             assert!(

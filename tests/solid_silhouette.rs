@@ -449,7 +449,6 @@ fn viewpoint_next_to_a_vertex() {
 }
 
 #[test]
-#[ignore = "sphere layer: wrong union, found by the solid_silhouette fuzz target (report to the sphere engineers)"]
 fn sphere_union_of_a_near_hemisphere_triangle_and_a_sliver() {
     // Two front triangles of an extruded star seen from 2.4e-7 off a face: A spans nearly a
     // hemisphere (two vertices 1.7e-6 from antipodal), B is a 3.4e-7 sr sliver sharing the edge

@@ -16,11 +16,14 @@ use arealight::glam::{DMat3, DQuat, DVec3};
 use arealight::internals::{
     bumpy_sphere, convex_silhouette, extruded_star, thesis_polyhedra, torus,
 };
+use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::solid::{
-    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, TriangleMesh, nonconvex_silhouette,
+    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, SilhouetteSampler, TriangleMesh,
+    TriangleSource, nonconvex_silhouette,
 };
-use arealight::sphere::SphericalPolygon;
+use arealight::sphere::{SphericalPolygon, SphericalTriangle};
+use robust::orient3d;
 use support::Rng;
 
 fn points_per_solid() -> usize {
@@ -226,4 +229,364 @@ fn sphere_42_fits_the_size_goal() {
         bsp.byte_size()
     );
     assert!(bsp.byte_size() <= 2_000_000, "{}", bsp.byte_size());
+}
+
+/// Angular distance from the unit `d` to the nearest edge of the triangle `t`.
+fn triangle_edge_distance(t: &[DVec3; 3], d: DVec3) -> f64 {
+    let ring = SphericalPolygon::new(vec![t.to_vec()]);
+    match ring {
+        Ok(p) => boundary_distance(&p, d),
+        Err(_) => 0.0,
+    }
+}
+
+/// Whether the unit `d` lies strictly inside the positively oriented triangle `t` (exact).
+fn strictly_inside(t: &[DVec3; 3], d: DVec3) -> bool {
+    let o = |a: DVec3, b: DVec3| orient3d(c3(a), c3(b), c3(d), c3(DVec3::ZERO)) > 0.0;
+    o(t[0], t[1]) && o(t[1], t[2]) && o(t[2], t[0])
+}
+
+fn c3(p: DVec3) -> robust::Coord3D<f64> {
+    robust::Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
+}
+
+/// Checks that `tris` is a triangulation of `poly`: every triangle positively oriented (exact
+/// `orient3d` on the unit vectors), solid angles adding up to the polygon's within `1e-12`
+/// relative, and every probe direction farther than `1e-9` rad from every edge covered by
+/// exactly as many triangles as `poly.contains` says (0 or 1). Probes: points inside each
+/// triangle, points just outside each of its edges, and uniform directions. Returns a message
+/// on failure.
+fn check_triangulation(
+    tris: &[[DVec3; 3]],
+    poly: &SphericalPolygon,
+    rng: &mut Rng,
+) -> Result<(), String> {
+    for t in tris {
+        // Exact on the rounded directions; a negative sign counts as wrong unless it is within
+        // the rounding of the directions, which the great circle through two corners a
+        // distance `sep` apart amplifies by 1 / sep (two corners about to merge, as a crossing
+        // reaching a vertex near the cell's boundary: seen 1e-10 apart, det -1.6e-17).
+        let o = orient3d(c3(t[0]), c3(t[1]), c3(t[2]), c3(DVec3::ZERO));
+        let sep = (t[0] - t[1])
+            .length()
+            .min((t[1] - t[2]).length())
+            .min((t[2] - t[0]).length());
+        let cross =
+            t[0].cross(t[1]).length() + t[1].cross(t[2]).length() + t[2].cross(t[0]).length();
+        if o.is_nan() || -o > 1e-15 * cross / sep.max(1e-300) || (o == 0.0 && sep > 1e-6) {
+            return Err(format!("triangle {t:?} not positively oriented ({o:e})"));
+        }
+    }
+    let sum: f64 = tris
+        .iter()
+        .map(|t| {
+            SphericalTriangle::new(t[0], t[1], t[2])
+                .map(|s| s.solid_angle())
+                .unwrap_or(0.0)
+        })
+        .sum();
+    // A triangle's solid angle from rounded unit vectors is uncertain by about eps over the
+    // chord between its most nearly antipodal vertices (its edge's great circle is that
+    // uncertain): that term is added to the 1e-12 relative (seen: 4e-9 sr with two corners
+    // 6e-8 from antipodal, from a point within 2e-8 of the line through their vertices).
+    let conditioning: f64 = tris
+        .iter()
+        .map(|t| {
+            let near = (t[0] + t[1])
+                .length()
+                .min((t[1] + t[2]).length())
+                .min((t[2] + t[0]).length());
+            1e-14 / near.max(1e-300)
+        })
+        .sum();
+    let area = poly.solid_angle();
+    if (sum - area).abs() > 1e-12 * area.max(1e-3) + conditioning {
+        return Err(format!(
+            "triangle areas {sum} vs silhouette {area} (conditioning term {conditioning:e})"
+        ));
+    }
+    let mut probes: Vec<DVec3> = (0..16).map(|_| rng.dir()).collect();
+    for t in tris {
+        for _ in 0..4 {
+            let w = DVec3::new(rng.f64(), rng.f64(), rng.f64()) + DVec3::splat(1e-3);
+            probes.push((t[0] * w.x + t[1] * w.y + t[2] * w.z).normalize());
+        }
+        for k in 0..3 {
+            // Just beyond the midpoint of edge k, away from the opposite corner.
+            let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let m = (a + b).normalize();
+            let off = 10f64.powf(rng.range(-8.0, -3.0));
+            probes.push((m + (m - c).normalize() * off).normalize());
+        }
+    }
+    // Corners of edges shorter than 1e-6 rad: near them `contains` is not a reliable
+    // reference (the great circle of an edge 1e-10 long is uncertain by 1e-6 rad; seen: a
+    // probe 6e-8 from a cluster of three corners within 2e-10, contained by the queried
+    // polygon and not by the direct silhouette, whose solid angles agree to 1e-17).
+    let mut clusters: Vec<DVec3> = Vec::new();
+    for r in poly.rings() {
+        for i in 0..r.len() {
+            if (r[i] - r[(i + 1) % r.len()]).length() < 1e-6 {
+                clusters.push(r[i]);
+            }
+        }
+    }
+    for t in tris {
+        for k in 0..3 {
+            if (t[k] - t[(k + 1) % 3]).length() < 1e-6 {
+                clusters.push(t[k]);
+            }
+        }
+    }
+    for d in probes {
+        if boundary_distance(poly, d) < 1e-9
+            || tris.iter().any(|t| triangle_edge_distance(t, d) < 1e-9)
+            || clusters.iter().any(|&c| (c - d).length() < 1e-6)
+        {
+            continue;
+        }
+        let count = tris.iter().filter(|t| strictly_inside(t, d)).count();
+        if count != usize::from(poly.contains(d)) {
+            return Err(format!(
+                "direction {d} covered by {count} triangles, contained: {}",
+                poly.contains(d)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A random point of the convex cell with vertices `cell`: a combination of the vertices with
+/// cubed random weights (pushed towards the boundary, as the thesis samples), a point within
+/// 1e-10 to 1e-2 of the cell's size of a vertex, or of the midpoint of two vertices (an edge
+/// or a diagonal of a face), pulled that little towards the centroid.
+fn point_in_cell(cell: &[DVec3], rng: &mut Rng) -> DVec3 {
+    let c = cell.iter().copied().sum::<DVec3>() / cell.len() as f64;
+    let pick = |rng: &mut Rng| cell[(rng.f64() * cell.len() as f64) as usize % cell.len()];
+    let near = 10f64.powf(rng.range(-10.0, -2.0));
+    match (rng.f64() * 4.0) as u32 {
+        0 | 1 => {
+            let w: Vec<f64> = cell.iter().map(|_| rng.f64().powi(3)).collect();
+            let total: f64 = w.iter().sum();
+            cell.iter().zip(&w).map(|(&p, &w)| p * (w / total)).sum()
+        }
+        2 => {
+            let v = pick(rng);
+            v + (c - v) * near
+        }
+        _ => {
+            let m = (pick(rng) + pick(rng)) * 0.5;
+            m + (c - m) * near
+        }
+    }
+}
+
+/// Per solid: build with triangulations, then at random points of the cells of the leaves
+/// that store one (`per_cell` each, for at most `max_cells` cells picked at random), check the
+/// stored triangulation, evaluated without the query's own check, against the queried
+/// silhouette. Returns the number of points checked.
+fn check_stored_triangulations(
+    name: &str,
+    solid: &ClosedMesh,
+    rng: &mut Rng,
+    per_cell: usize,
+    max_cells: usize,
+) -> usize {
+    let t0 = std::time::Instant::now();
+    let (bsp, cells) = SilhouetteBsp::build_triangulated_with_cells(solid).unwrap();
+    let build = t0.elapsed();
+    let (stored, rings) = bsp.triangulated_leaf_count();
+    assert_eq!(stored, cells.len(), "{name}");
+    let (mut checked, mut computed, mut elsewhere) = (0, 0, 0);
+    let mut out = Vec::new();
+    let keep = max_cells as f64 / cells.len().max(1) as f64;
+    for cell in &cells {
+        if rng.f64() > keep {
+            continue;
+        }
+        for _ in 0..per_cell {
+            let x = point_in_cell(cell, rng);
+            let frame = ShadingFrame::new(x, DVec3::Z, DVec3::new(0.2, 0.1, 1.0)).unwrap();
+            let Ok(poly) = bsp.query(&frame) else {
+                continue;
+            };
+            // The leaf data with triangle sections still decode to the silhouette.
+            if let Ok(d) = nonconvex_silhouette(solid, &frame) {
+                let (a, b) = (poly.solid_angle(), d.solid_angle());
+                assert!(
+                    (a - b).abs() <= 1e-9 * a.max(1e-3),
+                    "{name} x {x}: {a} vs {b}"
+                );
+            }
+            let Some(tris) = bsp.stored_triangulation(&frame) else {
+                // Within rounding of the cell's boundary, in a neighbour without one, or
+                // answered directly (near a face plane).
+                elsewhere += 1;
+                continue;
+            };
+            if let Err(msg) = check_triangulation(&tris, &poly, rng) {
+                panic!("{name} x {x}: stored triangulation invalid: {msg}");
+            }
+            checked += 1;
+            // The query's own check passes too.
+            if bsp.query_triangles(&frame, &mut out).unwrap() == TriangleSource::Computed {
+                computed += 1;
+            }
+        }
+    }
+    eprintln!(
+        "{name}: built with triangulations in {build:?}: {stored} of {rings} leaves with rings \
+         store one, {} triangles, {} bytes; {checked} points checked, {elsewhere} answered \
+         otherwise, {computed} rejected by the query's check",
+        bsp.stored_triangle_count(),
+        bsp.byte_size(),
+    );
+    // The query's check rejects only within rounding of the cell's boundary (corners about
+    // to merge), where half of these samples lie (within 1e-10 to 1e-2 of a vertex or edge).
+    assert!(
+        computed * 20 <= checked.max(1),
+        "{name}: {computed} query-time rejections"
+    );
+    checked
+}
+
+#[test]
+fn stored_triangulations_are_valid_everywhere_in_their_cells() {
+    let mut rng = Rng::new(0x7a1);
+    // Default: 4 points in each of at most 400 cells per solid; `TRI_POINTS=64 cargo test
+    // --release --test solid_silhouette_bsp stored_` samples 64 points in every cell.
+    let per_cell = std::env::var("TRI_POINTS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(4);
+    let max_cells = if per_cell > 4 { usize::MAX } else { 400 };
+    for (name, m) in thesis_polyhedra().unwrap().into_iter().skip(5) {
+        let solid = ClosedMesh::new(m).unwrap();
+        let checked = check_stored_triangulations(name, &solid, &mut rng, per_cell, max_cells);
+        assert!(checked >= 250, "{name}: only {checked} points checked");
+    }
+    for k in 0..2 {
+        let m = if k == 0 {
+            torus(1.0, 0.4, 4, 3).unwrap()
+        } else {
+            extruded_star(4, 0.5, 1.0, 0.3).unwrap()
+        };
+        let solid = ClosedMesh::new(m).unwrap();
+        let checked = check_stored_triangulations(
+            &format!("solid {k}"),
+            &solid,
+            &mut rng,
+            per_cell,
+            max_cells,
+        );
+        assert!(checked >= 250, "solid {k}: only {checked} points checked");
+    }
+}
+
+/// Hoeffding's bound for the mean of `n` independent values in an interval of width `range`:
+/// exceeded with probability below 1e-9.
+fn hoeffding(n: usize, range: f64) -> f64 {
+    range * ((2e9f64).ln() / (2.0 * n as f64)).sqrt()
+}
+
+#[test]
+fn silhouette_sampler_is_uniform_over_the_silhouette() {
+    // At points whose cell stores a triangulation (and a few where it is computed), 40 000
+    // directions from `SilhouetteSampler` must all lie in the queried silhouette, and estimate
+    // (i) the clamped-cosine integral (`ltc::clamped_cosine_integral` of the silhouette) and
+    // (ii) the silhouette's share in a hemisphere through its middle (the solid angle of its
+    // hemisphere clip over its own), each within Hoeffding's bound at 1e-9 (values in [0, 1];
+    // 48 checks, so a false alarm has probability below 5e-8).
+    let mut rng = Rng::new(0x5a3);
+    let n = 40_000;
+    let solids = thesis_polyhedra().unwrap();
+    let mut stored = 0;
+    for (name, m) in solids.into_iter().skip(5) {
+        let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(m).unwrap()).unwrap();
+        let mesh_center = DVec3::ZERO;
+        let mut cases = 0;
+        while cases < 6 {
+            let x = mesh_center + rng.dir() * rng.range(1.5, 6.0);
+            let frame = ShadingFrame::new(x, DVec3::Z, DVec3::X).unwrap();
+            let (Ok(poly), Ok(sampler)) = (bsp.query(&frame), SilhouetteSampler::new(&bsp, &frame))
+            else {
+                continue;
+            };
+            cases += 1;
+            stored += usize::from(sampler.source() == TriangleSource::Stored);
+            let omega = poly.solid_angle();
+            assert!(
+                (sampler.solid_angle() - omega).abs() <= 1e-9 * omega,
+                "{name} x {x}"
+            );
+            // A hemisphere whose circle passes through the silhouette's middle.
+            let mid = sampler
+                .triangles()
+                .iter()
+                .map(|t| t.vertices().iter().sum::<DVec3>() * t.solid_angle())
+                .sum::<DVec3>()
+                .normalize();
+            let normal = mid.cross(rng.dir()).normalize();
+            let share = poly.clip_to_hemisphere(normal).solid_angle() / omega;
+            let cosine = clamped_cosine_integral(&poly) / omega;
+            let (mut in_half, mut cos_sum) = (0usize, 0.0);
+            for _ in 0..n {
+                let d = sampler.sample(rng.point2());
+                assert!(
+                    poly.contains(d) || boundary_distance(&poly, d) < 1e-9,
+                    "{name} x {x}: sample {d} outside the silhouette"
+                );
+                assert_eq!(sampler.pdf(d), 1.0 / sampler.solid_angle(), "{name} x {x}");
+                in_half += usize::from(d.dot(normal) > 0.0);
+                cos_sum += d.z.max(0.0) / std::f64::consts::PI;
+            }
+            let bound = hoeffding(n, 1.0);
+            let est = in_half as f64 / n as f64;
+            assert!(
+                (est - share).abs() <= bound,
+                "{name} x {x}: hemisphere share {est} sampled, {share} exact (bound {bound})"
+            );
+            let est = cos_sum / n as f64;
+            assert!(
+                (est - cosine).abs() <= hoeffding(n, 1.0 / std::f64::consts::PI),
+                "{name} x {x}: clamped cosine {est} sampled, {cosine} exact"
+            );
+        }
+    }
+    assert!(
+        stored >= 12,
+        "only {stored} of 24 cases used stored triangulations"
+    );
+}
+
+#[test]
+fn convex_fans_are_valid_triangulations() {
+    // A convex polyhedron's silhouette seen from outside is strictly convex inside every cell
+    // of its face planes (three silhouette vertices seen on one great circle would put the
+    // point on a supporting plane through three vertices: a face plane), so the fan of its
+    // stored loop is a triangulation: checked as the stored ones are, at points in the box,
+    // near the solid and near the face planes.
+    let mut rng = Rng::new(0xfa4);
+    for (name, m) in thesis_polyhedra().unwrap().into_iter().take(5) {
+        let mesh = m.clone();
+        let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(m).unwrap()).unwrap();
+        let mut checked = 0;
+        for _ in 0..400 {
+            let x = sample(&bsp, &mesh, &mut rng);
+            let frame = ShadingFrame::new(x, DVec3::Z, DVec3::Y).unwrap();
+            let (Ok(poly), Some(tris)) = (bsp.query(&frame), bsp.stored_triangulation(&frame))
+            else {
+                continue;
+            };
+            if let Err(msg) = check_triangulation(&tris, &poly, &mut rng) {
+                panic!("{name} x {x}: fan invalid: {msg}");
+            }
+            checked += 1;
+        }
+        assert!(checked >= 200, "{name}: {checked}");
+    }
 }

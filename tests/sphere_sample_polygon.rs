@@ -1,5 +1,6 @@
 //! `PolygonSampler`: uniform over the polygon (chi-square on wedge cells whose solid angles come
-//! from hemisphere clipping, not from the sampler's triangles), `pdf` integrating to one
+//! from hemisphere clipping, not from the sampler's triangles; also on polygons 1e-9 to 1e-6 rad
+//! across, with the cells' areas from a relative-precision formula), `pdf` integrating to one
 //! (stratified quadrature with a stated bound), the sample mean against the closed-form first
 //! moment, and every sample of a tiny polygon inside it (exact crossing parity).
 //!
@@ -140,6 +141,102 @@ fn uniform_over_wedges() {
             })
             .sum();
         println!("{name}: chi2 {chi2:.1} (critical {critical:.1})");
+        assert!(chi2 < critical, "{name}: chi2 {chi2} >= {critical}");
+    }
+}
+
+/// Tiny polygons and the complement of one, with the axis the wedges are cut about (a point
+/// inside each, off its vertices' lines, so that every wedge plane passes through the polygon).
+/// (Wedges about a vertex of the 1e-9 L at z meet a fault of the hemisphere clip: the clip of a
+/// 1e-9 quad by a plane through its corner returns a hemisphere-sized lune.)
+fn tiny_polygons() -> Vec<(String, SphericalPolygon, DVec3)> {
+    let mut out = Vec::new();
+    for (c, where_) in [(DVec3::Z, "at z"), (center(), "generic")] {
+        for s in [1e-6, 1e-9] {
+            let l = SphericalPolygon::new(vec![ring(c, s, &L)]).unwrap();
+            let inner = at(c, 0.37 * s, 0.61 * s);
+            out.push((format!("{s:e} L {where_}"), l.clone(), inner));
+            if s == 1e-6 {
+                out.push((
+                    format!("complement of the {s:e} L {where_}"),
+                    l.complement(),
+                    inner,
+                ));
+            }
+        }
+        let mut hole = ring(
+            c,
+            3e-8,
+            &[(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)],
+        );
+        // About a point of the square between its edge and the hole.
+        hole.reverse();
+        let square = ring(
+            c,
+            1e-7,
+            &[(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)],
+        );
+        out.push((
+            format!("1e-7 square with a hole {where_}"),
+            SphericalPolygon::new(vec![square, hole]).unwrap(),
+            at(c, 0.61e-7, 0.23e-7),
+        ));
+    }
+    out
+}
+
+/// The azimuth cell of `p` about `axis`, from the difference `p - axis` (whose components
+/// keep the relative precision of a tiny offset, where `p . u` would carry the rounding of
+/// `axis . u`).
+fn wedge_of_offset(axis: DVec3, n: usize, p: DVec3) -> usize {
+    let (u, v) = axis.any_orthonormal_pair();
+    let d = p - axis;
+    let t = d.dot(v).atan2(d.dot(u)).rem_euclid(2.0 * PI);
+    ((t / (2.0 * PI) * n as f64) as usize).min(n - 1)
+}
+
+#[test]
+fn uniform_over_wedges_on_tiny_polygons() {
+    // As `uniform_over_wedges`, on polygons 1e-9 to 1e-6 rad across (and a complement of one),
+    // with the wedges' solid angles from the test's own relative-precision area (Van
+    // Oosterom-Strackee on differences, `check::reference_area`) of the hemisphere-clipped
+    // pieces: the sampler's triangles play no part in the expected counts.
+    let polys = tiny_polygons();
+    let n_wedges = 8;
+    let n = 80_000usize;
+    let critical = chi2_critical((n_wedges - 1) as f64, 1e-9 / polys.len() as f64);
+    let mut rng = Rng::new(25);
+    for (name, p, axis) in polys {
+        let s = PolygonSampler::new(&p).unwrap();
+        let total = check::reference_area(&p);
+        assert!(
+            (s.solid_angle() - total).abs() <= 1e-12 * total,
+            "{name}: {} vs {total}",
+            s.solid_angle()
+        );
+        let probs: Vec<f64> = (0..n_wedges)
+            .map(|k| {
+                let (n1, n2) = wedge_normals(axis, n_wedges, k);
+                check::reference_area(&p.clip_to_hemisphere(n1).clip_to_hemisphere(n2)) / total
+            })
+            .collect();
+        let sum: f64 = probs.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-6, "{name}: wedges sum to {sum}");
+        let mut counts = vec![0usize; n_wedges];
+        for _ in 0..n {
+            let d = s.sample(DVec2::new(rng.f64(), rng.f64()));
+            counts[wedge_of_offset(axis, n_wedges, d)] += 1;
+        }
+        let chi2: f64 = counts
+            .iter()
+            .zip(&probs)
+            .filter(|(_, p)| **p > 0.0)
+            .map(|(&k, &q)| {
+                let e = q * n as f64;
+                (k as f64 - e).powi(2) / e
+            })
+            .sum();
+        println!("{name}: wedges {probs:.3?}, chi2 {chi2:.1} (critical {critical:.1})");
         assert!(chi2 < critical, "{name}: chi2 {chi2} >= {critical}");
     }
 }

@@ -3,7 +3,7 @@
 //! 1e-12 relative, and exact coverage of a deterministic direction set (a Fibonacci lattice plus
 //! directions around every vertex and across every edge) against `SphericalPolygon::contains`.
 //! Extra-vertex counts are printed per family (`cargo test --test sphere_triangulate --
-//! --nocapture`).
+//! --nocapture`) and bounded: at most one except for the full sphere, none where none is needed.
 
 #[path = "sphere_triangulate_check/mod.rs"]
 mod check;
@@ -100,6 +100,15 @@ fn run(name: &str, p: &SphericalPolygon) -> check::Report {
         r.extra_vertices,
         r.area_error,
         r.checked
+    );
+    // Extra vertices only where needed (thesis 003 section 6.2): none of these families needs
+    // more than one (the far side of a region whose vertices an open hemisphere holds, or a
+    // hemisphere bounded by vertices on its great circle), except the full sphere (a
+    // tetrahedron's four). Families that need none assert 0 where they are built.
+    assert!(
+        r.extra_vertices <= 1 || p.is_full(),
+        "{name}: {} extra vertices\n{p:?}",
+        r.extra_vertices
     );
     r
 }
@@ -241,13 +250,14 @@ fn larger_than_a_hemisphere() {
         &poly(vec![reversed(sq), inner]),
     );
     // Two small holes on opposite sides of the sphere.
-    run(
+    let r = run(
         "sphere minus two antipodal squares",
         &poly(vec![
             reversed(ring(c, 0.2, &ngon(4))),
             reversed(ring(-c, 0.2, &ngon(4))),
         ]),
     );
+    assert_eq!(r.extra_vertices, 0);
     // A star ring of nearly a hemisphere and its complement.
     let mut rng = Rng::new(6);
     let s = star_ring(&mut rng, c, 12, 1.5, 0.9);
@@ -267,20 +277,25 @@ fn bands_hemispheres_and_the_full_sphere() {
         .collect();
     // Region between: bottom ring counter-clockwise seen from outside below... the band is on
     // the left of the bottom ring going east and of the top ring going west.
-    run("band", &poly(vec![bottom.clone(), reversed(top.clone())]));
-    run(
+    // No open hemisphere holds the band's or the caps' vertices, but triangles between them
+    // need no extra vertex (the stereographic chart).
+    let r = run("band", &poly(vec![bottom.clone(), reversed(top.clone())]));
+    assert_eq!(r.extra_vertices, 0);
+    let r = run(
         "polar caps",
         &poly(vec![top.clone(), reversed(bottom.clone())]),
     );
+    assert_eq!(r.extra_vertices, 0);
     let equator: Vec<DVec3> = (0..4).map(|i| e(PI / 2.0 * i as f64, 0.0)).collect();
     let r = run("upper hemisphere", &poly(vec![equator.clone()]));
     assert_eq!(r.extra_vertices, 1);
     run("lower hemisphere", &poly(vec![reversed(equator)]));
     // A lune between two meridians, from pole to pole.
-    run(
+    let r = run(
         "lune",
         &poly(vec![vec![DVec3::Z, e(0.0, 0.0), -DVec3::Z, e(0.5, 0.0)]]),
     );
+    assert_eq!((r.triangles, r.extra_vertices), (2, 0));
     let r = run("full sphere", &SphericalPolygon::full());
     assert_eq!((r.triangles, r.extra_vertices), (4, 4));
     assert!(SphericalPolygon::empty().triangulate().unwrap().is_empty());
@@ -331,10 +346,11 @@ fn reaching_the_hemisphere_boundary() {
     );
     let l = poly(vec![ring(DVec3::new(0.0, 0.3, 0.2).normalize(), 1.2, &L)]);
     run("L clipped at the horizon", &l.clip_to_hemisphere(DVec3::Z));
-    run(
+    let r = run(
         "complement of the L clipped at the horizon",
         &l.complement().clip_to_hemisphere(DVec3::Z),
     );
+    assert_eq!(r.extra_vertices, 0);
     // Vertices within 1e-9 rad above the horizon.
     let ring9: Vec<DVec3> = (0..7)
         .map(|i| {

@@ -190,6 +190,24 @@ impl Shape {
     ///   contradict each other), as for [`boolean`](super::boolean); never for well-separated or
     ///   exactly degenerate input such as shared edges and vertices.
     pub fn with_fill_rule(contours: Vec<Vec<DVec2>>, rule: FillRule) -> Result<Shape, GeomError> {
+        Shape::fill(contours, rule, true)
+    }
+
+    /// [`Shape::with_fill_rule`] without first checking whether small input is already simple:
+    /// for callers whose rings usually cross or overlap (a union of many overlapping pieces),
+    /// where that quadratic check is spent for nothing. Same result.
+    pub(crate) fn with_fill_rule_resolving(
+        contours: Vec<Vec<DVec2>>,
+        rule: FillRule,
+    ) -> Result<Shape, GeomError> {
+        Shape::fill(contours, rule, false)
+    }
+
+    fn fill(
+        contours: Vec<Vec<DVec2>>,
+        rule: FillRule,
+        try_simple: bool,
+    ) -> Result<Shape, GeomError> {
         check_coordinates(&contours, 0)?;
         let mut rings: Vec<Vec<DVec2>> = Vec::with_capacity(contours.len());
         for ring in contours {
@@ -209,7 +227,8 @@ impl Shape {
             .flatten()
             .fold(0.0f64, |m, p| m.max(p.x.abs()).max(p.y.abs()));
         let n: usize = rings.iter().map(Vec::len).sum();
-        if n <= SIMPLE_MAX
+        if try_simple
+            && n <= SIMPLE_MAX
             && let Some(s) = simple_rings(&rings, rule, scale)
         {
             return Ok(s);

@@ -45,20 +45,23 @@
 //!   edges, vertex on edge, vertex on vertex, identical contours, holes touching outers, a
 //!   50-triangle grid union, 50-step difference chains against union-first), input errors, and
 //!   the FHP vertex classes (`contact_classes`).
-//! - `tests/planar_proptest.rs`: 256 cases per property (`PLANAR_CASES=N` for more) against
+//! - `compare/tests/planar_proptest.rs` (the workspace member `compare/`, which alone builds the
+//!   reference clippers: `cargo test -p arealight-compare`): 256 cases per property (`PLANAR_CASES=N` for more) against
 //!   i_overlay and clipper2 (symmetric-difference area at most `1e-7` of the operands' area) and
 //!   the identities among our own results (`1e-9`), on random, integer-grid, copied,
 //!   sub-polygon, shared-edge, vertex-on-edge, far-from-origin and chained inputs.
 //! - `tests/planar_fast.rs`: the fast path against the robust pipeline (identical results
 //!   wherever the fast path answers; bail-out on exact and near degeneracies; taken on generic
 //!   inputs and on the benchmark inputs).
-//! - `tests/planar_fill.rs`: `with_fill_rule` and the GeoJSON constructors on random
+//! - `compare/tests/planar_fill.rs`: `with_fill_rule` and the GeoJSON constructors on random
 //!   self-intersecting rings, grid soups, overlapping stars, bow-ties, self-touching and nested
 //!   rings at scales `2^-20..2^20` with offsets, against i_overlay's and clipper2's resolution
 //!   under the same rule and against the exact winding number at sample points; hand-checked
 //!   areas, bad input, slivers.
-//! - `tests/planar_regressions.rs`: every minimized failure as a named test; proptest's seeds
-//!   are in `proptest-regressions/planar_proptest.txt`.
+//! - `tests/planar_regressions.rs`: every minimized failure as a named test (their checks
+//!   against i_overlay in `compare/tests/planar_regressions.rs`); proptest's seeds are in
+//!   `compare/proptest-regressions/planar_proptest.txt`; golden fixtures checked against both
+//!   references in `compare/tests/planar_fixtures.rs`.
 //! - `fuzz/fuzz_targets/planar_{intersection,union,difference,xor}.rs`: validity and identities;
 //!   run with `RUSTC_BOOTSTRAP=1 cargo fuzz run planar_difference -- -max_total_time=60`
 //!   (after `cargo install cargo-fuzz`).
@@ -100,4 +103,4 @@ pub use contour::Contour;
 pub use fill::FillRule;
 pub use predicates::MAX_COORD;
 pub use shape::Shape;
-pub(crate) use triangulate::constrained_delaunay;
+pub(crate) use triangulate::{Cdt, constrained_delaunay};

@@ -9,9 +9,27 @@ use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 use crate::GeomError;
 
+/// A constrained Delaunay triangulation ([`constrained_delaunay`]): counter-clockwise triangles
+/// as index triples into the input points, and for each triangle edge `s` (from vertex `s` to
+/// vertex `s + 1 mod 3`) the triangle across it and whether it is a constraint.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Cdt {
+    /// The triangles, covering the convex hull of the points.
+    pub tris: Vec<[usize; 3]>,
+    /// `across[k][s]`: the index of the triangle on the other side of edge `s` of triangle `k`,
+    /// or [`Cdt::HULL`] on the convex hull.
+    pub across: Vec<[u32; 3]>,
+    /// `constraint[k]`, bit `s`: edge `s` of triangle `k` is (a piece of) a segment.
+    pub constraint: Vec<u8>,
+}
+
+impl Cdt {
+    /// The value of [`Cdt::across`] for an edge on the convex hull.
+    pub const HULL: u32 = u32::MAX;
+}
+
 /// The constrained Delaunay triangulation of `points` with every segment of `segments` (pairs of
-/// indices into `points`) as an edge: the triangles, counter-clockwise, as index triples into
-/// `points`, covering the convex hull of the points.
+/// indices into `points`) as an edge, with triangle adjacency ([`Cdt`]).
 ///
 /// Points at the same position are one vertex, named by the first index that has it. A segment
 /// through other points is split there (its pieces are edges). Spade's predicates are exact
@@ -31,11 +49,11 @@ use crate::GeomError;
 /// # References
 ///
 /// - L. P. Chew. *Constrained Delaunay triangulations.* Algorithmica 4, 1989.
-/// - spade: `ConstrainedDelaunayTriangulation::try_add_constraint`.
+/// - spade: `ConstrainedDelaunayTriangulation::try_bulk_load_cdt`.
 pub(crate) fn constrained_delaunay(
     points: &[DVec2],
     segments: &[[usize; 2]],
-) -> Result<Vec<[usize; 3]>, GeomError> {
+) -> Result<Cdt, GeomError> {
     let mut largest = 0.0f64;
     for (i, p) in points.iter().enumerate() {
         if !p.is_finite() {
@@ -46,40 +64,72 @@ pub(crate) fn constrained_delaunay(
     let (s1, s2) = pow2_scale(largest);
     let min = spade::MIN_ALLOWED_VALUE;
     let flush = |x: f64| if x.abs() < min { 0.0 } else { x };
-    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
-        ConstrainedDelaunayTriangulation::new();
-    // The first input index at each spade vertex, and the spade vertex of each input point.
+    let scaled: Vec<Point2<f64>> = points
+        .iter()
+        .map(|p| {
+            let q = *p * s1 * s2;
+            Point2::new(flush(q.x), flush(q.y))
+        })
+        .collect();
+    // Points at the same position are one vertex, named by the first index that has it: sorted
+    // by bits, each run of equal positions maps to its smallest index.
+    let key = |p: &Point2<f64>| (p.x.to_bits(), p.y.to_bits());
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_unstable_by_key(|&i| (key(&scaled[i]), i));
+    let mut vertex_of = vec![0usize; points.len()];
     let mut first: Vec<usize> = Vec::with_capacity(points.len());
-    let mut handle = Vec::with_capacity(points.len());
-    for (i, p) in points.iter().enumerate() {
-        let q = *p * s1 * s2;
-        let h = cdt
-            .insert(Point2::new(flush(q.x), flush(q.y)))
-            .map_err(|_| GeomError::NonFinite { ring: 0, vertex: i })?;
-        if h.index() == first.len() {
+    let mut unique: Vec<Point2<f64>> = Vec::with_capacity(points.len());
+    for (k, &i) in order.iter().enumerate() {
+        if k == 0 || key(&scaled[i]) != key(&scaled[order[k - 1]]) {
             first.push(i);
+            unique.push(scaled[i]);
         }
-        handle.push(h);
+        vertex_of[i] = unique.len() - 1;
     }
+    let mut edges: Vec<[usize; 2]> = Vec::with_capacity(segments.len());
     for &[i, j] in segments {
-        let (hi, hj) = (handle[i], handle[j]);
-        if hi == hj {
-            continue;
-        }
-        if cdt.try_add_constraint(hi, hj).is_empty() {
-            return Err(GeomError::Undecidable(
-                "segments of the planar triangulation cross in rounded coordinates",
-            ));
+        let (a, b) = (vertex_of[i], vertex_of[j]);
+        if a != b {
+            edges.push([a, b]);
         }
     }
-    let mut out = vec![];
+    // Spade's bulk loading (vertices from the center outwards, constraints added as their
+    // nearer end is inserted) costs about n log n where inserting one point at a time walks
+    // from the last one; both keep the vertex order, so spade's vertex k is `unique[k]`.
+    let mut crossing = false;
+    let cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+        ConstrainedDelaunayTriangulation::try_bulk_load_cdt(unique, edges, |_| crossing = true)
+            .map_err(|_| GeomError::NonFinite { ring: 0, vertex: 0 })?;
+    if crossing {
+        return Err(GeomError::Undecidable(
+            "segments of the planar triangulation cross in rounded coordinates",
+        ));
+    }
+    // Spade numbers the outer face 0 and the inner faces from 1, in the order it iterates them.
+    let n = cdt.num_inner_faces();
+    let mut out = Cdt {
+        tris: Vec::with_capacity(n),
+        across: Vec::with_capacity(n),
+        constraint: Vec::with_capacity(n),
+    };
     for face in cdt.inner_faces() {
-        let [a, b, c] = face.vertices();
-        out.push([
-            first[a.fix().index()],
-            first[b.fix().index()],
-            first[c.fix().index()],
-        ]);
+        let edges = face.adjacent_edges();
+        let mut tri = [0usize; 3];
+        let mut across = [Cdt::HULL; 3];
+        let mut constraint = 0u8;
+        for (s, e) in edges.iter().enumerate() {
+            tri[s] = first[e.from().fix().index()];
+            if let Some(f) = e.rev().face().as_inner() {
+                across[s] = (f.fix().index() - 1) as u32;
+            }
+            if e.as_undirected().data().is_constraint_edge() {
+                constraint |= 1 << s;
+            }
+        }
+        debug_assert_eq!(face.fix().index() - 1, out.tris.len());
+        out.tris.push(tri);
+        out.across.push(across);
+        out.constraint.push(constraint);
     }
     Ok(out)
 }
@@ -116,9 +166,22 @@ mod tests {
             DVec2::new(0.0, 1.0),
             DVec2::new(1.0, 0.0), // a repeat of point 1
         ];
-        let tris = constrained_delaunay(&pts, &[[1, 3], [0, 4]]).unwrap();
+        let cdt = constrained_delaunay(&pts, &[[1, 3], [0, 4]]).unwrap();
+        let tris = &cdt.tris;
         assert_eq!(tris.len(), 2);
-        for t in &tris {
+        // The two triangles are across the constraint 1-3 from each other, and the hull
+        // elsewhere; the constraints are 1-3 and 0-1 (segment 0-4, 4 a repeat of 1).
+        for (k, t) in tris.iter().enumerate() {
+            for s in 0..3 {
+                let e = [t[s], t[(s + 1) % 3]];
+                let diagonal = e.contains(&1) && e.contains(&3);
+                let bottom = e.contains(&0) && e.contains(&1);
+                assert_eq!(cdt.across[k][s] == 1 - k as u32, diagonal);
+                assert_eq!(cdt.across[k][s] == Cdt::HULL, !diagonal);
+                assert_eq!(cdt.constraint[k] & (1 << s) != 0, diagonal || bottom);
+            }
+        }
+        for t in tris {
             // Counter-clockwise, and the constraint 1-3 is an edge of both.
             let [a, b, c] = t.map(|i| pts[i]);
             assert!((b - a).perp_dot(c - a) > 0.0);
@@ -147,7 +210,7 @@ mod tests {
                 DVec2::new(1.0, 1.0) * k,
                 DVec2::new(0.0, 1.0) * k,
             ];
-            assert_eq!(constrained_delaunay(&pts, &[[0, 2]]).unwrap().len(), 2);
+            assert_eq!(constrained_delaunay(&pts, &[[0, 2]]).unwrap().tris.len(), 2);
         }
     }
 }

@@ -5,14 +5,16 @@
 //!   a shading point. Which part of each light the point sees comes from the visibility layer
 //!   ([`crate::visibility::ClipVisibility`], the exact rule of [`Scene::visible_region`]; for
 //!   convex and planar lights with separated blockers its fast path,
-//!   [`crate::visibility::ClipVisibility::visible_pieces`]). [`Scene::shade_with`] reuses a
+//!   [`crate::visibility::ClipVisibility::visible_pieces`]). [`Scene::shade_in`] reuses a
 //!   [`ShadeContext`] (scratch storage, one per thread).
 //! - [`Scene::shade_per_light`]: every light's share, split into diffuse and specular lobes,
 //!   with its unshadowed value ([`LightShading`]), for denoising and ratio estimators.
 //! - [`Material`]: Lambert + GGX with Schlick's Fresnel.
 //! - [`MonteCarlo`]: an estimator of the same radiance (solid-angle sampling of the lights'
-//!   triangles, exact ray-triangle visibility), with its standard error, for tests and
-//!   comparisons.
+//!   triangulated silhouettes or of their faces, [`LightSampling`]; exact ray-triangle
+//!   visibility), with its standard error, for tests and comparisons.
+//! - [`RatioEstimator`]: the analytic unshadowed radiance times a Monte Carlo estimate of the
+//!   shadow ratio (\[HHM18\], the baseline of seed 000 section 4.2).
 //!
 //! The geometry types of the scene live in [`crate::solid`] and are re-exported here
 //! ([`TriangleMesh`], [`ConvexPolyhedron`], [`Body`], [`ShadingFrame`]).
@@ -59,16 +61,27 @@
 //!   section 6 (solid-angle sampling of silhouettes, \[Arv95\], \[Pet20\]).
 //! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
+//! - \[HHM18\] E. Heitz, S. Hill, M. McGuire. *Combining analytic direct illumination and
+//!   stochastic shadows.* I3D 2018.
 
+mod batch;
 pub(crate) mod demo;
 mod material;
 mod query;
+pub mod ratio;
 pub(crate) mod reference;
 mod scene;
+mod two_sided;
+mod validate;
 
 pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 pub use crate::visibility::{Blocker, Method};
+pub use batch::BatchResult;
+#[cfg(feature = "rayon")]
+pub use batch::PAR_MIN_RUN;
 pub use material::Material;
 pub use query::{LightShading, ShadeContext};
-pub use reference::{Estimate, MonteCarlo, ReferenceBrdf};
+pub use ratio::{LightRatio, RatioEstimator};
+pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf};
 pub use scene::{Light, Scene};
+pub use validate::{SceneIssue, SceneReport};

@@ -11,7 +11,7 @@
 //! pieces cut by half-spaces, never built as spherical polygons, integrated as they are) where it
 //! applies, and from the spherical path ([`ClipVisibility::visible_region`]) elsewhere; the two
 //! agree to rounding (`tests/shade_speed.rs`). A [`ShadeContext`] holds the fast path's scratch
-//! storage: [`Scene::shade_with`] reuses the caller's, [`Scene::shade`] makes one on the stack.
+//! storage: [`Scene::shade_in`] reuses the caller's, [`Scene::shade`] makes one on the stack.
 
 use alloc::vec::Vec;
 
@@ -19,7 +19,6 @@ use glam::{DMat3, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::GeomError;
 use crate::ltc::{
     clamped_cosine_integral_upper, lookup, ltc_integral, ltc_rings_integral, upper_rings_integral,
 };
@@ -28,6 +27,7 @@ use crate::sphere::SphericalPolygon;
 #[cfg(doc)]
 use crate::visibility::ClipVisibility;
 use crate::visibility::{Pieces, Visibility};
+use crate::{GeomError, IntoDVec3};
 
 /// What a failed LTC lookup or integral reports: the frame's view and the material were
 /// validated, and the visible region is a valid polygon, so any error is a give-up.
@@ -71,9 +71,22 @@ impl LightShading {
 /// The LTC inverse matrix and the per-channel specular scale (`norm` with Schlick's Fresnel,
 /// [`crate::ltc::LtcLookup::specular_scale`]) for the frame's view angle and the material's
 /// roughness; `None` for a material without a specular lobe. One table lookup per shading point.
-type SpecularSetup = Option<(DMat3, DVec3)>;
+pub(super) type SpecularSetup = Option<(DMat3, DVec3)>;
 
-fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularSetup, GeomError> {
+/// The shading frame of the entry points' arguments, widened at the boundary
+/// ([`IntoDVec3`]).
+fn frame(
+    point: impl IntoDVec3,
+    normal: impl IntoDVec3,
+    view: impl IntoDVec3,
+) -> Result<ShadingFrame, GeomError> {
+    ShadingFrame::new(point.into_dvec3(), normal.into_dvec3(), view.into_dvec3())
+}
+
+pub(super) fn specular_setup(
+    frame: &ShadingFrame,
+    material: &Material,
+) -> Result<SpecularSetup, GeomError> {
     if !material.has_specular() {
         return Ok(None);
     }
@@ -87,7 +100,7 @@ fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularS
     Ok(Some((look.m_inv, scale)))
 }
 
-/// Scratch storage and counters of shading queries ([`Scene::shade_with`]): the visibility fast
+/// Scratch storage and counters of shading queries ([`Scene::shade_in`]): the visibility fast
 /// path's [`Pieces`], kept so that their buffers are reused from one query to the next.
 ///
 /// Inline storage covers lights and blockers of up to 16 vertices, so neither a context kept by
@@ -106,7 +119,7 @@ fn specular_setup(frame: &ShadingFrame, material: &Material) -> Result<SpecularS
 /// let mut ctx = ShadeContext::new();
 /// for k in 0..4 {
 ///     let x = DVec3::new(0.1 * k as f64, 0.0, 0.0);
-///     let rgb = scene.shade_with(&mut ctx, x, DVec3::Z, DVec3::Z, &white)?;
+///     let rgb = scene.shade_in(&mut ctx, x, DVec3::Z, DVec3::Z, &white)?;
 ///     assert_eq!(rgb, scene.shade(x, DVec3::Z, DVec3::Z, &white)?);
 /// }
 /// // A quad light seen from the front: every query took the fast path.
@@ -168,7 +181,10 @@ fn piece_integrals(pieces: &Pieces, spec: SpecularSetup) -> Option<(f64, f64)> {
 
 /// The diffuse (clamped cosine over pi) and LTC integrals over region pieces already clipped to
 /// the upper hemisphere; the second is zero without a specular lobe.
-fn integrals(pieces: &[SphericalPolygon], spec: SpecularSetup) -> Result<(f64, f64), GeomError> {
+pub(super) fn integrals(
+    pieces: &[SphericalPolygon],
+    spec: SpecularSetup,
+) -> Result<(f64, f64), GeomError> {
     let (mut diffuse, mut specular) = (0.0, 0.0);
     for piece in pieces {
         diffuse += clamped_cosine_integral_upper(piece);
@@ -179,15 +195,46 @@ fn integrals(pieces: &[SphericalPolygon], spec: SpecularSetup) -> Result<(f64, f
     Ok((diffuse, specular))
 }
 
+/// The diffuse and LTC integrals of light `i`'s visible region (`blocked`) or of its region
+/// with every other object removed, as `vis` gives it: from the backend's fast path
+/// ([`Visibility::visible_pieces`]) where it has one that applies, else from its spherical
+/// polygons ([`Visibility::visible_region`], [`Visibility::unoccluded_region`]). Counted in
+/// `ctx`.
+pub(super) fn region_integrals<V: Visibility + ?Sized>(
+    vis: &V,
+    i: usize,
+    frame: &ShadingFrame,
+    spec: SpecularSetup,
+    blocked: bool,
+    ctx: &mut ShadeContext,
+) -> Result<(f64, f64), GeomError> {
+    if vis.visible_pieces(i, frame, blocked, &mut ctx.pieces)?
+        && let Some(v) = piece_integrals(&ctx.pieces, spec)
+    {
+        ctx.fast += 1;
+        return Ok(v);
+    }
+    ctx.spherical += 1;
+    // The spherical path's pieces are already clipped to the upper hemisphere.
+    let region = if blocked {
+        vis.visible_region(i, frame)?
+    } else {
+        vis.unoccluded_region(i, frame)?
+    };
+    integrals(&region, spec)
+}
+
 impl Scene {
     /// The outgoing radiance (RGB) at `point` towards `view`, for a surface with normal
     /// `normal` and material `material`: seed 000 Alg. 1 summed over the lights.
     ///
     /// `view` points from the surface towards the viewer; `normal` and `view` need not be
-    /// normalized. For each light the visible region is computed in the shading frame
-    /// ([`Scene::visible_region`]), and integrated with Baum's formula for the diffuse lobe and,
-    /// after the LTC transform `M^-1` looked up for the view angle and roughness, for the GGX lobe
-    /// (HDHN16 eq. 2 / seed 000 eq. 2, Alg. 1 lines 13-16).
+    /// normalized. All three may be `f32` (glam's `Vec3`, `Vec3A`, `[f32; 3]`, see
+    /// [`IntoDVec3`]): they are widened exactly, and the computation is `f64`. For each light
+    /// the visible region is computed in the shading frame ([`Scene::visible_region`]), and
+    /// integrated with Baum's formula for the diffuse lobe and, after the LTC transform `M^-1`
+    /// looked up for the view angle and roughness, for the GGX lobe (HDHN16 eq. 2 / seed 000
+    /// eq. 2, Alg. 1 lines 13-16).
     ///
     /// # Errors
     ///
@@ -211,41 +258,100 @@ impl Scene {
     /// covers the half-space behind the faces it lies on (a hemisphere seen from a point on a
     /// face, a lune from an edge), so such a point sees the light only through the other side
     /// of those face planes; a mesh occluder's triangles seen edge-on cover nothing. A point on
-    /// a planar light's plane sees none of that light (it is seen edge-on); a point on a convex
-    /// light sees the part of the sphere its silhouette path gives (see the
-    /// [module documentation](crate::shade)).
+    /// a planar light's plane sees none of that light (it is seen edge-on); a point inside a
+    /// closed light that bounds a solid, or on a convex light's surface, receives nothing from
+    /// it.
     ///
-    /// Each call makes a [`ShadeContext`] on the stack; [`Scene::shade_with`] reuses one.
+    /// Each call makes a [`ShadeContext`] on the stack; [`Scene::shade_in`] reuses one.
     pub fn shade(
         &self,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
-        self.shade_with(&mut ShadeContext::new(), point, normal, view, material)
+        self.shade_in(&mut ShadeContext::new(), point, normal, view, material)
     }
 
-    /// [`Scene::shade`] with the caller's scratch storage: the same value, without setting up a
-    /// context per call, and with the context's counters of which path each light took. Keep one
-    /// [`ShadeContext`] per thread.
+    /// [`Scene::shade`] in the caller's [`ShadeContext`]: the same value, bit for bit, without
+    /// setting up scratch storage per call, and with the context's counters of which path each
+    /// light took. Keep one context per thread.
     ///
     /// # Errors
     ///
     /// As [`Scene::shade`].
-    pub fn shade_with(
+    pub fn shade_in(
         &self,
         ctx: &mut ShadeContext,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        let frame = frame(point, normal, view)?;
+        let mut total = DVec3::ZERO;
+        let spec = specular_setup(&frame, material)?;
+        for i in 0..self.lights().len() {
+            total += self.shade_light_in(i, &frame, material, spec, ctx)?;
+        }
+        Ok(total)
+    }
+
+    /// [`Scene::shade`] with the visible regions of another [`Visibility`] backend over the same
+    /// lights and occluders, e.g. a
+    /// [`PluckerVisibility`](crate::visibility::PluckerVisibility) built from
+    /// [`Scene::visibility`] (or one of its per-thread
+    /// [`PluckerVisibility::with_context`](crate::visibility::PluckerVisibility::with_context)
+    /// views, which reuse trees across calls). The integration is [`Scene::shade`]'s.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::shade::{ConvexPolyhedron, Light, Material, Scene, TriangleMesh};
+    /// use arealight::visibility::PluckerVisibility;
+    /// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+    /// let cube = ConvexPolyhedron::cuboid(DVec3::new(0.3, 0.0, 1.5), DVec3::splat(0.25))?;
+    /// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![cube.into()])?;
+    /// let floor = Material::new(DVec3::splat(0.8), DVec3::splat(0.04), 0.5)?;
+    /// let (x, n, v) = (DVec3::ZERO, DVec3::Z, DVec3::new(0.3, 0.0, 1.0));
+    /// let clip = scene.shade(x, n, v, &floor)?;
+    /// assert_eq!(scene.shade_with(scene.visibility(), x, n, v, &floor)?, clip);
+    /// let plucker = PluckerVisibility::from_clip(scene.visibility().clone());
+    /// let lazy = scene.shade_with(&plucker, x, n, v, &floor)?;
+    /// assert!((lazy - clip).abs().max_element() <= 1e-12 * clip.max_element());
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`]; [`GeomError::OutOfRange`] when `vis` has another number of lights.
+    pub fn shade_with(
+        &self,
+        vis: &dyn Visibility,
         point: DVec3,
         normal: DVec3,
         view: DVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
+        if vis.light_count() != self.lights().len() {
+            return Err(GeomError::OutOfRange {
+                what: "light count of the visibility backend (the scene's)",
+                value: vis.light_count() as f64,
+                limit: self.lights().len() as f64,
+            });
+        }
         let frame = ShadingFrame::new(point, normal, view)?;
-        let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
-        for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, spec, ctx)?;
+        let mut ctx = ShadeContext::new();
+        let mut total = DVec3::ZERO;
+        for (i, light) in self.lights().iter().enumerate() {
+            let (diffuse, specular) = region_integrals(vis, i, &frame, spec, true, &mut ctx)?;
+            let mut out = material.albedo() * diffuse;
+            if let Some((_, scale)) = spec {
+                out += scale * specular;
+            }
+            total += out * light.radiance();
         }
         Ok(total)
     }
@@ -258,13 +364,13 @@ impl Scene {
     pub fn shade_light(
         &self,
         light: usize,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
         self.light(light)?;
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
         self.shade_light_in(light, &frame, material, spec, &mut ShadeContext::new())
     }
@@ -302,18 +408,19 @@ impl Scene {
     /// As [`Scene::shade`].
     pub fn shade_per_light(
         &self,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<Vec<LightShading>, GeomError> {
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
         let mut ctx = ShadeContext::new();
         let mut out = Vec::with_capacity(self.lights().len());
         for (i, light) in self.lights().iter().enumerate() {
-            let unshadowed = self.light_integrals(i, &frame, spec, false, &mut ctx)?;
-            let shadowed = self.light_integrals(i, &frame, spec, true, &mut ctx)?;
+            let vis = self.light_visibility(i, &frame);
+            let unshadowed = region_integrals(vis, i, &frame, spec, false, &mut ctx)?;
+            let shadowed = region_integrals(vis, i, &frame, spec, true, &mut ctx)?;
             // The two regions may come from different paths (the fast path declines only where a
             // blocker needs the spherical one), which agree to rounding: the visible part of a
             // light never gives more than the whole.
@@ -335,63 +442,6 @@ impl Scene {
         Ok(out)
     }
 
-    /// The diffuse and LTC integrals of light `i`'s visible region (`blocked`) or of its region
-    /// with every other object removed: from the fast path where it applies, else from the
-    /// spherical path.
-    fn light_integrals(
-        &self,
-        i: usize,
-        frame: &ShadingFrame,
-        spec: SpecularSetup,
-        blocked: bool,
-        ctx: &mut ShadeContext,
-    ) -> Result<(f64, f64), GeomError> {
-        match self.fast_integrals(i, frame, spec, blocked, ctx)? {
-            Some(v) => Ok(v),
-            None => self.spherical_integrals(i, frame, spec, blocked, ctx),
-        }
-    }
-
-    /// [`Scene::light_integrals`] from the fast path, `None` where it does not apply.
-    fn fast_integrals(
-        &self,
-        i: usize,
-        frame: &ShadingFrame,
-        spec: SpecularSetup,
-        blocked: bool,
-        ctx: &mut ShadeContext,
-    ) -> Result<Option<(f64, f64)>, GeomError> {
-        if self
-            .visibility()
-            .visible_pieces(i, frame, blocked, &mut ctx.pieces)?
-            && let Some(v) = piece_integrals(&ctx.pieces, spec)
-        {
-            ctx.fast += 1;
-            return Ok(Some(v));
-        }
-        Ok(None)
-    }
-
-    /// [`Scene::light_integrals`] from the spherical path.
-    fn spherical_integrals(
-        &self,
-        i: usize,
-        frame: &ShadingFrame,
-        spec: SpecularSetup,
-        blocked: bool,
-        ctx: &mut ShadeContext,
-    ) -> Result<(f64, f64), GeomError> {
-        ctx.spherical += 1;
-        let vis = self.visibility();
-        // The spherical path's pieces are already clipped to the upper hemisphere.
-        let region = if blocked {
-            vis.visible_region(i, frame)?
-        } else {
-            vis.unoccluded_region(i, frame)?
-        };
-        integrals(&region, spec)
-    }
-
     fn shade_light_in(
         &self,
         i: usize,
@@ -401,7 +451,8 @@ impl Scene {
         ctx: &mut ShadeContext,
     ) -> Result<DVec3, GeomError> {
         let light = &self.lights()[i];
-        let (diffuse, specular) = self.light_integrals(i, frame, spec, true, ctx)?;
+        let vis = self.light_visibility(i, frame);
+        let (diffuse, specular) = region_integrals(vis, i, frame, spec, true, ctx)?;
         let mut out = material.albedo() * diffuse;
         if let Some((_, scale)) = spec {
             out += scale * specular;

@@ -10,18 +10,32 @@ use crate::sphere::SphericalPolygon;
 use crate::visibility::{Blocker, ClipVisibility, Method};
 
 /// An area light: a body emitting the uniform RGB radiance `radiance` from its outer surface.
+///
+/// # Which side emits
+///
+/// Only the front side of each triangle emits: the side its normal points to, from which its
+/// corners run counter-clockwise ([`TriangleMesh`](crate::solid::TriangleMesh)). For
+/// [`TriangleMesh::quad(c, u, v)`](crate::solid::TriangleMesh::quad) that is the side `u x v`
+/// points to; for a closed mesh or a convex polyhedron, the outside. A light facing away from
+/// everything gives a black image and no error: [`Scene::validate`] reports it. A planar light
+/// made with [`Light::two_sided`] emits from both sides.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Light {
     body: Body,
     radiance: DVec3,
+    two_sided: bool,
 }
 
 impl Light {
-    /// A light of the given geometry and RGB radiance.
+    /// A light of the given geometry and RGB radiance, emitting from the front side of its
+    /// triangles only (see "Which side emits" above; [`Light::two_sided`] for both sides).
     ///
     /// # Errors
     ///
-    /// [`GeomError::OutOfRange`] for a negative or non-finite radiance component.
+    /// - [`GeomError::OutOfRange`] for a negative or non-finite radiance component;
+    /// - [`GeomError::OverlappingLightTriangles`] for a planar mesh whose triangles overlap
+    ///   (each would emit over the overlap: a planar light's triangles are integrated as
+    ///   disjoint pieces).
     pub fn new(body: impl Into<Body>, radiance: DVec3) -> Result<Self, GeomError> {
         for c in radiance.to_array() {
             if !(c >= 0.0 && c.is_finite()) {
@@ -32,10 +46,60 @@ impl Light {
                 });
             }
         }
+        let body = body.into();
+        if let Some((triangle, other)) = body.mesh().planar_overlap() {
+            return Err(GeomError::OverlappingLightTriangles { triangle, other });
+        }
         Ok(Light {
-            body: body.into(),
+            body,
             radiance,
+            two_sided: false,
         })
+    }
+
+    /// A planar light that emits `radiance` from both of its sides: from behind its plane it
+    /// gives what the same light turned around ([`TriangleMesh::flipped`]) would give, in
+    /// front what it gives as built. Its geometry blocks other lights as any light's does.
+    ///
+    /// Costs nothing per shading point over a one-sided light (one facing test picks the side);
+    /// a scene with two-sided lights keeps a second copy of its visibility data for the back
+    /// sides, built by [`Scene::new`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Light::new`]; [`GeomError::Degenerate`] for a body that is not a planar
+    /// [`TriangleMesh`] (a closed light has no second side to show, and a curved open mesh
+    /// would need a facing decision per triangle).
+    ///
+    /// [`TriangleMesh`]: crate::solid::TriangleMesh
+    /// [`TriangleMesh::flipped`]: crate::solid::TriangleMesh::flipped
+    pub fn two_sided(body: impl Into<Body>, radiance: DVec3) -> Result<Self, GeomError> {
+        let mut light = Light::new(body, radiance)?;
+        match &light.body {
+            Body::Mesh(m) if m.is_planar() => {}
+            _ => {
+                return Err(GeomError::Degenerate(
+                    "a two-sided light must be a planar TriangleMesh",
+                ));
+            }
+        }
+        light.two_sided = true;
+        Ok(light)
+    }
+
+    /// Whether the light emits from both sides ([`Light::two_sided`]).
+    #[must_use]
+    pub fn is_two_sided(&self) -> bool {
+        self.two_sided
+    }
+
+    /// The same light with another geometry (the turned-around copy of a two-sided light).
+    pub(super) fn with_body(&self, body: Body) -> Light {
+        Light {
+            body,
+            radiance: self.radiance,
+            two_sided: self.two_sided,
+        }
     }
 
     /// The light's geometry.
@@ -93,6 +157,9 @@ impl AsRef<Body> for Light {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
     vis: ClipVisibility<Light>,
+    /// With two-sided lights: the same scene with each of them turned around
+    /// ([`Scene::light_visibility`]).
+    back: Option<ClipVisibility<Light>>,
 }
 
 impl Scene {
@@ -106,8 +173,10 @@ impl Scene {
     /// None today (lights and shapes are validated when built); the `Result` leaves room for
     /// scene-level checks.
     pub fn new(lights: Vec<Light>, occluders: Vec<Body>) -> Result<Self, GeomError> {
+        let back = super::two_sided::back_visibility(&lights, &occluders);
         Ok(Scene {
             vis: ClipVisibility::new(lights, occluders),
+            back,
         })
     }
 
@@ -115,6 +184,7 @@ impl Scene {
     #[must_use]
     pub fn with_method(mut self, method: Method) -> Self {
         self.vis = self.vis.with_method(method);
+        self.back = self.back.map(|b| b.with_method(method));
         self
     }
 
@@ -136,10 +206,27 @@ impl Scene {
         self.vis.occluders()
     }
 
-    /// The visibility backend.
+    /// The visibility backend. It holds every light as built: queries of a two-sided light
+    /// ([`Light::two_sided`]) from behind its plane go to a copy of the scene in which that
+    /// light is turned around.
     #[must_use]
     pub fn visibility(&self) -> &ClipVisibility<Light> {
         &self.vis
+    }
+
+    /// The visibility backend that holds light `light` facing the frame's point where it can:
+    /// [`Scene::visibility`], or for a two-sided light whose plane has the point behind it, the
+    /// copy of the scene with that light turned around. Every query of one light goes through
+    /// here, so the rest of the crate sees one-sided lights only.
+    pub(crate) fn light_visibility(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+    ) -> &ClipVisibility<Light> {
+        match &self.back {
+            Some(back) if super::two_sided::seen_from_behind(self.lights(), light, frame) => back,
+            _ => &self.vis,
+        }
     }
 
     /// Light `i`, or [`GeomError::OutOfRange`] past the end.
@@ -158,7 +245,7 @@ impl Scene {
         light: usize,
         frame: &ShadingFrame,
     ) -> impl Iterator<Item = usize> + '_ {
-        self.vis
+        self.light_visibility(light, frame)
             .blockers_between(light, frame)
             .filter_map(|b| match b {
                 Blocker::Occluder(k) => Some(k),
@@ -173,7 +260,8 @@ impl Scene {
         light: usize,
         frame: &ShadingFrame,
     ) -> impl Iterator<Item = Blocker> + '_ {
-        self.vis.blockers_between(light, frame)
+        self.light_visibility(light, frame)
+            .blockers_between(light, frame)
     }
 
     /// The part of light `light` visible from the frame's point, in the shading frame, clipped to
@@ -188,7 +276,8 @@ impl Scene {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        self.vis.visible_region(light, frame)
+        self.light_visibility(light, frame)
+            .visible_region(light, frame)
     }
 
     /// The region light `light` covers seen from the frame's point, before any blocker
@@ -202,6 +291,7 @@ impl Scene {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
-        self.vis.light_region(light, frame)
+        self.light_visibility(light, frame)
+            .light_region(light, frame)
     }
 }

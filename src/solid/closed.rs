@@ -10,7 +10,7 @@ use robust::{Coord, orient2d, orient3d};
 
 use super::mesh::TriangleMesh;
 use crate::GeomError;
-use crate::sphere::predicates::c3;
+use crate::sphere::predicates::{c3, triangle_solid_angle};
 
 /// A closed triangle mesh that bounds a solid: every edge is shared by exactly two triangles
 /// running opposite ways, the triangles around every vertex form a single fan, and no two
@@ -107,6 +107,34 @@ impl ClosedMesh {
     #[must_use]
     pub fn mesh(&self) -> &TriangleMesh {
         &self.mesh
+    }
+
+    /// Whether `x` lies inside the solid, decided by the generalized winding number: the sum of
+    /// the signed solid angles of the triangles seen from `x` (Van Oosterom and Strackee 1983)
+    /// is `4 pi` inside a closed, outward-oriented surface and `0` outside; a point on the
+    /// surface gets about `2 pi` from the triangles it lies on and counts as outside. Rounding
+    /// moves the sum by far less than the `2 pi` margin except within rounding distance of the
+    /// surface, where either answer describes the same point.
+    ///
+    /// Why a light needs it: seen from inside, every ray leaves the solid through a back face
+    /// before it can meet a front one, so a closed light sends nothing to an interior point,
+    /// although the union of its front faces' projections is not empty when it is not convex.
+    #[must_use]
+    pub fn encloses(&self, x: DVec3) -> bool {
+        let b = self.mesh.bounding_sphere();
+        if (x - b.center).length_squared() > b.radius * b.radius {
+            return false;
+        }
+        let verts = self.mesh.vertices();
+        let mut total = 0.0;
+        for t in self.mesh.triangles() {
+            // A vertex at the point itself (on the surface) adds nothing.
+            if let [Some(a), Some(b), Some(c)] = t.map(|i| (verts[i as usize] - x).try_normalize())
+            {
+                total += triangle_solid_angle(a, b, c);
+            }
+        }
+        total > 2.0 * core::f64::consts::TAU * 0.75
     }
 
     /// The mesh, giving up the validation.

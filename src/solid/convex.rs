@@ -7,7 +7,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use robust::orient3d;
 
-use super::facing::{Side, face_distances, face_side};
+use super::facing::{FACE_TOLERANCE, Side, face_distances, face_side};
 use super::mesh::{BoundingSphere, DEGENERATE_TRIANGLE, MeshEdge, TriangleMesh, check_vertices};
 use crate::GeomError;
 use crate::sphere::predicates::c3;
@@ -125,6 +125,21 @@ impl ConvexPolyhedron {
     /// `face_side(mesh, f, x)`).
     pub(crate) fn facing(&self, x: DVec3, out: &mut Vec<f64>) -> f64 {
         face_distances(&self.mesh, x, out)
+    }
+
+    /// Whether some face is strictly in front of `x` by the facing predicate. A point with none
+    /// is inside the polyhedron or on its surface: as a light it sends nothing there (its outer
+    /// surface faces away everywhere), while as a blocker it covers what
+    /// [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) says.
+    pub(crate) fn has_front_face(&self, x: DVec3) -> bool {
+        let b = self.mesh.bounding_sphere();
+        let rel = x - b.center;
+        let tol = FACE_TOLERANCE * (b.radius + rel.length());
+        self.mesh
+            .normals()
+            .iter()
+            .zip(self.mesh.offsets())
+            .any(|(n, d)| Side::of(n.dot(rel) - d, tol) == Side::Front)
     }
 }
 

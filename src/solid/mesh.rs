@@ -257,11 +257,81 @@ impl TriangleMesh {
     }
 
     /// Whether every vertex lies in one plane and every triangle faces the same way (a flat
-    /// light such as a quad). The triangles of a planar mesh are assumed not to overlap, so their
-    /// projections from any point are disjoint.
+    /// light such as a quad). A planar light's triangles must not overlap, so that their
+    /// projections from any point are disjoint ([`Light::new`](crate::shade::Light::new) checks).
     #[must_use]
     pub fn is_planar(&self) -> bool {
         self.planar
+    }
+
+    /// For a planar mesh, the first pair of triangles (by index) whose interiors overlap, or
+    /// `None` (also for a non-planar mesh). Exact: the triangles are projected to the coordinate
+    /// plane their common normal is most nearly perpendicular to, which keeps the coordinates
+    /// as given, and two triangles have disjoint interiors iff an edge line of one has the other
+    /// on its closed outer side (separating axes of two convex polygons), decided by Shewchuk's
+    /// `orient2d`. Boxes are swept along the first coordinate, so the cost is about `n log n`
+    /// plus the pairs whose boxes overlap.
+    pub(crate) fn planar_overlap(&self) -> Option<(usize, usize)> {
+        if !self.planar {
+            return None;
+        }
+        let n = self.normals[0].abs();
+        let (i, j) = if n.x >= n.y && n.x >= n.z {
+            (1, 2)
+        } else if n.y >= n.z {
+            (2, 0)
+        } else {
+            (0, 1)
+        };
+        let p = |v: u32| {
+            let v = self.vertices[v as usize].to_array();
+            robust::Coord { x: v[i], y: v[j] }
+        };
+        // Counter-clockwise in the projection: the orientation every triangle shares.
+        let tris: Vec<[robust::Coord<f64>; 3]> = self
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(p);
+                if robust::orient2d(a, b, c) < 0.0 {
+                    [a, c, b]
+                } else {
+                    [a, b, c]
+                }
+            })
+            .collect();
+        // Each triangle's extent along the first coordinate, for the sweep.
+        let spans: Vec<(f64, f64)> = tris
+            .iter()
+            .map(|t| {
+                let xs = t.map(|c| c.x);
+                (xs[0].min(xs[1]).min(xs[2]), xs[0].max(xs[1]).max(xs[2]))
+            })
+            .collect();
+        let separated = |s: &[robust::Coord<f64>; 3], t: &[robust::Coord<f64>; 3]| {
+            (0..3).any(|k| {
+                let (a, b) = (s[k], s[(k + 1) % 3]);
+                t.iter().all(|&c| robust::orient2d(a, b, c) <= 0.0)
+            })
+        };
+        let mut order: Vec<usize> = (0..tris.len()).collect();
+        order.sort_by(|&a, &b| spans[a].0.total_cmp(&spans[b].0));
+        let mut found: Option<(usize, usize)> = None;
+        for (k, &a) in order.iter().enumerate() {
+            let hi = spans[a].1;
+            for &b in &order[k + 1..] {
+                if spans[b].0 >= hi {
+                    break;
+                }
+                if !separated(&tris[a], &tris[b]) && !separated(&tris[b], &tris[a]) {
+                    let pair = (a.min(b), a.max(b));
+                    if found.is_none_or(|f| pair < f) {
+                        found = Some(pair);
+                    }
+                }
+            }
+        }
+        found
     }
 
     /// Whether the mesh is a closed, consistently oriented surface: every directed edge `a -> b`
@@ -351,6 +421,39 @@ impl TriangleMesh {
             loops.push(ring);
         }
         loops
+    }
+
+    /// The same surface facing the other way: each triangle's corners in reverse order (the
+    /// first corner kept), so every normal, and the side a light emits from, is turned around.
+    ///
+    /// Exact: the normals and plane offsets are the negated ones, bit for bit (what
+    /// [`TriangleMesh::new`] would compute for the reversed triangles), so the facing predicate
+    /// ([`crate::solid::face_side`]) gives exactly the opposite side for every point.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::solid::TriangleMesh;
+    /// let down = TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y, DVec3::X)?;
+    /// assert_eq!(down.triangle_normal(0), DVec3::NEG_Z);
+    /// assert_eq!(down.flipped().triangle_normal(0), DVec3::Z);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    #[must_use]
+    pub fn flipped(&self) -> TriangleMesh {
+        let triangles: Vec<[u32; 3]> = self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect();
+        let (edges, closed) = edge_adjacency(&triangles);
+        TriangleMesh {
+            vertices: self.vertices.clone(),
+            triangles,
+            normals: self.normals.iter().map(|n| -*n).collect(),
+            offsets: self.offsets.iter().map(|d| -d).collect(),
+            edges,
+            bounds: self.bounds,
+            planar: self.planar,
+            closed,
+        }
     }
 
     /// The mesh of all triangles of `self` and `other` (no vertices are merged).

@@ -8,6 +8,7 @@
 //! - [`ConvexPolyhedron`]: a closed convex mesh, validated or built as a convex hull, and the
 //!   primitives (`cuboid`, `icosphere`, `ellipsoid`, `frustum`; [`TriangleMesh::quad`]).
 //! - [`Body`]: the geometry of one object of a scene, either of the two.
+//! - [`Bvh`]: a bounding-volume hierarchy over a mesh's triangles, for culling.
 //! - [`ShadingFrame`]: the local frame of a shading point.
 //! - [`face_side`]: the one facing predicate (does a mesh triangle face a point), with its
 //!   tolerance [`FACE_TOLERANCE`].
@@ -22,6 +23,7 @@
 //! - Thesis 003: section 4.2 (silhouettes of convex polyhedra oriented by front faces).
 
 mod body;
+mod bvh;
 mod closed;
 mod convex;
 pub(crate) mod facing;
@@ -32,9 +34,12 @@ mod primitives;
 pub(crate) mod separation;
 pub(crate) mod silhouette;
 
-pub use silhouette::{DEFAULT_REGION_RADII, SilhouetteBsp, nonconvex_silhouette};
+pub use silhouette::{
+    DEFAULT_REGION_RADII, SilhouetteBsp, SilhouetteSampler, TriangleSource, nonconvex_silhouette,
+};
 
 pub use body::Body;
+pub use bvh::Bvh;
 pub use closed::ClosedMesh;
 pub use convex::ConvexPolyhedron;
 pub use facing::{FACE_TOLERANCE, Side, face_side};

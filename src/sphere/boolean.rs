@@ -10,7 +10,7 @@ use smallvec::SmallVec;
 use super::clip::HORIZON_TOLERANCE;
 use super::gnomonic::{Gnomonic, enclosing_cap};
 use super::order::order_directed_edges;
-use super::polygon::{SphericalPolygon, Verts, close_ring};
+use super::polygon::{SphericalPolygon, Verts, close_ring, regularized};
 use super::predicates::tangent_frame;
 use crate::GeomError;
 use crate::planar::{BoolOp, Shape, boolean};
@@ -58,12 +58,21 @@ impl SphericalPolygon {
     /// # Ok::<(), arealight::GeomError>(())
     /// ```
     ///
+    /// The result is always a valid input ([`SphericalPolygon::validate`]). The operation works
+    /// at a resolution of about `1e-11` rad (see the weld tolerance): vertex copies closer than
+    /// that become one vertex and vertices that close to the other operand's edges are put on
+    /// them, and result rings thinner than validation accepts are dropped, so that the region
+    /// moves by at most that distance times the length of the edges involved.
+    ///
     /// # Errors
     ///
     /// Only [`GeomError::Undecidable`] (both operands are valid polygons, so nothing else can be
-    /// wrong with the input): when the planar operation cannot resolve a configuration in `f64`,
-    /// or when the merged pieces fail to close into valid rings; valid operands in exactly
-    /// degenerate positions (shared vertices and edges) are supported.
+    /// wrong with the input), when `f64` cannot resolve the operands' contacts consistently (the
+    /// planar operation does not settle, or neither a projection nor the octant split, in the
+    /// coordinate frame or a rotated one, gives a valid result); valid operands
+    /// in exactly degenerate positions (shared vertices and edges) are supported. In the crate's
+    /// tests this happens for about one difference in ten thousand of a chain over a mesh whose
+    /// vertex copies are jittered by `1e-11`.
     pub fn boolean(
         &self,
         other: &SphericalPolygon,
@@ -81,22 +90,54 @@ impl SphericalPolygon {
         if let Ok((c, cos_r)) = enclosing_cap(&verts)
             && cos_r >= MIN_CAP_COS
         {
-            match projected(self, other, op, c) {
-                // The planar operation could not settle a configuration within rounding in this
-                // projection; the octant split sees it in other coordinates (and usually in
-                // simpler pieces), so it gets a second, deterministic attempt.
-                Err(GeomError::Degenerate(_) | GeomError::Undecidable(_)) => {}
-                done => return done.map_err(|e| e.give_up(BOOLEAN_FAILED)),
+            let sin_r = crate::math::sqrt((1.0 - cos_r * cos_r).max(0.0));
+            // A result that met a near-degeneracy (vertices welded, parts regularized away, rings
+            // touching or within SEPARATION of each other) is validated; one that fails
+            // validation, or a planar operation that cannot settle a configuration within
+            // rounding, goes to the octant split (other coordinates, simpler pieces).
+            match projected(self, other, op, c, weld_tolerance(sin_r)) {
+                Ok((r, true)) => return Ok(r),
+                Ok((r, false)) if r.validate().is_ok() => return Ok(r),
+                _ => {}
             }
         }
-        split(self, other, op).map_err(|e| e.give_up(BOOLEAN_FAILED))
+        if let Some(r) = separated(self, other, op) {
+            return Ok(r);
+        }
+        // The operands are valid: what fails from here on is a numerical give-up.
+        let first = match split(self, other, op) {
+            Ok(r) if r.validate().is_ok() => return Ok(r),
+            Ok(_) => GeomError::Undecidable(BOOLEAN_FAILED),
+            Err(e) => e.give_up(BOOLEAN_FAILED),
+        };
+        rotated_split(self, other, op).ok_or(first)
     }
 }
 
-/// What [`SphericalPolygon::boolean`] reports when its pieces fail within rounding in a way that
-/// is not already an [`GeomError::Undecidable`] (a planar contour or a ring the rounding made
-/// invalid).
-const BOOLEAN_FAILED: &str = "a spherical set operation produced an invalid piece within rounding";
+/// [`split`] in a rotated frame, for when the coordinate octants cut the operands badly: a piece
+/// thinner than the octant merge resolves (a corner of an operand poking `1e-13` across a
+/// coordinate plane) leaves pieces that do not close. The rotation (1 rad about `(1, 2, 3)`, no
+/// coordinate plane mapped near another) moves the cuts elsewhere. The rotated operands and the
+/// result rotated back must validate; `None` otherwise.
+fn rotated_split(
+    a: &SphericalPolygon,
+    b: &SphericalPolygon,
+    op: BoolOp,
+) -> Option<SphericalPolygon> {
+    let r = glam::DMat3::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 1.0);
+    let (ra, rb) = (a.transformed(r).ok()?, b.transformed(r).ok()?);
+    ra.validate().ok()?;
+    rb.validate().ok()?;
+    let result = split(&ra, &rb, op).ok()?;
+    let back = result.transformed(r.transpose()).ok()?;
+    back.validate().ok()?;
+    Some(back)
+}
+
+/// What [`SphericalPolygon::boolean`] reports when neither a projection nor the octant split
+/// gives a valid result and the failure is not already an [`GeomError::Undecidable`].
+const BOOLEAN_FAILED: &str = "spherical boolean: the operands are closer to a degenerate contact \
+     than f64 resolves (no projection and no octant split, plain or rotated, gave a valid result)";
 
 /// Results that need no geometry: an empty or full operand.
 fn trivial(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<SphericalPolygon> {
@@ -118,6 +159,63 @@ fn trivial(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<Sph
         _ => return None,
     };
     Some(r)
+}
+
+/// Operands whose boundaries lie in disjoint caps (each smaller than a hemisphere): no edge of
+/// one meets the other, so each result ring is a ring of an operand, kept, dropped or reversed,
+/// and the operation is decided exactly by two containment tests. This is how tiny polygons far
+/// apart (near antipodal, for which no cap holds both operands) are combined without the
+/// octant split, whose reassembly merges endpoints at a fixed `1e-9`.
+///
+/// Outside both caps each operand is constant; inside `A`'s cap, `B` is constant and equals its
+/// value at `A`'s center (`a_in_b`), and the other way round. The result's boundary near `A` is
+/// `A`'s rings where the operation depends on `A` there: always for `Xor` (reversed where `B`
+/// holds), for `Intersection` where `B` holds, for `Union` where it does not, and so on. With no
+/// boundary left the result is constant: empty, except for a union of two regions each
+/// containing the other's boundary (full).
+fn separated(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<SphericalPolygon> {
+    let cap = |p: &SphericalPolygon| {
+        let verts: SmallVec<[DVec3; 16]> = p.rings().flatten().copied().collect();
+        enclosing_cap(&verts).ok()
+    };
+    let ((ca, cos_a), (cb, cos_b)) = (cap(a)?, cap(b)?);
+    let angle = |cos: f64| crate::math::atan2(crate::math::sqrt((1.0 - cos * cos).max(0.0)), cos);
+    let between = crate::math::atan2(ca.cross(cb).length(), ca.dot(cb));
+    // The caps' radii are rounded to about 1e-16 (and come out of an iteration stopped at
+    // 1e-15 of optimality): a margin far above that.
+    if !(between > angle(cos_a) + angle(cos_b) + 1e-9) {
+        return None;
+    }
+    let (a_in_b, b_in_a) = (b.contains(ca), a.contains(cb));
+    // For each operand: keep its rings, keep them reversed, or drop them.
+    let (keep_a, keep_b) = match op {
+        BoolOp::Intersection => (a_in_b.then_some(false), b_in_a.then_some(false)),
+        BoolOp::Union => ((!a_in_b).then_some(false), (!b_in_a).then_some(false)),
+        BoolOp::Difference => ((!a_in_b).then_some(false), b_in_a.then_some(true)),
+        BoolOp::Xor => (Some(a_in_b), Some(b_in_a)),
+    };
+    let mut verts = Verts::new();
+    let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
+    for (p, keep) in [(a, keep_a), (b, keep_b)] {
+        let Some(reverse) = keep else { continue };
+        for ring in p.rings() {
+            let start = verts.len();
+            verts.extend_from_slice(ring);
+            if reverse {
+                verts[start..].reverse();
+            }
+            ends.push(verts.len() as u32);
+        }
+    }
+    if ends.is_empty() {
+        let full = op == BoolOp::Union && a_in_b && b_in_a;
+        return Some(if full {
+            SphericalPolygon::full()
+        } else {
+            SphericalPolygon::empty()
+        });
+    }
+    Some(SphericalPolygon::from_parts(verts, ends))
 }
 
 /// One operand in the plane: a bounded shape, and whether the region is its complement (the
@@ -154,18 +252,36 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
 }
 
 /// Vertices of the two operands closer than this chord are made the same vertex before an
-/// operation. Results of earlier operations carry the round-off of their projections, so one
-/// mesh vertex can reach a later operation as several copies a few ulps apart (up to about
-/// `1e-13` for vertices far from the projection center); the planar operation must see them as
-/// one vertex, or it meets edges that overlap within rounding but not exactly.
-const WELD_TOLERANCE: f64 = 1e-12;
+/// operation, and a vertex within four times it of the other operand's edge is put on that edge
+/// ([`snap_to_edges`]); result rings keep no edge shorter than that either. This is the
+/// resolution of the set operations (snap rounding): one mesh vertex reaches an operation as
+/// several copies (results of earlier operations carry the round-off of their projections, up to
+/// about `1e-13`; a mesh transformed along different paths per triangle, or given by the caller
+/// with copies that differ in the last digits, up to about `1e-11`), and the planar operation
+/// must see them as one vertex, or it meets edges that overlap within rounding but not exactly
+/// and leaves slivers and spikes of that width between the parts, which later operations cannot
+/// process reliably. Features narrower than this are below what a renderer resolves (1e-11 rad
+/// is 1e-8 of a unit at a thousand units).
+///
+/// The tolerance shrinks with the operands' extent ([`weld_tolerance`]): vertices near the
+/// projection center carry only the rounding of unit vectors (about `1e-16`), and the operands
+/// of a tiny operation (polygons `1e-10` rad across) must not be distorted by it.
+const WELD_TOLERANCE: f64 = 1e-11;
+
+/// [`WELD_TOLERANCE`] for operands within a cap of radius `r` about the projection center
+/// (`sin r` given): all of it for caps from a milliradian up, in proportion to the cap below
+/// (a hundred-millionth of the cap), down to `1e-15` (a few ulps of a unit vector).
+fn weld_tolerance(sin_r: f64) -> f64 {
+    WELD_TOLERANCE * (sin_r * 1e3).clamp(1e-4, 1.0)
+}
 
 /// Both operands with every vertex replaced by the first vertex (in either operand) within
-/// [`WELD_TOLERANCE`] of it; repeats that this creates along a ring are dropped. `None` when no
+/// `tolerance` of it; repeats that this creates along a ring are dropped. `None` when no
 /// two vertices are that close (the common case), so the operands are used as they are.
 fn weld(
     a: &SphericalPolygon,
     b: &SphericalPolygon,
+    tolerance: f64,
 ) -> Option<(SphericalPolygon, SphericalPolygon)> {
     let all: Vec<DVec3> = a.rings().chain(b.rings()).flatten().copied().collect();
     // Sort by x so that each vertex is compared only with those within the tolerance window.
@@ -174,10 +290,10 @@ fn weld(
     let mut rep: Vec<usize> = (0..all.len()).collect();
     for (k, &i) in order.iter().enumerate() {
         for &j in &order[k + 1..] {
-            if all[j].x - all[i].x > WELD_TOLERANCE {
+            if all[j].x - all[i].x > tolerance {
                 break;
             }
-            if (all[i] - all[j]).length() <= WELD_TOLERANCE {
+            if (all[i] - all[j]).length() <= tolerance {
                 // The earliest vertex (by input position) represents the group.
                 let (ri, rj) = (rep[i], rep[j]);
                 let r = ri.min(rj);
@@ -186,7 +302,8 @@ fn weld(
             }
         }
     }
-    if rep.iter().enumerate().all(|(i, &r)| r == i) {
+    // Merging identical copies changes nothing: only a vertex that moves counts.
+    if rep.iter().enumerate().all(|(i, &r)| all[r] == all[i]) {
         return None;
     }
     let mut at = 0usize;
@@ -210,6 +327,74 @@ fn weld(
     let wa = rebuild(a);
     let wb = rebuild(b);
     Some((wa, wb))
+}
+
+/// `into` with every vertex of `from` that lies within `tolerance` of one of its edges (beside
+/// it: the foot of the perpendicular inside the arc, the vertex not an endpoint) inserted into
+/// that edge, and the largest such distance; `None` when there is none (the common case).
+///
+/// This is snap rounding at the resolution validation demands. Two operands' edges leaving a
+/// shared vertex in almost the same direction, or crossing at an almost flat angle, would give
+/// the result a wedge narrower than its `1e-12` rad fold test: when the far end of the shorter
+/// edge lies within the tolerance (four weld distances) of the other edge it is put on it
+/// (moving that edge by at most that), and otherwise the wedge is wider than the tolerance over
+/// `pi` rad.
+fn snap_to_edges(
+    into: &SphericalPolygon,
+    from: &SphericalPolygon,
+    tolerance: f64,
+) -> Option<(SphericalPolygon, f64)> {
+    if into.is_full() || into.is_empty() || from.is_full() || from.is_empty() {
+        return None;
+    }
+    let points: SmallVec<[DVec3; 24]> = from.rings().flatten().copied().collect();
+    // (edge's index among all of into's vertices, vertex to insert, its position along the edge)
+    let mut inserts: SmallVec<[(usize, DVec3, f64); 4]> = SmallVec::new();
+    let mut bend = 0.0f64;
+    let mut base = 0usize;
+    for ring in into.rings() {
+        let m = ring.len();
+        for i in 0..m {
+            let (p, q) = (ring[i], ring[(i + 1) % m]);
+            let nrm = p.cross(q - p);
+            let len = nrm.length();
+            for &v in &points {
+                // Cheap screen: the distance to the edge's great circle.
+                let off = (v - p).dot(nrm).abs();
+                if !(off <= tolerance * len) || v == p || v == q {
+                    continue;
+                }
+                // Beside the arc: turning from p to v and from v to q both go its way round.
+                if p.cross(v).dot(nrm) > 0.0 && v.cross(q).dot(nrm) > 0.0 {
+                    inserts.push((base + i, v, (v - p).length_squared()));
+                    bend = bend.max(off / len);
+                }
+            }
+        }
+        base += m;
+    }
+    if inserts.is_empty() {
+        return None;
+    }
+    // Along each edge in order from its start.
+    inserts.sort_by(|x, y| x.0.cmp(&y.0).then(x.2.total_cmp(&y.2)));
+    let mut verts = Verts::new();
+    let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
+    let mut at = 0usize;
+    let mut k = 0usize;
+    for ring in into.rings() {
+        let start = verts.len();
+        for &p in ring {
+            verts.push(p);
+            while k < inserts.len() && inserts[k].0 == at {
+                verts.push(inserts[k].1);
+                k += 1;
+            }
+            at += 1;
+        }
+        close_ring(&mut verts, &mut ends, start);
+    }
+    Some((SphericalPolygon::from_parts(verts, ends), bend))
 }
 
 /// Splits a ring that visits a vertex more than once (a pinch, valid on the sphere) into simple
@@ -244,10 +429,33 @@ fn projected(
     b: &SphericalPolygon,
     op: BoolOp,
     c: DVec3,
-) -> Result<SphericalPolygon, GeomError> {
+    weld_tol: f64,
+) -> Result<(SphericalPolygon, bool), GeomError> {
     let g = Gnomonic::new(c)?;
-    let welded = weld(a, b);
+    // Welding and snapping move vertices by up to a few weld tolerances; an operand with its
+    // own structure that close (earlier results can have it) could be broken by that, so each
+    // change is kept only if the operand stays valid.
+    let welded = weld(a, b, weld_tol);
+    // Whether the result needs validating: not when nothing moved and its rings keep apart
+    // (a vertex snapped onto an edge moves nothing but that edge, by at most the tolerance, and
+    // where it makes rings touch, they are not apart).
+    let clean = welded.is_none();
+    let welded = welded.filter(|(wa, wb)| wa.validate().is_ok() && wb.validate().is_ok());
     let (a, b) = welded.as_ref().map_or((a, b), |(wa, wb)| (wa, wb));
+    // Weld and edge snapping together: no vertex of one operand is left within 4 times the weld
+    // tolerance of an edge of the other without lying on it.
+    // Vertices that lie on the edge to rounding change nothing (exact contacts, the common
+    // case of snapping); an edge bent by more is checked.
+    let kept = |s: Option<(SphericalPolygon, f64)>| {
+        s.filter(|(p, bend)| *bend <= 1e-14 || p.validate().is_ok())
+            .map(|(p, _)| p)
+    };
+    let snapped = (
+        kept(snap_to_edges(a, b, 4.0 * weld_tol)),
+        kept(snap_to_edges(b, a, 4.0 * weld_tol)),
+    );
+    let a = snapped.0.as_ref().unwrap_or(a);
+    let b = snapped.1.as_ref().unwrap_or(b);
     let (pa, pb) = (to_plane(a, &g)?, to_plane(b, &g)?);
     let (ca, cb) = (pa.complemented, pb.complemented);
     let (sa, sb) = (&pa.shape, &pb.shape);
@@ -287,8 +495,68 @@ fn projected(
         // such repeats are dropped, and a ring left with fewer than three vertices with them.
         close_ring(&mut verts, &mut ends, start);
     }
-    let r = SphericalPolygon::from_parts(verts, ends);
-    Ok(if complemented { r.complement() } else { r })
+    let (r, changed) = regularized(verts, ends, 4.0 * weld_tol);
+    let clean = clean && !changed && rings_apart(&r, SEPARATION);
+    let r = if complemented { r.complement() } else { r };
+    Ok((r, clean))
+}
+
+/// Distance between different rings of a result below which it is validated: rings that touch
+/// (pinches) or nearly touch are where rounding can leave a result that validation rejects;
+/// results whose rings stay this far apart (an occluder inside a light, a clean crossing) are
+/// valid by construction and skip the check.
+const SEPARATION: f64 = 1e-9;
+
+/// Whether every two rings of `p` are farther apart than `d`: no vertex of one within `d` of a
+/// vertex or an edge of the other (their bounding boxes, grown by `d` and the edges' sagitta,
+/// decide most pairs at once).
+fn rings_apart(p: &SphericalPolygon, d: f64) -> bool {
+    let rings: SmallVec<[&[DVec3]; 4]> = p.rings().collect();
+    if rings.len() < 2 {
+        return true;
+    }
+    let boxes: SmallVec<[(DVec3, DVec3); 4]> = rings
+        .iter()
+        .map(|r| {
+            let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+            let mut sag = 0.0f64;
+            for (i, &v) in r.iter().enumerate() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+                sag = sag.max(1.0 - 0.5 * (v + r[(i + 1) % r.len()]).length());
+            }
+            let grow = DVec3::splat(sag + d);
+            (lo - grow, hi + grow)
+        })
+        .collect();
+    for i in 0..rings.len() {
+        for j in i + 1..rings.len() {
+            let ((li, hi), (lj, hj)) = (boxes[i], boxes[j]);
+            if li.cmpgt(hj).any() || lj.cmpgt(hi).any() {
+                continue;
+            }
+            for (x, y) in [(rings[i], rings[j]), (rings[j], rings[i])] {
+                for (k, &a) in x.iter().enumerate() {
+                    let b = x[(k + 1) % x.len()];
+                    let nrm = a.cross(b - a);
+                    let len = nrm.length();
+                    for &v in y {
+                        if (v - a).length() <= d {
+                            return false;
+                        }
+                        // Within d of the edge's great circle, beside the arc.
+                        if (v - a).dot(nrm).abs() <= d * len
+                            && a.cross(v).dot(nrm) >= 0.0
+                            && v.cross(b).dot(nrm) >= 0.0
+                        {
+                            return false;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    true
 }
 
 /// Vertices of any contour lying exactly inside the segment `a-b` (not at its ends), in order
@@ -343,7 +611,7 @@ fn split(
         // holds with a margin (cosine 1/sqrt 3).
         let piece = match trivial(&pa, &pb, op) {
             Some(r) => r,
-            None => projected(&pa, &pb, op, DVec3::new(sx, sy, sz))?,
+            None => projected(&pa, &pb, op, DVec3::new(sx, sy, sz), WELD_TOLERANCE)?.0,
         };
         for ring in piece.rings() {
             any = true;

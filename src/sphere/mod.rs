@@ -8,6 +8,7 @@
 
 mod boolean;
 mod clip;
+mod exact;
 mod gnomonic;
 mod order;
 mod polygon;

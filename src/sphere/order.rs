@@ -6,7 +6,7 @@ use core::f64::consts::PI;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::polygon::{SphericalPolygon, nearest_feature, ring_left_area};
+use super::polygon::{SphericalPolygon, ring_left_area, rings_contain};
 use super::predicates::normalize_any;
 use crate::GeomError;
 
@@ -69,9 +69,7 @@ pub fn order_edges(edges: &[(DVec3, DVec3)]) -> Result<SphericalPolygon, GeomErr
             .map(|j| {
                 (0..k)
                     .filter(|&i| {
-                        i != j
-                            && nearest_feature(core::iter::once(&rings[i][..]), rings[j][0])
-                                .is_some_and(|(_, inside)| inside)
+                        i != j && rings_contain(core::iter::once(&rings[i][..]), rings[j][0])
                     })
                     .count()
             })

@@ -37,7 +37,12 @@ pub(crate) type Verts = SmallVec<[DVec3; 12]>;
 /// empty region; the full sphere, which has no boundary, is [`SphericalPolygon::full`].
 ///
 /// Values built with [`SphericalPolygon::new`] are valid: vertices are unit vectors, rings are
-/// simple, disjoint and consistently oriented. Every operation of the crate returns valid values.
+/// simple and disjoint except at pinches, and consistently oriented. A pinch is a vertex shared
+/// (the same direction) by two rings, or visited twice by one ring: rings may touch there, as
+/// long as they do not cross there (the visits' edges do not interleave around the vertex);
+/// results of clipping and set operations have them where a hole touches an outer boundary or
+/// two parts meet at a corner. Every operation of the crate returns valid values
+/// ([`SphericalPolygon::validate`]).
 ///
 /// # Examples
 ///
@@ -66,7 +71,8 @@ pub struct SphericalPolygon {
 impl SphericalPolygon {
     /// Builds a polygon from rings of directions, validating them.
     ///
-    /// Each vertex may have any non-zero finite length and is normalized. Orientation is taken as
+    /// Each vertex may have any non-zero finite length and is normalized (one that is a unit
+    /// vector to within `4 eps` in squared length is kept as given). Orientation is taken as
     /// given (interior on the left). No rings is the empty region.
     ///
     /// # Errors
@@ -76,25 +82,33 @@ impl SphericalPolygon {
     ///   [`COINCIDENT_TOLERANCE`], [`GeomError::AntipodalVertices`] for consecutive vertices within
     ///   [`ANTIPODAL_TOLERANCE`] of antipodal;
     /// - [`GeomError::TooFewVertices`] for a ring of fewer than three vertices;
-    /// - [`GeomError::SelfIntersecting`] when a ring crosses or touches itself or another ring
-    ///   (checked exactly, with Shewchuk's `orient3d`; the check is quadratic in the vertex count);
+    /// - [`GeomError::SelfIntersecting`] when a ring crosses itself or another ring, touches one
+    ///   anywhere but at a pinch (a vertex shared by both, or visited twice by one ring, where
+    ///   touching is allowed), crosses one at a pinch, or leaves a vertex along the direction of
+    ///   another edge there (within `1e-12` rad, or with the shorter edge's far end within
+    ///   `5e-16` of the other's great circle: a spike, or an overlap); checked exactly, with
+    ///   Shewchuk's `orient3d`, on the pairs of edges whose bounding boxes meet;
     /// - [`GeomError::ZeroArea`] for a ring whose vertices lie on one great circle to within
     ///   rounding (its smaller side is below `1e-12` times its squared perimeter);
     /// - [`GeomError::InconsistentOrientation`] when two rings bounding the same face disagree on
-    ///   which side is inside (for example two nested rings both counter-clockwise).
+    ///   which side is inside (for example two nested rings both counter-clockwise);
+    /// - [`GeomError::Undecidable`] when the rings are valid as given, but normalizing their
+    ///   vertices makes them cross (a vertex within rounding of another ring's edge).
     pub fn new(rings: Vec<Vec<DVec3>>) -> Result<Self, GeomError> {
         let mut poly = SphericalPolygon::empty();
         // The caller's vertices scaled by powers of two only (exact), for the exact predicates:
         // an exact degeneracy in the input (a vertex exactly on another edge, a spike) is no
         // longer exact once normalized, but the sign of det(a, b, c) survives positive scaling.
         let mut raw: Vec<DVec3> = Vec::new();
+        let mut renormalized = false;
         for (r, ring) in rings.iter().enumerate() {
             let start = poly.verts.len();
             for (i, &p) in ring.iter().enumerate() {
                 if !p.is_finite() {
                     return Err(GeomError::NonFinite { ring: r, vertex: i });
                 }
-                let u = normalize_any(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?;
+                let u = unit_as_given(p).ok_or(GeomError::ZeroVector { ring: r, vertex: i })?;
+                renormalized |= u != p;
                 poly.verts.push(u);
                 raw.push(scale_pow2(p));
             }
@@ -115,9 +129,101 @@ impl SphericalPolygon {
             poly.ends.push(poly.verts.len() as u32);
         }
         poly.check_simple(&raw)?;
+        if renormalized {
+            // The given rings are simple; the normalized ones, which are stored, must be too.
+            // They differ only for a vertex within rounding of another edge.
+            poly.check_simple(&poly.verts).map_err(|_| {
+                GeomError::Undecidable(
+                    "a vertex lies within rounding of another edge: the rings are simple as \
+                     given but cross once their vertices are normalized",
+                )
+            })?;
+        }
         poly.check_area()?;
         poly.check_consistent()?;
         Ok(poly)
+    }
+
+    /// Checks every invariant that [`SphericalPolygon::new`] establishes and that every result of
+    /// the crate's operations keeps: unit vertices (to within `1e-14`), rings of at least three vertices with no two
+    /// consecutive ones coincident or antipodal, rings simple, disjoint except at shared
+    /// vertices and not folding back on themselves (exact predicates, and the `1e-12` rad fold
+    /// test), no ring thinner than [`GeomError::ZeroArea`] allows, and consistent orientation.
+    /// Equivalently: `SphericalPolygon::new(p.rings().map(<[_]>::to_vec).collect())` succeeds
+    /// and gives `p` back.
+    ///
+    /// This is the one invariant checker shared by the tests and the fuzz targets. It costs
+    /// about `n log n` in the number of edges (a sweep over their bounding boxes) plus the
+    /// exact tests of the pairs it finds.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::planar::BoolOp;
+    /// use arealight::sphere::SphericalPolygon;
+    ///
+    /// let a = SphericalPolygon::new(vec![vec![DVec3::X, DVec3::Y, DVec3::Z]])?;
+    /// // B is A with one vertex moved by 2e-12: A - B is a sliver no operation can resolve.
+    /// let moved = (DVec3::Y + DVec3::new(1e-12, 0.0, 1e-12)).normalize();
+    /// let b = SphericalPolygon::new(vec![vec![DVec3::X, moved, DVec3::Z]])?;
+    /// let d = a.boolean(&b, BoolOp::Difference)?;
+    /// d.validate()?; // every result is a valid input
+    /// assert!(d.solid_angle() < 1e-11);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// The first violated invariant, as the error [`SphericalPolygon::new`] would report for it,
+    /// or [`GeomError::Degenerate`] for storage that no input could have produced (a vertex
+    /// that is not a unit vector, the full sphere with rings).
+    pub fn validate(&self) -> Result<(), GeomError> {
+        if self.full {
+            return if self.ends.is_empty() && self.verts.is_empty() {
+                Ok(())
+            } else {
+                Err(GeomError::Degenerate("the full sphere has rings"))
+            };
+        }
+        let mut start = 0usize;
+        for (r, &end) in self.ends.iter().enumerate() {
+            let end = end as usize;
+            if end < start || end > self.verts.len() {
+                return Err(GeomError::Degenerate("ring bounds out of order"));
+            }
+            let ring = &self.verts[start..end];
+            let n = ring.len();
+            for (i, p) in ring.iter().enumerate() {
+                if !p.is_finite() {
+                    return Err(GeomError::NonFinite { ring: r, vertex: i });
+                }
+                // Unit to within a few dozen ulps (points made on a circle from a rounded frame
+                // carry a few): every use is scale-invariant or far coarser than that.
+                if !((p.length_squared() - 1.0).abs() <= 1e-14) {
+                    return Err(GeomError::Degenerate("a vertex is not a unit vector"));
+                }
+            }
+            if n < 3 {
+                return Err(GeomError::TooFewVertices { ring: r, count: n });
+            }
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                if (a - b).length() <= COINCIDENT_TOLERANCE {
+                    return Err(GeomError::CoincidentVertices { ring: r, vertex: i });
+                }
+                if (a + b).length() <= ANTIPODAL_TOLERANCE {
+                    return Err(GeomError::AntipodalVertices { ring: r, vertex: i });
+                }
+            }
+            start = end;
+        }
+        if start != self.verts.len() {
+            return Err(GeomError::Degenerate("vertices after the last ring"));
+        }
+        self.check_simple(&self.verts)?;
+        self.check_area()?;
+        self.check_consistent()
     }
 
     /// The empty region (no rings).
@@ -237,7 +343,7 @@ impl SphericalPolygon {
         }
         let mut out = self.clone();
         for v in out.verts.iter_mut() {
-            *v = normalize_any(m * *v)
+            *v = unit_as_given(m * *v)
                 .ok_or(GeomError::Degenerate("a vertex maps to the zero vector"))?;
         }
         Ok(if det < 0.0 {
@@ -258,10 +364,16 @@ impl SphericalPolygon {
     /// its own vertices (chosen so that no vertex is near its antipode, where the triangle formula
     /// is ill-conditioned); a triangle's area is only defined modulo `4 pi` when its far edge
     /// passes near the apex's antipode, but the sum modulo `4 pi` is exact. The rings' areas add
-    /// up to the region's area modulo `4 pi`. Accuracy: about `1e-15 * n` absolute for `n`
-    /// vertices, and full relative precision for small polygons (the determinant is evaluated on
-    /// edge differences), so a polygon of 1e-6 rad across keeps about 1e-10 relative accuracy,
-    /// which is what its unit-vector vertices determine.
+    /// up to the region's area modulo `4 pi`; they are summed as the signed areas of their
+    /// smaller sides, so that a small region with holes (an annulus 1e-16 sr wide) keeps its
+    /// precision, and a total within its rounding bound of zero is resolved by one point far
+    /// from the boundary (empty or full). Accuracy: about `1e-15 * n` absolute for `n`
+    /// vertices, and full relative precision for small polygons and their complements' small
+    /// sides (the determinant is evaluated on edge differences), so a polygon of 1e-6 rad across
+    /// keeps about 1e-10 relative accuracy, which is what its unit-vector vertices determine. An
+    /// edge between nearly antipodal vertices `a`, `b` has its great circle only to about
+    /// `1e-16 / |a + b|` rad, and the area loses that much times the edge's length (down to about
+    /// `1e-6` for `|a + b|` at [`ANTIPODAL_TOLERANCE`]).
     #[must_use]
     pub fn solid_angle(&self) -> f64 {
         const FOUR_PI: f64 = 4.0 * PI;
@@ -272,20 +384,36 @@ impl SphericalPolygon {
             0 => 0.0,
             1 => ring_left_area(&self.verts),
             _ => {
-                let total: f64 = self.rings().map(ring_left_area).sum();
-                let omega = total.rem_euclid(FOUR_PI);
-                // Modulo 4 pi, a nearly empty and a nearly full region look alike; one point far
-                // from the boundary tells them apart.
-                let tol = 1e-9;
-                if omega < tol || omega > FOUR_PI - tol {
-                    let full_ish = self.contains(self.far_point());
-                    return match (full_ish, omega < tol) {
-                        (true, true) => FOUR_PI,
-                        (false, false) => 0.0,
-                        _ => omega,
-                    };
+                // The rings' areas add up to the region's modulo 4 pi. Summing their smaller sides
+                // (each with its own relative precision) keeps a small total precise, where the
+                // left areas of holes (4 pi - epsilon each) would swamp it.
+                let (mut total, mut err) = (0.0, 0.0);
+                for ring in self.rings() {
+                    let (a, e) = ring_small_area_err(ring);
+                    total += a;
+                    err += e + f64::EPSILON * total.abs();
                 }
-                omega
+                let r = if (-2.0 * PI..=2.0 * PI).contains(&total) {
+                    total
+                } else {
+                    let left = total.rem_euclid(FOUR_PI);
+                    err += 4.0 * f64::EPSILON * FOUR_PI;
+                    if left > 2.0 * PI {
+                        left - FOUR_PI
+                    } else {
+                        left
+                    }
+                };
+                if r.abs() > err {
+                    return if r > 0.0 { r } else { FOUR_PI + r };
+                }
+                // Within rounding of both the empty and the full region, which look alike modulo
+                // 4 pi: one point far from the boundary tells them apart.
+                if self.contains(self.far_point()) {
+                    FOUR_PI + r.min(0.0)
+                } else {
+                    r.max(0.0)
+                }
             }
         }
     }
@@ -304,7 +432,7 @@ impl SphericalPolygon {
         if self.full {
             return true;
         }
-        nearest_feature(self.rings(), p).is_some_and(|(_, inside)| inside)
+        rings_contain(self.rings(), p)
     }
 
     /// A direction well away from the boundary: the best of the six axis directions.
@@ -328,7 +456,8 @@ impl SphericalPolygon {
     fn check_simple(&self, raw: &[DVec3]) -> Result<(), GeomError> {
         // Every edge as (ring, index in ring, start, end), with start and end as indices into
         // `verts` (unit vectors) and `raw` (exactly scaled input).
-        let mut edges: Vec<(usize, usize, usize, usize)> = Vec::with_capacity(self.verts.len());
+        let mut edges: SmallVec<[(usize, usize, usize, usize); 32]> =
+            SmallVec::with_capacity(self.verts.len());
         let mut start = 0usize;
         for (r, &end) in self.ends.iter().enumerate() {
             let end = end as usize;
@@ -343,8 +472,24 @@ impl SphericalPolygon {
             other_ring: s,
         };
         let v = &self.verts;
-        for (k, &(r, i, a, b)) in edges.iter().enumerate() {
-            for &(s, j, c, d) in &edges[k + 1..] {
+        // Only arcs whose bounding boxes overlap can meet: boxes of the endpoints grown by the
+        // arc's sagitta 1 - |a + b| / 2 (the farthest a minor arc strays from its chord), with a
+        // margin for rounding.
+        let boxes: SmallVec<[(DVec3, DVec3); 32]> = edges
+            .iter()
+            .map(|&(_, _, a, b)| {
+                let (p, q) = (v[a], v[b]);
+                let grow = DVec3::splat((1.0 - 0.5 * (p + q).length()).max(0.0) + 1e-15);
+                (p.min(q) - grow, p.max(q) + grow)
+            })
+            .collect();
+        let overlap = |k: usize, l: usize| {
+            let (bk, bl) = (boxes[k], boxes[l]);
+            !(bl.0.cmpgt(bk.1).any() || bk.0.cmpgt(bl.1).any())
+        };
+        let check = |k: usize, l: usize| -> Result<(), GeomError> {
+            let ((r, i, a, b), (s, j, c, d)) = (edges[k], edges[l]);
+            {
                 let n = self.ring_len(r);
                 let consecutive = r == s && (j == (i + 1) % n || i == (j + 1) % n);
                 // A shared endpoint (the same direction) is allowed; the two edges may not leave
@@ -366,11 +511,10 @@ impl SphericalPolygon {
                         // Within rounding of the same direction counts as overlapping: a spike
                         // narrower than 1e-12 rad has no side any later operation can resolve
                         // (an exactly collinear spike in the caller's coordinates is no longer
-                        // exactly collinear once normalized).
+                        // exactly collinear once normalized, hence the test on those too).
                         let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
-                        let parallel = orient(raw[xi], raw[pi], raw[qi]) == 0
-                            || tp.cross(tq).length() <= 1e-12 * tp.length() * tq.length();
-                        if parallel && tp.dot(tq) > 0.0 {
+                        let exact_fold = tp.dot(tq) > 0.0 && orient(raw[xi], raw[pi], raw[qi]) == 0;
+                        if exact_fold || folds_back(p, x, q) {
                             return Err(err(r, s));
                         }
                         // The far ends may still meet the other edge (two edges sharing both
@@ -383,6 +527,38 @@ impl SphericalPolygon {
                         }
                     }
                 }
+            }
+            Ok(())
+        };
+        let ne = edges.len();
+        if ne <= 48 {
+            // Few edges (the common case): every pair, in input order.
+            for k in 0..ne {
+                for l in k + 1..ne {
+                    if overlap(k, l) {
+                        check(k, l)?;
+                    }
+                }
+            }
+        } else {
+            // A sweep along x, then the pairs found in input order, so that the first violation
+            // reported is the first in the input.
+            let mut order: Vec<usize> = (0..ne).collect();
+            order.sort_by(|&x, &y| boxes[x].0.x.total_cmp(&boxes[y].0.x));
+            let mut pairs: Vec<(usize, usize)> = Vec::new();
+            for (w, &k) in order.iter().enumerate() {
+                for &l in &order[w + 1..] {
+                    if boxes[l].0.x > boxes[k].1.x {
+                        break;
+                    }
+                    if overlap(k, l) {
+                        pairs.push((k.min(l), k.max(l)));
+                    }
+                }
+            }
+            pairs.sort_unstable();
+            for (k, l) in pairs {
+                check(k, l)?;
             }
         }
         self.check_pinches()
@@ -411,7 +587,13 @@ impl SphericalPolygon {
             if group.len() > 1 {
                 let x = group[0].0;
                 let (u, v) = super::predicates::tangent_frame(x);
-                let ang = |p: DVec3| crate::math::atan2(p.dot(v), p.dot(u));
+                // Directions of the neighbours in the tangent plane at x, from the differences
+                // q - x (exact for close points): x . u is zero only to rounding, which would
+                // swamp the direction of an edge shorter than about 1e-13.
+                let ang = |p: DVec3| {
+                    let d = p - x;
+                    crate::math::atan2(d.dot(v), d.dot(u))
+                };
                 let two_pi = 2.0 * PI;
                 for (gi, &(_, ri, pi, ni)) in group.iter().enumerate() {
                     let (lo, span) = (ang(ni), (ang(pi) - ang(ni)).rem_euclid(two_pi));
@@ -442,16 +624,7 @@ impl SphericalPolygon {
     /// well-shaped rings (a square `1e-7` rad across) are accepted.
     fn check_area(&self) -> Result<(), GeomError> {
         for (r, ring) in self.rings().enumerate() {
-            let left = ring_left_area(ring);
-            let area = left.min(4.0 * PI - left);
-            let n = ring.len();
-            let perimeter: f64 = (0..n)
-                .map(|i| {
-                    let (a, b) = (ring[i], ring[(i + 1) % n]);
-                    crate::math::atan2(a.cross(b).length(), a.dot(b))
-                })
-                .sum();
-            if !(area > 1e-12 * perimeter * perimeter) {
+            if is_sliver(ring) {
                 return Err(GeomError::ZeroArea { ring: r });
             }
         }
@@ -483,8 +656,7 @@ impl SphericalPolygon {
                         .find(|p| !rings[i].contains(p))
                         .copied()
                         .unwrap_or_else(|| (rings[j][0] + rings[j][1]).normalize());
-                    side[i * k + j] = nearest_feature(core::iter::once(rings[i]), probe)
-                        .is_some_and(|(_, inside)| inside);
+                    side[i * k + j] = rings_contain(core::iter::once(rings[i]), probe);
                 }
             }
         }
@@ -502,6 +674,137 @@ impl SphericalPolygon {
         }
         Ok(())
     }
+}
+
+/// `false` when a ring is certainly not a sliver ([`is_sliver`]), by a bound without
+/// trigonometry that is conclusive for ordinary rings.
+///
+/// The vector area of the ring's arcs, `1/2 sum theta_i m_i` (angle `theta_i`, unit normal `m_i`
+/// of edge `i`), is `int_W x dA` over either side `W` (the two integrals cancel over the sphere),
+/// so its length is at most the smaller side's area. The chords' vector area
+/// `1/2 sum sin(theta_i) m_i` differs from it by at most `sum (theta_i - sin theta_i) / 2 <=
+/// sum theta_i^3 / 12`, with `theta <= (pi / 2) chord`; the perimeter is at most `pi / 2` times
+/// the sum of the chords.
+pub(crate) fn may_be_sliver(ring: &[DVec3]) -> bool {
+    let m = ring.len();
+    let (mut area2, mut chords, mut cubes) = (DVec3::ZERO, 0.0, 0.0);
+    for i in 0..m {
+        let (a, b) = (ring[i], ring[(i + 1) % m]);
+        area2 += a.cross(b);
+        let c = (b - a).length();
+        chords += c;
+        cubes += c * c * c;
+    }
+    let half_pi = 0.5 * PI;
+    let lower =
+        0.5 * area2.length() - half_pi * half_pi * half_pi / 12.0 * cubes - 1e-15 * m as f64;
+    let perimeter = half_pi * chords;
+    !(lower > 1e-12 * perimeter * perimeter)
+}
+
+/// Whether a ring's smaller side is below `1e-12` times its squared perimeter: the
+/// [`GeomError::ZeroArea`] criterion of [`SphericalPolygon::new`], which operations also apply
+/// to their results (a ring that thin is dropped as an artifact of rounding).
+pub(crate) fn is_sliver(ring: &[DVec3]) -> bool {
+    if !may_be_sliver(ring) {
+        return false;
+    }
+    let area = ring_small_area(ring).abs();
+    let n = ring.len();
+    let perimeter: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            crate::math::atan2(a.cross(b).length(), a.dot(b))
+        })
+        .sum();
+    !(area > 1e-12 * perimeter * perimeter)
+}
+
+/// Whether the ring folds back at `x` between its neighbours `p` and `q`: the two edges leave
+/// `x` in the same direction, exactly, within `1e-12` rad, or so nearly that the far end of the
+/// shorter one lies within `5e-16` (a few ulps of a unit vector: the rounding of the vertices)
+/// of the other's great circle (a spike, or a notch of the same width). This is the test [`SphericalPolygon::new`] applies to
+/// edges sharing an endpoint: a wedge that narrow has no side any later operation can resolve
+/// (the direction of an edge of length `l` is only known to about `1e-16 / l`).
+pub(crate) fn folds_back(p: DVec3, x: DVec3, q: DVec3) -> bool {
+    let (tp, tq) = (p - x * p.dot(x), q - x * q.dot(x));
+    if !(tp.dot(tq) > 0.0) {
+        return false;
+    }
+    let (lp, lq) = (tp.length(), tq.length());
+    let cross = tp.cross(tq).length();
+    orient(x, p, q) == 0 || cross <= 1e-12 * lp * lq || cross <= 5e-16 * lp.max(lq)
+}
+
+/// The result of an operation, built from rings that may hold what validation rejects (the
+/// operations are exact up to rounding, and rounding can leave features below the resolution
+/// validation demands): consecutive vertices closer than `merge` (the operation's weld
+/// distance, so that the next operation does not weld them itself) become one, vertices where a
+/// ring folds back ([`folds_back`]) are removed (this cuts a spike or fills a notch narrower
+/// than `1e-12` rad), and rings left with fewer than three vertices or thinner than
+/// [`is_sliver`] are dropped. The region moves by at most those edges, wedges and slivers. When
+/// every ring is dropped, the result is empty or full as the rings' region was (small or
+/// large).
+///
+/// Also returns whether anything was changed.
+pub(crate) fn regularized(
+    verts: Verts,
+    ends: SmallVec<[u32; 2]>,
+    merge: f64,
+) -> (SphericalPolygon, bool) {
+    let mut out = Verts::new();
+    let mut out_ends: SmallVec<[u32; 2]> = SmallVec::new();
+    let mut dropped_large = false;
+    let mut changed = false;
+    let mut start = 0usize;
+    for &end in &ends {
+        let ring = &verts[start..end as usize];
+        start = end as usize;
+        let mut r: Verts = ring.iter().copied().collect();
+        // Remove short edges' second ends and fold vertices until none is left; each pass
+        // removes a vertex or stops.
+        loop {
+            let m = r.len();
+            if m < 3 {
+                break;
+            }
+            let fold = (0..m).find(|&i| {
+                let (p, x, q) = (r[(i + m - 1) % m], r[i], r[(i + 1) % m]);
+                p == q || (x - p).length() <= merge || folds_back(p, x, q)
+            });
+            match fold {
+                Some(i) => {
+                    r.remove(i);
+                    changed = true;
+                }
+                None => break,
+            }
+        }
+        let begin = out.len();
+        out.extend_from_slice(&r);
+        let before = out_ends.len();
+        close_ring(&mut out, &mut out_ends, begin);
+        if out_ends.len() > before && is_sliver(&out[begin..]) {
+            dropped_large |= ring_small_area(ring) < 0.0;
+            out.truncate(begin);
+            out_ends.pop();
+            changed = true;
+        } else if out_ends.len() == before {
+            dropped_large |= ring.len() >= 3 && ring_small_area(ring) < 0.0;
+            changed = true;
+        } else if out.len() - begin != r.len() {
+            changed = true;
+        }
+    }
+    if out_ends.is_empty() && !ends.is_empty() {
+        let r = if dropped_large {
+            SphericalPolygon::full()
+        } else {
+            SphericalPolygon::empty()
+        };
+        return (r, true);
+    }
+    (SphericalPolygon::from_parts(out, out_ends), changed)
 }
 
 /// Ends the ring begun at `start`: drops vertices that coincide with their predecessor, and the
@@ -524,6 +827,21 @@ pub(crate) fn close_ring(verts: &mut Verts, ends: &mut SmallVec<[u32; 2]>, start
         verts.truncate(start);
     } else {
         ends.push(w as u32);
+    }
+}
+
+/// `p` as a unit vector: `p` itself, bit for bit, when its squared length is within `4 eps` of
+/// 1 (as [`normalize_any`] leaves a vector), else normalized; `None` for zero or non-finite `p`.
+///
+/// Normalizing a unit vector again moves it by an ulp, which can put it on the other side of an
+/// edge passing within an ulp (a vertex exactly on another edge's great circle in the caller's
+/// coordinates, beyond its end): the stored polygon would cross itself where the given one does
+/// not, and a polygon passed through the identity map would not be itself.
+pub(crate) fn unit_as_given(p: DVec3) -> Option<DVec3> {
+    if (p.length_squared() - 1.0).abs() <= 4.0 * f64::EPSILON {
+        Some(p)
+    } else {
+        normalize_any(p)
     }
 }
 
@@ -553,20 +871,130 @@ fn scale_pow2(p: DVec3) -> DVec3 {
 
 /// Solid angle of the region to the left of one ring, in `[0, 4 pi]`.
 pub(crate) fn ring_left_area(ring: &[DVec3]) -> f64 {
+    let small = ring_small_area(ring);
+    // A tiny clockwise ring gives -epsilon and maps to 4 pi - epsilon, as it should.
+    if small >= 0.0 {
+        small
+    } else {
+        4.0 * PI + small
+    }
+}
+
+/// The solid angle of a ring's smaller side, positive when that side is on the left (the ring
+/// runs counter-clockwise around it), negative when on the right: in `[-2 pi, 2 pi]`, with full
+/// relative precision for small rings of either orientation.
+///
+/// The fan of Van Oosterom-Strackee triangles gives the left area modulo `4 pi`; for a small
+/// ring that is `+-epsilon` directly, with the relative precision of its edge differences, which
+/// the left area of a clockwise ring (`4 pi - epsilon`, absolute error about `1e-15`) loses.
+pub(crate) fn ring_small_area(ring: &[DVec3]) -> f64 {
+    ring_small_area_with::<false>(ring).0
+}
+
+/// [`ring_small_area`] with a bound on its rounding error: each triangle's determinant on edge
+/// differences rounds by a few ulps of the product of the two edge lengths (bounded by half the
+/// sum of their squares), its angle by that over the denominator, plus the rounding of the
+/// angle and of the sum.
+pub(crate) fn ring_small_area_err(ring: &[DVec3]) -> (f64, f64) {
+    ring_small_area_with::<true>(ring)
+}
+
+fn ring_small_area_with<const ERR: bool>(ring: &[DVec3]) -> (f64, f64) {
     let n = ring.len();
     let apex = fan_apex(ring);
-    let mut sum = 0.0;
+    let (mut sum, mut err) = (0.0, 0.0);
     for i in 0..n {
         let (b, c) = (ring[i], ring[(i + 1) % n]);
         // Triangles through the apex vertex itself are degenerate and contribute exactly zero.
         if b != apex && c != apex {
-            sum += triangle_solid_angle(apex, b, c);
+            let t = triangle_solid_angle(apex, b, c);
+            sum += t;
+            if ERR {
+                // t = 2 atan2(det, den) moves by 2 (|den| e_det + |det| e_den) / (det^2 + den^2)
+                // for errors e_det, e_den of its arguments: a few ulps of the edges' product
+                // (at most half the sum of their squares) and of the four unit terms of den.
+                // Over det^2 + den^2, not den^2: where den alone vanishes (b and c almost
+                // antipodal, the apex a quarter turn from both) the angle is near +-pi and
+                // conditioned by |det|.
+                let det = apex.dot((b - apex).cross(c - apex));
+                let den = 1.0 + apex.dot(b) + b.dot(c) + c.dot(apex);
+                let sides = 0.5 * ((b - apex).length_squared() + (c - apex).length_squared());
+                let spread = (sides * den.abs() + 4.0 * det.abs()) / (det * det + den * den);
+                err += 32.0 * f64::EPSILON * (spread + t.abs() + sum.abs());
+            }
         }
     }
-    // A ring's left area is in (0, 4 pi); the fan gives it modulo 4 pi. A tiny clockwise ring
-    // gives -epsilon and maps to 4 pi - epsilon, as it should.
-    let area = sum.rem_euclid(4.0 * PI);
-    area.clamp(0.0, 4.0 * PI)
+    if (-2.0 * PI..=2.0 * PI).contains(&sum) {
+        return (sum, err);
+    }
+    let left = sum.rem_euclid(4.0 * PI);
+    let small = if left > 2.0 * PI {
+        left - 4.0 * PI
+    } else {
+        left
+    };
+    (small, err + 8.0 * f64::EPSILON * 4.0 * PI)
+}
+
+/// Whether the unit vector `p` lies in the region bounded by `rings` (none: no region): the test
+/// of [`SphericalPolygon::contains`], also for a subset of a polygon's rings (one ring alone
+/// bounds the region on its left).
+///
+/// The side of the nearest boundary feature decides, where it is well-conditioned: within a
+/// quarter turn (squared chord at most 2). Farther away (for a tiny polygon all features are
+/// then almost equally far, and the direction from each towards `p` is almost normal to the
+/// sphere) every vertex lies in the open hemisphere about `-p`, whose gnomonic plane holds the
+/// whole boundary with `p` at infinity: `p` is inside iff the outermost rings run clockwise
+/// there ([`far_side_inside`]).
+pub(crate) fn rings_contain<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]> + Clone,
+    p: DVec3,
+) -> bool {
+    let Some((d, inside)) = nearest_feature(rings.clone(), p) else {
+        return false;
+    };
+    if d <= 2.0 {
+        return inside;
+    }
+    far_side_inside(rings, -p).unwrap_or(inside)
+}
+
+/// When every vertex of `rings` lies in the open hemisphere about `c` (by more than
+/// [`super::HORIZON_TOLERANCE`]): whether the region contains the far side of that hemisphere
+/// (its bounding circle and `-c`), else `None`.
+///
+/// In the gnomonic plane about `c` the rings are closed polygons and the far side is at
+/// infinity; the unbounded face is inside the region iff the outermost rings run clockwise,
+/// i.e. iff the total signed area is negative (nested rings alternate and are smaller than their
+/// parents). Each ring's shoelace sum is taken about its own first vertex: summing
+/// `P_i x P_{i+1}` about the plane's origin instead adds terms of the size of the ring's distance
+/// from `c` times its width, whose rounding swamps the area of a ring of 1e-8 rad or less. A
+/// total within rounding of zero (nested rings of almost equal areas) decides nothing (`None`).
+pub(crate) fn far_side_inside<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    c: DVec3,
+) -> Option<bool> {
+    let (mut area2, mut size2, mut terms) = (0.0, 0.0f64, 0usize);
+    for ring in rings {
+        let project = |p: DVec3| {
+            let w = p.dot(c);
+            (w > super::HORIZON_TOLERANCE).then(|| p / w)
+        };
+        let origin = project(*ring.first()?)?;
+        let mut prev = DVec3::ZERO;
+        for &p in &ring[1..] {
+            let d = project(p)? - origin;
+            area2 += prev.cross(d).dot(c);
+            let d2 = d.length_squared();
+            if d2 > size2 {
+                size2 = d2;
+            }
+            prev = d;
+        }
+        terms += ring.len();
+    }
+    // Each term rounds by a few ulps of |prev| |d| <= size2.
+    (area2.abs() > 1e-12 * terms as f64 * size2).then_some(area2 < 0.0)
 }
 
 /// The fan apex for [`ring_left_area`]: the first vertex when no vertex lies near its antipode
@@ -611,34 +1039,52 @@ pub(crate) fn nearest_feature<'a>(
         for i in 0..n {
             let a = ring[i];
             let b = ring[(i + 1) % n];
-            let nrm = a.cross(b);
+            // a x (b - a) = a x b, without the cancellation that would leave a short edge's
+            // normal with a relative error of 1e-16 over its length.
+            let nrm = a.cross(b - a);
+            let len = nrm.length();
             // p's nearest point on the great circle lies inside the arc iff turning from a to p
-            // and from p to b both go the arc's way round.
-            if a.cross(p).dot(nrm) > 0.0 && p.cross(b).dot(nrm) > 0.0 {
-                let s = p.dot(nrm) / nrm.length(); // sine of the distance to the circle
+            // and from p to b both go the arc's way round. The turns are taken from differences
+            // (a x p = a x (p - a)), so their rounding is relative to |p - a| and |b - p|; a foot
+            // within that rounding of an end is left to the end's vertex, which is then as near
+            // and decides the side from all the edges there (an edge whose foot only rounds
+            // into the arc would decide it alone, and wrongly, when p lies straight above a
+            // vertex outside the edge's wedge).
+            let pa = p - a;
+            let bp = b - p;
+            if a.cross(pa).dot(nrm) > 1e-15 * pa.length() * len
+                && p.cross(bp).dot(nrm) > 1e-15 * bp.length() * len
+            {
+                // Sine of the distance to the circle (p - a is exact for close points).
+                let s = pa.dot(nrm) / len;
                 let s2 = (s * s).min(1.0);
                 // Squared chord to the nearest point, 2 - 2 cos(d), without cancellation.
                 let d = 2.0 * s2 / (1.0 + crate::math::sqrt(1.0 - s2));
                 consider(d, Ok(s > 0.0));
             }
-            consider((p - a).length_squared(), Err(a));
+            consider(pa.length_squared(), Err(a));
         }
     }
     let (d, what) = best?;
     Some((d, what.unwrap_or_else(|v| vertex_side(rings, v, p))))
 }
 
-/// Whether `p` (a point, or a tangent direction at `v`) lies inside the region near the vertex
-/// `v`, from every visit of the rings to `v` (a pinch vertex is visited more than once). Around `v`, the sector just counter-clockwise of
-/// an edge direction is inside iff that edge leaves `v` (the interior is on the left of every
-/// edge); so the answer is the kind of the edge met first turning clockwise from `p`.
+/// Whether the point `p` lies inside the region near the vertex `v`, from every visit of the
+/// rings to `v` (a pinch vertex is visited more than once). Around `v`, the sector just
+/// counter-clockwise of an edge direction is inside iff that edge leaves `v` (the interior is on
+/// the left of every edge); so the answer is the kind of the edge met first turning clockwise
+/// from `p`.
 pub(crate) fn vertex_side<'a>(
     rings: impl Iterator<Item = &'a [DVec3]>,
     v: DVec3,
     p: DVec3,
 ) -> bool {
     let (u, w) = super::predicates::tangent_frame(v);
-    let ang = |q: DVec3| crate::math::atan2(q.dot(w), q.dot(u));
+    // Directions in the tangent plane at v from the differences q - v, as in `check_pinches`.
+    let ang = |q: DVec3| {
+        let d = q - v;
+        crate::math::atan2(d.dot(w), d.dot(u))
+    };
     let target = ang(p);
     // (clockwise turn from p's direction to the edge's, edge leaves v)
     let mut best = (f64::INFINITY, false);
@@ -766,6 +1212,44 @@ mod tests {
             SphericalPolygon::full().complement(),
             SphericalPolygon::empty()
         );
+    }
+
+    /// `regularized` removes a spike narrower than the fold test and a repeated vertex, drops a
+    /// sliver ring, and says empty or full when every ring goes.
+    #[test]
+    fn regularized_removes_what_validation_rejects() {
+        let (a, b, c, d) = (
+            DVec3::new(1.0, 0.0, 0.2).normalize(),
+            DVec3::new(0.0, 1.0, 0.3).normalize(),
+            DVec3::new(0.1, 0.2, 1.0).normalize(),
+            DVec3::new(0.2, 0.1, 1.0).normalize(),
+        );
+        // A spike from c out towards d and back, 1e-14 rad wide, and a repeated vertex.
+        let tip = (d + (d - c).cross(c) * 1e-14).normalize();
+        let spiky: Verts = [a, b, b, c, tip, c, d].into_iter().collect();
+        let ends: SmallVec<[u32; 2]> = SmallVec::from_slice(&[spiky.len() as u32]);
+        assert!(
+            SphericalPolygon::from_parts(spiky.clone(), ends.clone())
+                .validate()
+                .is_err()
+        );
+        let (r, changed) = regularized(spiky, ends, 1e-13);
+        assert!(changed);
+        r.validate().unwrap();
+        let clean = SphericalPolygon::new(vec![vec![a, b, c, d]]).unwrap();
+        assert!((r.solid_angle() - clean.solid_angle()).abs() < 1e-13);
+        // A sliver ring alone (counter-clockwise: the path out bulges to the right of the arc
+        // back): dropped, leaving the empty region; reversed, the full sphere.
+        let mid = (a + b).normalize();
+        let sliver: Verts = [a, (mid - a.cross(b) * 1e-14).normalize(), b, mid]
+            .into_iter()
+            .collect();
+        let ends: SmallVec<[u32; 2]> = SmallVec::from_slice(&[4]);
+        let (r, _) = regularized(sliver.clone(), ends.clone(), 1e-13);
+        assert!(r.is_empty());
+        let reversed: Verts = sliver.into_iter().rev().collect();
+        let (r, _) = regularized(reversed, ends, 1e-13);
+        assert!(r.is_full());
     }
 
     #[test]

@@ -82,11 +82,27 @@ fn on_arc(p: DVec3, a: DVec3, b: DVec3) -> bool {
 /// counter-clockwise seen from outside, in `(-2 pi, 2 pi)`.
 ///
 /// Van Oosterom and Strackee (1983): `tan(Omega / 2) = det(a, b, c) / (1 + a.b + b.c + c.a)`.
-/// The determinant is evaluated on edge differences, `a . ((b - a) x (c - a))`, which keeps full
-/// relative precision for tiny triangles where `b x c` would cancel.
+/// The determinant is evaluated on edge differences, `a . (e x f)` for the two shorter of the
+/// edges `b - a`, `c - b`, `a - c` (whose cross products, in cyclic order, are all equal): that
+/// keeps full relative precision for tiny triangles, where `b x c` would cancel, and for thin
+/// ones seen from a far vertex, where the cross product of the two long edges would (a triangle
+/// 1e-8 wide from a vertex a radian away lost 1e-9 of its area that way).
 #[inline]
 pub(crate) fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let det = a.dot((b - a).cross(c - a));
+    let (e1, e2, e3) = (b - a, c - b, a - c);
+    let (l1, l2, l3) = (
+        e1.length_squared(),
+        e2.length_squared(),
+        e3.length_squared(),
+    );
+    let cross = if l1 >= l2 && l1 >= l3 {
+        e2.cross(e3)
+    } else if l2 >= l3 {
+        e3.cross(e1)
+    } else {
+        e1.cross(e2)
+    };
+    let det = a.dot(cross);
     let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
     2.0 * crate::math::atan2(det, den)
 }

@@ -6,7 +6,8 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::cull::{above_horizon, may_occlude};
+use super::cull::{Shaft, above_horizon, may_occlude, shaft_triangles};
+use super::union::{BlockerAccel, BlockerGeometry, LightRegion, one_pass};
 use super::{Blocker, Visibility};
 use crate::GeomError;
 use crate::planar::BoolOp;
@@ -16,7 +17,7 @@ use crate::solid::silhouette::{
     TriangleRole, clipped_triangle_polygon, convex_silhouette, nonconvex_silhouette,
     triangle_polygon,
 };
-use crate::solid::{Body, BoundingSphere, ClosedMesh, ShadingFrame, TriangleMesh};
+use crate::solid::{Body, BoundingSphere, Bvh, ClosedMesh, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
 
 /// What a failed union of a mesh light's front faces reports: the faces are valid polygons, so
@@ -32,15 +33,23 @@ const DIFFERENCE_GREW: &str =
 const DIFFERENCE_FAILED: &str =
     "subtracting a blocker's region from a light's region failed within rounding";
 
-/// How convex polyhedra are turned into spherical polygons.
+/// How objects are turned into spherical polygons and combined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum Method {
-    /// One silhouette polygon per convex polyhedron (seed 000 Alg. 2); meshes per triangle.
+    /// One silhouette polygon per convex polyhedron (seed 000 Alg. 2), meshes by their
+    /// triangles inside the shaft to the light, all blockers that lie wholly on the point's side
+    /// of the light removed in one planar pass (see `visibility/union.rs`); a closed mesh
+    /// light's region is the union of its front faces computed in the same chart.
     #[default]
     Silhouette,
-    /// Every shape per triangle (seed 000 section 4.4), convex ones included. Slower; it exists
-    /// as a cross-check of the silhouette path and for comparisons.
+    /// As [`Method::Silhouette`] for convex shapes and mesh lights, but every blocker region
+    /// (a convex silhouette, or each triangle of a mesh) subtracted in turn by its own spherical
+    /// boolean, as seed 000 Alg. 1 is written: the path before the one-pass union, kept for
+    /// comparisons.
+    Sequential,
+    /// Every shape per triangle (seed 000 section 4.4), convex ones included, subtracted in
+    /// turn. Slower; it exists as a cross-check of the silhouette paths and for comparisons.
     PerTriangle,
 }
 
@@ -71,7 +80,19 @@ pub struct ClipVisibility<L> {
     /// Per planar mesh light: its [`Outline`], for the fast path
     /// ([`ClipVisibility::visible_pieces`]).
     pub(super) outlines: Vec<Option<Outline>>,
+    /// Per blocker slot: a bounding-volume hierarchy over the triangles of a body with at least
+    /// [`BVH_MIN_TRIANGLES`] of them, for culling by shafts, and whether front faces alone
+    /// cover what a closed mesh hides.
+    accels: Vec<BlockerAccel>,
+    /// Per light and blocker slot, as `separations`: some vertex of the blocker lies in the
+    /// plane of one of the light's triangles (by [`face_side`]). Such a blocker is never
+    /// subtracted whole (see [`ClipVisibility::visible_region`], step 2).
+    touching: Vec<bool>,
 }
+
+/// Bodies with at least this many triangles get a [`Bvh`]; for fewer, testing every triangle
+/// against a shaft costs less than descending a tree.
+pub const BVH_MIN_TRIANGLES: usize = 32;
 
 /// How a blocker acts on one front face of a light (or on all of them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,10 +122,25 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             .collect();
         let occluder_bounds = occluders.iter().map(Body::bounding_sphere).collect();
         let mut separations = Vec::with_capacity(lights.len() * (occluders.len() + lights.len()));
+        let mut touching = Vec::with_capacity(separations.capacity());
         for (i, light) in lights.iter().enumerate() {
             let lm = light.as_ref().mesh();
+            let touches = |m: &TriangleMesh| {
+                let b = m.bounding_sphere();
+                (0..lm.triangle_count()).any(|f| {
+                    // Only a blocker whose bounding sphere reaches the plane has vertices on it
+                    // (with a margin far above the facing tolerance).
+                    let n = lm.triangle_normal(f);
+                    let d = n.dot(b.center - lm.triangle(f)[0]).abs();
+                    d <= b.radius * (1.0 + 1e-6) + 1e-6 * lm.bounding_sphere().radius
+                        && m.vertices()
+                            .iter()
+                            .any(|&v| face_side(lm, f, v) == Side::On)
+                })
+            };
             for o in &occluders {
                 separations.push(separating_plane(lm, o.mesh()));
+                touching.push(touches(o.mesh()));
             }
             for (k, other) in lights.iter().enumerate() {
                 separations.push(if k == i {
@@ -112,8 +148,14 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 } else {
                     separating_plane(lm, other.as_ref().mesh())
                 });
+                touching.push(k != i && touches(other.as_ref().mesh()));
             }
         }
+        let accels = occluders
+            .iter()
+            .chain(lights.iter().map(AsRef::as_ref))
+            .map(|b| BlockerAccel::new(b, BVH_MIN_TRIANGLES))
+            .collect();
         let solids = lights
             .iter()
             .map(|l| match l.as_ref() {
@@ -137,6 +179,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             solids,
             separations,
             outlines,
+            accels,
+            touching,
         }
     }
 
@@ -194,6 +238,33 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// The precomputed separating plane between light `light` and blocker `b`, if any.
     pub(super) fn separation(&self, light: usize, b: Blocker) -> Option<Separation> {
         self.separations[light * self.blocker_count() + self.slot(b)]
+    }
+
+    /// Whether convex shapes are taken by their silhouettes.
+    fn silhouettes(&self) -> bool {
+        self.method != Method::PerTriangle
+    }
+
+    /// The bounding-volume hierarchy of a blocker's triangles, if it has one.
+    pub(super) fn bvh(&self, b: Blocker) -> Option<&Bvh> {
+        self.accels[self.slot(b)].bvh.as_ref()
+    }
+
+    /// Bytes held by the bounding-volume hierarchies of all objects, and the number of
+    /// triangles they cover.
+    #[must_use]
+    pub fn bvh_bytes(&self) -> (usize, usize) {
+        self.accels
+            .iter()
+            .filter_map(|a| a.bvh.as_ref())
+            .fold((0, 0), |(b, t), h| {
+                (b + h.byte_size(), t + h.triangle_count())
+            })
+    }
+
+    /// Whether blocker `b` has a vertex in the plane of a triangle of light `light`.
+    pub(super) fn touches(&self, light: usize, b: Blocker) -> bool {
+        self.touching[light * self.blocker_count() + self.slot(b)]
     }
 
     /// The geometry and bounding sphere of a blocker.
@@ -266,10 +337,16 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ///    crosses the plane once, blocker first. It is then subtracted whole from the light's
     ///    region (seed 000 Alg. 1 lines 7-12), which costs one dot product per point beyond the
     ///    paper's plain subtraction. With `x` on the light's side it hides nothing (culled in
-    ///    step 1).
-    /// 3. A blocker that interpenetrates the light is tested against each front face's plane
-    ///    (its vertices, by the facing predicate [`face_side`]): entirely in every
-    ///    `H_f`, it is subtracted whole as in 2; in none, it is dropped.
+    ///    step 1). A blocker that touches the plane of a light triangle (a vertex on it by
+    ///    [`face_side`], e.g. a box hanging from a quad light) is not in the open `H_f` there:
+    ///    it goes to step 3.
+    /// 3. A blocker that interpenetrates or touches the light is tested against each front
+    ///    face's plane (its vertices, by the facing predicate [`face_side`]): entirely in
+    ///    every `H_f`, with no vertex on a face plane, it is subtracted whole as in 2; in none,
+    ///    it is dropped. Its points in a face's plane hide nothing of that face: subtracted
+    ///    whole, a face of the blocker lying in the light's plane would hide the directions
+    ///    through it from a point inside the blocker or on its surface, so such a blocker
+    ///    straddles (step 4).
     /// 4. Otherwise, and for open non-planar mesh lights, the light is handled face by face: each
     ///    front triangle's projection (seed 000 section 4.4) minus the blockers that are whole on
     ///    its side, minus each triangle of a straddling blocker cut by the face plane to its part
@@ -321,7 +398,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         blocked: bool,
     ) -> Result<(Vec<SphericalPolygon>, bool), GeomError> {
         let body = self.light_body(light)?;
-        if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[light]) {
+        if !above_horizon(frame.origin(), frame.normal(), self.light_bounds[light])
+            || self.seen_from_inside(light, body, frame.origin())
+        {
             return Ok((Vec::new(), false));
         }
         let mesh = body.mesh();
@@ -330,7 +409,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         let mut overlapping: SmallVec<[Blocker; 4]> = SmallVec::new();
         if blocked {
             for b in self.blockers_between(light, frame) {
-                if self.separation(light, b).is_some() {
+                if self.separation(light, b).is_some() && !self.touches(light, b) {
                     whole.push(b);
                 } else {
                     overlapping.push(b);
@@ -365,6 +444,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
         }
         if straddling.is_empty() && !self_blocking {
+            if self.method == Method::Silhouette
+                && let Some(out) = self.one_pass_region(light, frame, &whole)?
+            {
+                return Ok((out, true));
+            }
             let mut out = self.light_region_unchecked(light, frame)?;
             if !whole.is_empty() {
                 let mut regions = Vec::new();
@@ -378,7 +462,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
             // Checked where pieces came out of set operations on single triangles: differences
             // (whole blockers) or the union of a non-convex mesh light's front faces.
-            let silhouette = matches!((body, self.method), (Body::Convex(_), Method::Silhouette));
+            let silhouette = matches!(body, Body::Convex(_)) && self.silhouettes();
             let combined =
                 !whole.is_empty() || (matches!(body, Body::Mesh(_)) && !mesh.is_planar());
             return Ok((out, !silhouette && combined));
@@ -415,12 +499,13 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                     }
                     Reach::Straddles => {
                         let (body, _) = self.blocker(b);
-                        piece = subtract_cut(piece, body, true, mesh, f, frame)?;
+                        piece = subtract_cut(piece, body, self.bvh(b), true, mesh, f, frame)?;
                     }
                 }
             }
             if own_blockers && !piece.is_empty() {
-                piece = subtract_cut(piece, body, false, mesh, f, frame)?;
+                let own = self.bvh(Blocker::Light(light));
+                piece = subtract_cut(piece, body, own, false, mesh, f, frame)?;
             }
             if !piece.is_empty() {
                 // Differences only remove: a piece larger than the face's part it started from
@@ -441,18 +526,51 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// facing predicate ([`face_side`]; vertices within its tolerance are on the plane).
     fn reach(&self, light: usize, b: Blocker, f: usize) -> Reach {
         let mesh = self.lights[light].as_ref().mesh();
-        let (mut front, mut behind) = (false, false);
+        let (mut front, mut behind, mut on) = (false, false, false);
         for &v in self.blocker(b).0.mesh().vertices() {
             match face_side(mesh, f, v) {
                 Side::Front => front = true,
                 Side::Behind => behind = true,
-                Side::On => {}
+                Side::On => on = true,
             }
         }
-        match (front, behind) {
-            (true, false) => Reach::Whole,
-            (false, _) => Reach::Nothing,
-            (true, true) => Reach::Straddles,
+        match (front, behind, on) {
+            (true, false, false) => Reach::Whole,
+            (false, _, _) => Reach::Nothing,
+            // Part of the blocker lies in the face's plane and hides nothing: subtracted whole,
+            // it would hide the directions through that part from a point inside the blocker
+            // or on its surface (seen from outside a closed blocker a ray enters it elsewhere
+            // first, but that is not known here).
+            (true, _, _) => Reach::Straddles,
+        }
+    }
+
+    /// The visible region of light `light` minus the `whole` blockers in one planar pass
+    /// ([`Method::Silhouette`]; see `visibility/union.rs`), or `None` when the light is too wide
+    /// for one chart. A non-planar mesh light (closed here: open ones go face by face) is the
+    /// union of its front faces in the same chart, other lights their
+    /// [`ClipVisibility::light_region`] pieces.
+    fn one_pass_region(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        whole: &[Blocker],
+    ) -> Result<Option<Vec<SphericalPolygon>>, GeomError> {
+        let body = self.light_body(light)?;
+        let blockers: SmallVec<[BlockerGeometry<'_>; 8]> = whole
+            .iter()
+            .map(|&b| (self.blocker(b).0, &self.accels[self.slot(b)]))
+            .collect();
+        let bound = self.light_bounds[light];
+        match body {
+            Body::Mesh(m) if !m.is_planar() || !blockers.is_empty() => {
+                one_pass(LightRegion::FrontFaces(m), bound, &blockers, frame)
+            }
+            _ if blockers.is_empty() => Ok(None),
+            _ => {
+                let pieces = self.light_region_unchecked(light, frame)?;
+                one_pass(LightRegion::Pieces(&pieces), bound, &blockers, frame)
+            }
         }
     }
 
@@ -482,7 +600,22 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
+        if self.seen_from_inside(light, self.light_body(light)?, frame.origin()) {
+            return Ok(Vec::new());
+        }
         upper_pieces(self.light_region_unchecked(light, frame)?)
+    }
+
+    /// Whether `x` is inside closed light `light` (`body`). Seen from inside, every ray leaves
+    /// the light through a back face before it can meet a front one, and its outer surface
+    /// emits nothing inwards: the light has no region there, though a convex light's silhouette
+    /// is then the whole sphere and a non-convex one's front faces need not be empty. A point
+    /// on the surface of a convex light has no front face either and receives nothing from it.
+    fn seen_from_inside(&self, light: usize, body: &Body, x: DVec3) -> bool {
+        match body {
+            Body::Convex(p) => !p.has_front_face(x),
+            _ => self.solids[light].as_ref().is_some_and(|s| s.encloses(x)),
+        }
     }
 
     fn light_region_unchecked(
@@ -498,10 +631,10 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 alloc::vec![s]
             }
         };
-        if let (Body::Convex(p), Method::Silhouette) = (body, self.method) {
+        if let (Body::Convex(p), true) = (body, self.silhouettes()) {
             return Ok(one(upper_part(&convex_silhouette(p, frame)?)?));
         }
-        if let (Some(solid), Method::Silhouette) = (&self.solids[light], self.method) {
+        if let (Some(solid), true) = (&self.solids[light], self.silhouettes()) {
             match nonconvex_silhouette(solid, frame) {
                 Ok(s) => return Ok(one(upper_part(&s)?)),
                 Err(e) if e.is_undecidable() => {}
@@ -544,8 +677,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ) -> Result<(), GeomError> {
         let (x, n) = (frame.origin(), frame.normal());
         let lb = self.light_bounds[light];
-        match (self.blocker(b).0, self.method) {
-            (Body::Convex(p), Method::Silhouette) => {
+        match (self.blocker(b).0, self.silhouettes()) {
+            (Body::Convex(p), true) => {
                 let occ = upper_part(&convex_silhouette(p, frame)?)?;
                 if !occ.is_empty() {
                     out.push(occ);
@@ -553,7 +686,10 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
             (body, _) => {
                 let mesh = body.mesh();
-                for t in 0..mesh.triangle_count() {
+                let mut ts = Vec::new();
+                shaft_triangles(mesh, self.bvh(b), &Shaft::to_sphere(x, n, lb), &mut ts);
+                for t in ts {
+                    let t = t as usize;
                     if !may_occlude(x, n, lb, triangle_bound(mesh.triangle(t))) {
                         continue;
                     }
@@ -590,15 +726,27 @@ impl<L: AsRef<Body>> Visibility for ClipVisibility<L> {
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
         self.region(light, frame, false)
     }
+
+    fn visible_pieces(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        blocked: bool,
+        out: &mut super::Pieces,
+    ) -> Result<bool, GeomError> {
+        ClipVisibility::visible_pieces(self, light, frame, blocked, out)
+    }
 }
 
 /// Subtracts from `piece` (part of light face `f` of `light_mesh`) the triangles of `blocker`
 /// cut to their parts strictly on the shading point's side of `f`'s plane (step 4 of
 /// [`ClipVisibility::visible_region`]). `external` is false when the blocker is the light's own
 /// mesh (then `f` itself is skipped).
+#[allow(clippy::too_many_arguments)]
 fn subtract_cut(
     mut piece: SphericalPolygon,
     blocker: &Body,
+    bvh: Option<&Bvh>,
     external: bool,
     light_mesh: &TriangleMesh,
     f: usize,
@@ -611,7 +759,10 @@ fn subtract_cut(
     // meet a back one, so the back ones add nothing.
     let front_only = matches!(blocker, Body::Convex(_))
         && (0..bm.triangle_count()).any(|t| face_side(bm, t, x) == Side::Front);
-    for t in 0..bm.triangle_count() {
+    let mut ts = Vec::new();
+    shaft_triangles(bm, bvh, &Shaft::to_sphere(x, up_world, face_bound), &mut ts);
+    for t in ts {
+        let t = t as usize;
         if (!external && t == f) || (front_only && face_side(bm, t, x) == Side::Behind) {
             continue;
         }

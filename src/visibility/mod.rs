@@ -5,8 +5,9 @@
 //! - [`ClipVisibility`]: the exact rule `visible(f) = proj(f) - U_B proj(B n H_f)` evaluated with
 //!   spherical set operations (seed 000 Alg. 1, extended to blockers that interpenetrate or hide
 //!   lights); see [`ClipVisibility::visible_region`].
-//! - A second backend, the lazily built BSP of occluder equivalence classes in Pluecker space
-//!   (seed 002, Alg. 1), can implement the same trait.
+//! - [`PluckerVisibility`]: the same rule by the lazily built BSP of occluder equivalence
+//!   classes in Pluecker space (seed 002, Alg. 1), with trees reused across coherent queries
+//!   through a caller-owned [`PluckerContext`]; see [`plucker`].
 //!
 //! Blockers are named by [`Blocker`] (an occluder or another light), never by a bare index.
 //! Culling (seed 000 `GetBetween`, section 3.5) discards blockers that cannot lie between the
@@ -15,11 +16,14 @@
 mod clip;
 pub(crate) mod cull;
 mod pieces;
+pub mod plucker;
+mod union;
 
 use alloc::vec::Vec;
 
-pub use clip::{ClipVisibility, Method};
+pub use clip::{BVH_MIN_TRIANGLES, ClipVisibility, Method};
 pub use pieces::Pieces;
+pub use plucker::{PluckerContext, PluckerVisibility, WithContext};
 
 use crate::GeomError;
 use crate::solid::ShadingFrame;
@@ -69,4 +73,26 @@ pub trait Visibility {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError>;
+
+    /// The backend's fast path, where it has one: the region of
+    /// [`Visibility::visible_region`] (`blocked`) or of [`Visibility::unoccluded_region`]
+    /// (without) as [`Pieces`] in `out`, whose integrals are those of the polygons up to
+    /// rounding. `Ok(true)` when `out` holds the region, `Ok(false)` when the caller must ask
+    /// for the polygons. The default has no fast path; [`ClipVisibility`] answers with
+    /// [`ClipVisibility::visible_pieces`].
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::OutOfRange`] for a light index past the end (the default, which declines
+    /// every query, leaves that to [`Visibility::visible_region`]).
+    fn visible_pieces(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        blocked: bool,
+        out: &mut Pieces,
+    ) -> Result<bool, GeomError> {
+        let _ = (light, frame, blocked, out);
+        Ok(false)
+    }
 }

@@ -58,12 +58,17 @@
 //! - a convex light (its silhouette ring), or a planar mesh light (its boundary loops,
 //!   [`TriangleMesh::boundary_loops`], once per scene: seen from the front its region is the
 //!   region they bound, not a union of its triangles);
-//! - blockers that are separated from the light by the precomputed plane (step 2 of
-//!   [`ClipVisibility::visible_region`]: subtracted whole), convex (their contour half-spaces)
-//!   or meshes (each triangle's three half-spaces, seen from either side).
+//! - blockers that are separated from the light by the precomputed plane and touch none of its
+//!   triangles' planes (step 2 of [`ClipVisibility::visible_region`]: subtracted whole),
+//!   convex (their contour half-spaces) or meshes below
+//!   [`BVH_MIN_TRIANGLES`](super::BVH_MIN_TRIANGLES) triangles (each triangle's three
+//!   half-spaces, seen from either side).
 //!
 //! It declines (`Ok(false)`), leaving the region to the spherical path, for everything else: a
-//! blocker that interpenetrates the light, non-planar mesh lights, a planar light seen
+//! blocker that interpenetrates the light or has a vertex in the plane of one of its triangles,
+//! a mesh blocker with a hierarchy (the one-pass union culls its triangles by shafts, see
+//! `visibility/union.rs`), a point inside a closed light or on its surface (a convex light
+//! without a front face), non-planar mesh lights, a planar light seen
 //! edge-on by some of its triangles and not others, every silhouette that
 //! [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) would not take as one
 //! loop chained by vertex index with well separated vertices (the point inside or on a convex
@@ -879,11 +884,17 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             if out.is_empty() {
                 break;
             }
-            // Interpenetrating blockers act face by face: the spherical path's business.
+            // Interpenetrating blockers, and blockers with a vertex in the plane of a light
+            // triangle (never subtracted whole: the touching part hides nothing), act face by
+            // face: the spherical path's business. Meshes large enough for a hierarchy go to
+            // the one-pass union, which culls their triangles by shafts.
             let fits = self.separation(light, b).is_some()
+                && !self.touches(light, b)
                 && match self.blocker(b).0 {
                     Body::Convex(p) => convex_planes(p, frame, out) && out.subtract(),
-                    Body::Mesh(m) => self.subtract_triangles(light, m, frame, out),
+                    Body::Mesh(m) => {
+                        self.bvh(b).is_none() && self.subtract_triangles(light, m, frame, out)
+                    }
                 };
             if !fits {
                 out.clear();

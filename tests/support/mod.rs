@@ -8,6 +8,7 @@
 //!   integrals with stated bounds, quadrature over spherical triangles.
 //! - [`ltc`]: quadrature about a pole, histogram checks of samplers.
 //! - [`shade`]: shading points on meshes and the ground, views above a surface.
+//! - [`visibility`]: an exact ray arbiter between visible regions.
 #![allow(dead_code)]
 
 pub mod ltc;
@@ -15,6 +16,7 @@ pub mod planar;
 pub mod rng;
 pub mod shade;
 pub mod sphere;
+pub mod visibility;
 
 pub use rng::Rng;
 

@@ -47,6 +47,10 @@
 //! its right child (the left child follows it); a leaf holds the offset of its data. Leaf data
 //! are small integers stored with the narrowest width (1, 2 or 4 bytes) that holds all of them:
 //! vertex indices for convex polyhedra, `edge << 2 | direction | from-crossing` for arcs.
+//! Built with triangulations ([`SilhouetteBsp::build_triangulated`]), each leaf with rings
+//! ends with its triangle count and its triangles as index triples into its `n` corners (the
+//! arcs' starts), one element `i + n (j + n k)` each where `n^3` fits the width (the width of
+//! everything else decides), else three.
 
 use alloc::collections::BTreeMap;
 use alloc::vec;
@@ -60,12 +64,18 @@ use super::convex::chain_by_index;
 use super::nonconvex::{
     Arc, ORDER_ERROR, Outline, collinear, evaluate_rings, outline, outline_with,
 };
+use super::triangulated::{
+    CellCorners, Extra, OnFace, SNAP_REL, TriangleSource, certified_triangulation, evaluate_stored,
+    fan_or_list, raw_stored,
+};
 use super::{convex_silhouette, nonconvex_silhouette};
 use crate::GeomError;
 use crate::solid::facing::{FACE_TOLERANCE, Side, face_distances};
 use crate::solid::{ClosedMesh, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 use crate::sphere::predicates::c3;
-use crate::sphere::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon};
+use crate::sphere::{
+    ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, SphericalTriangle,
+};
 
 /// The default box of a BSP is the mesh's bounding sphere's center plus or minus this many
 /// bounding radii along each axis. Shading points farther out are answered by the direct
@@ -152,7 +162,12 @@ pub struct SilhouetteBsp {
     hi: DVec3,
     leaves: u32,
     direct_leaves: u32,
+    /// Whether leaves with rings carry a triangulation section (built with triangulations).
+    triangulated: bool,
 }
+
+/// The rings of a leaf as arcs and ring ends, read from the leaf data.
+type Rings = (SmallVec<[Arc; 24]>, SmallVec<[u32; 4]>);
 
 impl SilhouetteBsp {
     /// Precomputed silhouettes of a closed mesh in its default box
@@ -182,6 +197,72 @@ impl SilhouetteBsp {
         let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi);
         b.build_nonconvex();
         b.finish(Source::Solid(solid.clone()), lo, hi)
+    }
+
+    /// As [`SilhouetteBsp::build`], also storing per leaf a triangulation of its silhouette
+    /// that is certified valid everywhere in the leaf's cell (thesis 003 section 6.2.3; the
+    /// certificate and its argument are in the documentation of [`SilhouetteSampler`]'s
+    /// module, `solid/silhouette/triangulated.rs`), for [`SilhouetteBsp::query_triangles`].
+    /// Convex polyhedra need none: seen from a point of a cell of the face planes (off them by
+    /// more than the facing predicate's tolerance), the silhouette is strictly convex, since
+    /// three of its vertices seen on one great circle would put the point on a supporting
+    /// plane through three vertices, a face plane; so the fan of the stored loop from its
+    /// first vertex is a triangulation, and for them this is [`SilhouetteBsp::build`].
+    ///
+    /// [`SilhouetteSampler`]: crate::solid::SilhouetteSampler
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::build_in`].
+    pub fn build_triangulated(solid: &ClosedMesh) -> Result<Self, GeomError> {
+        let (lo, hi) = default_region(solid.mesh());
+        SilhouetteBsp::build_triangulated_in(solid, lo, hi)
+    }
+
+    /// As [`SilhouetteBsp::build_triangulated`], in the box `[lo, hi]`.
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::build_in`].
+    pub fn build_triangulated_in(
+        solid: &ClosedMesh,
+        lo: DVec3,
+        hi: DVec3,
+    ) -> Result<Self, GeomError> {
+        Ok(SilhouetteBsp::build_triangulated_recording(solid, lo, hi, false)?.0)
+    }
+
+    /// As [`SilhouetteBsp::build_triangulated`], also returning the vertices of the cell of
+    /// every leaf that stores a triangulation (the convex cell its certificate covers), for
+    /// tests that sample points per cell.
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::build_in`].
+    #[doc(hidden)]
+    pub fn build_triangulated_with_cells(
+        solid: &ClosedMesh,
+    ) -> Result<(Self, Vec<Vec<DVec3>>), GeomError> {
+        let (lo, hi) = default_region(solid.mesh());
+        SilhouetteBsp::build_triangulated_recording(solid, lo, hi, true)
+    }
+
+    fn build_triangulated_recording(
+        solid: &ClosedMesh,
+        lo: DVec3,
+        hi: DVec3,
+        record: bool,
+    ) -> Result<(Self, Vec<Vec<DVec3>>), GeomError> {
+        if let Ok(p) = ConvexPolyhedron::from_mesh(solid.mesh()) {
+            return Ok((SilhouetteBsp::build_convex_in(&p, lo, hi)?, Vec::new()));
+        }
+        check_region(lo, hi)?;
+        let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi);
+        b.triangulate = Some(OnFace::new(solid.mesh()));
+        b.cells = record.then(Vec::new);
+        b.build_nonconvex();
+        let cells = b.cells.take().unwrap_or_default();
+        Ok((b.finish(Source::Solid(solid.clone()), lo, hi)?, cells))
     }
 
     /// Precomputed silhouettes of a convex polyhedron in its default box (thesis 003 section
@@ -225,38 +306,18 @@ impl SilhouetteBsp {
         if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
             return self.direct(frame);
         }
-        let Some(leaf) = self.leaf_of(x) else {
+        let Some(leaf) = self.leaf_of(x, matches!(self.source, Source::Solid(_))) else {
             return self.direct(frame);
         };
         let mut at = leaf as usize;
         match &self.source {
-            Source::Convex(poly) => {
-                let len = self.read(at) as usize;
-                if len == 0 {
-                    return convex_silhouette(poly, frame);
+            Source::Convex(poly) => match self.convex_loop(poly, at, frame) {
+                Some(out) => {
+                    let len = out.len() as u32;
+                    Ok(SphericalPolygon::from_parts(out, smallvec::smallvec![len]))
                 }
-                let verts = poly.vertices();
-                let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(len);
-                for k in 0..len {
-                    let v = verts[self.read(at + 1 + k) as usize];
-                    match frame.to_local(v).try_normalize() {
-                        Some(u) => out.push(u),
-                        None => return convex_silhouette(poly, frame),
-                    }
-                }
-                // The spacing test of `convex_silhouette`, which then takes its general path.
-                let spaced = (0..len).all(|k| {
-                    let (a, b) = (out[k], out[(k + 1) % len]);
-                    (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
-                });
-                if !spaced {
-                    return convex_silhouette(poly, frame);
-                }
-                Ok(SphericalPolygon::from_parts(
-                    out,
-                    smallvec::smallvec![len as u32],
-                ))
-            }
+                None => convex_silhouette(poly, frame),
+            },
             Source::Solid(solid) => {
                 let header = self.read(at);
                 at += 1;
@@ -265,22 +326,7 @@ impl SilhouetteBsp {
                     FULL => Ok(SphericalPolygon::full()),
                     DIRECT => nonconvex_silhouette(solid, frame),
                     _ => {
-                        let mut arcs: SmallVec<[Arc; 24]> = SmallVec::new();
-                        let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
-                        for _ in 0..header - RINGS {
-                            let len = self.read(at) as usize;
-                            at += 1;
-                            for _ in 0..len {
-                                let w = self.read(at);
-                                at += 1;
-                                arcs.push(Arc {
-                                    edge: w >> 2,
-                                    forward: w & 2 != 0,
-                                    from_crossing: w & 1 != 0,
-                                });
-                            }
-                            ends.push(arcs.len() as u32);
-                        }
+                        let (arcs, ends) = self.read_rings(header, &mut at);
                         let rings = evaluate_rings(solid.mesh(), &arcs, &ends, frame)?;
                         let mut verts: SmallVec<[DVec3; 12]> = SmallVec::new();
                         let mut ring_ends: SmallVec<[u32; 2]> = SmallVec::new();
@@ -305,6 +351,181 @@ impl SilhouetteBsp {
         }
     }
 
+    /// A triangulation of the silhouette seen from the frame's point (local frame), written to
+    /// `out`: positively oriented spherical triangles with disjoint interiors whose union is
+    /// the region of [`SilhouetteBsp::query`] (up to the rounding of its vertices). Where the
+    /// tree stores a certified triangulation for the point's cell
+    /// ([`SilhouetteBsp::build_triangulated`]), or for a convex polyhedron (the fan of its
+    /// silhouette loop), it is evaluated at the point and checked there (each triangle's
+    /// orientation exactly, their solid angles below `4 pi`); otherwise, or when that check
+    /// fails, the queried silhouette is triangulated at the point
+    /// ([`SphericalPolygon::triangulate`]). The result says which.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::solid::{ClosedMesh, ShadingFrame, SilhouetteBsp, TriangleSource};
+    /// use arealight::internals::thesis_polyhedra;
+    /// let (_, bowl) = thesis_polyhedra()?.pop().unwrap();
+    /// let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(bowl)?)?;
+    /// let frame = ShadingFrame::new(DVec3::new(0.3, -0.2, 3.0), DVec3::Z, DVec3::Z)?;
+    /// let mut tris = Vec::new();
+    /// assert_eq!(bsp.query_triangles(&frame, &mut tris)?, TriangleSource::Stored);
+    /// let area: f64 = tris.iter().map(|t| t.solid_angle()).sum();
+    /// assert!((area - bsp.query(&frame)?.solid_angle()).abs() < 1e-12);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// Those of [`SilhouetteBsp::query`] and [`SphericalPolygon::triangulate`].
+    pub fn query_triangles(
+        &self,
+        frame: &ShadingFrame,
+        out: &mut Vec<SphericalTriangle>,
+    ) -> Result<TriangleSource, GeomError> {
+        out.clear();
+        if self.stored_into(frame, out) {
+            return Ok(TriangleSource::Stored);
+        }
+        *out = self.query(frame)?.triangulate()?;
+        Ok(TriangleSource::Computed)
+    }
+
+    /// The stored triangulation (or convex fan) evaluated and checked at the point; `false`
+    /// where there is none or the check fails.
+    fn stored_into(&self, frame: &ShadingFrame, out: &mut Vec<SphericalTriangle>) -> bool {
+        let x = frame.origin();
+        if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
+            return false;
+        }
+        let Some(leaf) = self.leaf_of(x, true) else {
+            return false;
+        };
+        let mut at = leaf as usize;
+        match &self.source {
+            Source::Convex(poly) => match self.convex_loop(poly, at, frame) {
+                Some(dirs) => {
+                    let n = dirs.len() as u32;
+                    fan_or_list(&dirs, (1..n - 1).map(|k| [0, k, k + 1]), out)
+                }
+                None => false,
+            },
+            Source::Solid(solid) => {
+                let header = self.read(at);
+                at += 1;
+                if !self.triangulated || header < RINGS {
+                    return false;
+                }
+                let (arcs, ends) = self.read_rings(header, &mut at);
+                let tris = self.read_triangles(at, arcs.len());
+                !tris.is_empty() && evaluate_stored(solid.mesh(), &arcs, &ends, &tris, frame, out)
+            }
+        }
+    }
+
+    /// The stored triangulation of the point's cell evaluated at the point (local frame) with
+    /// no check: `None` where there is none. For tests of the build-time certificate.
+    #[doc(hidden)]
+    #[must_use]
+    pub fn stored_triangulation(&self, frame: &ShadingFrame) -> Option<Vec<[DVec3; 3]>> {
+        let x = frame.origin();
+        if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
+            return None;
+        }
+        let mut at = self.leaf_of(x, true)? as usize;
+        match &self.source {
+            Source::Convex(poly) => {
+                let d = self.convex_loop(poly, at, frame)?;
+                Some((1..d.len() - 1).map(|k| [d[0], d[k], d[k + 1]]).collect())
+            }
+            Source::Solid(solid) => {
+                let header = self.read(at);
+                at += 1;
+                if !self.triangulated || header < RINGS {
+                    return None;
+                }
+                let (arcs, ends) = self.read_rings(header, &mut at);
+                let tris = self.read_triangles(at, arcs.len());
+                if tris.is_empty() {
+                    return None;
+                }
+                raw_stored(solid.mesh(), &arcs, &ends, &tris, frame)
+            }
+        }
+    }
+
+    /// The silhouette loop of a convex polyhedron's leaf as unit directions, or `None` where
+    /// [`convex_silhouette`] answers (no loop stored, or vertices too close to chain).
+    fn convex_loop(
+        &self,
+        poly: &ConvexPolyhedron,
+        at: usize,
+        frame: &ShadingFrame,
+    ) -> Option<SmallVec<[DVec3; 12]>> {
+        let len = self.read(at) as usize;
+        if len == 0 {
+            return None;
+        }
+        let verts = poly.vertices();
+        let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(len);
+        for k in 0..len {
+            let v = verts[self.read(at + 1 + k) as usize];
+            out.push(frame.to_local(v).try_normalize()?);
+        }
+        // The spacing test of `convex_silhouette`, which then takes its general path.
+        let spaced = (0..len).all(|k| {
+            let (a, b) = (out[k], out[(k + 1) % len]);
+            (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+        });
+        spaced.then_some(out)
+    }
+
+    /// The rings of a leaf with `header` (at least [`RINGS`]), read from `*at` on; `*at` ends
+    /// after them.
+    fn read_rings(&self, header: u32, at: &mut usize) -> Rings {
+        let mut arcs: SmallVec<[Arc; 24]> = SmallVec::new();
+        let mut ends: SmallVec<[u32; 4]> = SmallVec::new();
+        for _ in 0..header - RINGS {
+            let len = self.read(*at) as usize;
+            *at += 1;
+            for _ in 0..len {
+                let w = self.read(*at);
+                *at += 1;
+                arcs.push(Arc {
+                    edge: w >> 2,
+                    forward: w & 2 != 0,
+                    from_crossing: w & 1 != 0,
+                });
+            }
+            ends.push(arcs.len() as u32);
+        }
+        (arcs, ends)
+    }
+
+    /// The triangle section of a leaf with `corners` corners at `at` (after its rings): index
+    /// triples into the corners, empty where the leaf stores none.
+    fn read_triangles(&self, at: usize, corners: usize) -> SmallVec<[[u32; 3]; 16]> {
+        let t = self.read(at) as usize;
+        if packs(corners, self.width) {
+            let n = corners as u32;
+            (0..t)
+                .map(|k| {
+                    let w = self.read(at + 1 + k);
+                    [w % n, w / n % n, w / (n * n)]
+                })
+                .collect()
+        } else {
+            (0..t)
+                .map(|k| {
+                    let b = at + 1 + 3 * k;
+                    [self.read(b), self.read(b + 1), self.read(b + 2)]
+                })
+                .collect()
+        }
+    }
+
     /// The direct algorithm for the polyhedron.
     fn direct(&self, frame: &ShadingFrame) -> Result<SphericalPolygon, GeomError> {
         match &self.source {
@@ -314,12 +535,14 @@ impl SilhouetteBsp {
     }
 
     /// The data offset of the leaf holding `x`; `None` when a triple test is within rounding,
-    /// or, for a non-convex solid, `x` lies within the facing predicate's tolerance of a face
-    /// plane on the path: there the face counts as edge-on while the exact tests of planes
-    /// through vertices of that face see `x` on one side, so `x` may belong to no stored cell
-    /// (the direct algorithm then decides, or gives up, itself).
-    fn leaf_of(&self, x: DVec3) -> Option<u32> {
-        let band = matches!(self.source, Source::Solid(_));
+    /// or, with `band`, when `x` lies within the facing predicate's tolerance of a face plane
+    /// on the path. A non-convex solid's query always sets it: there the face counts as
+    /// edge-on while the exact tests of planes through vertices of that face see `x` on one
+    /// side, so `x` may belong to no stored cell (the direct algorithm then decides, or gives
+    /// up, itself). The stored triangulations set it for convex polyhedra too: within the band
+    /// a face counted edge-on may in fact be seen from its front, and the loop is then convex
+    /// only up to the tolerance.
+    fn leaf_of(&self, x: DVec3, band: bool) -> Option<u32> {
         let mesh = self.source.mesh();
         let b = mesh.bounding_sphere();
         let rel = x - b.center;
@@ -423,6 +646,53 @@ impl SilhouetteBsp {
             }
         }
         n
+    }
+
+    /// Number of leaves that store a certified triangulation
+    /// ([`SilhouetteBsp::build_triangulated`]), and number of leaves with silhouette rings (the
+    /// leaves that could store one; the others are empty, full, or answered directly).
+    #[must_use]
+    pub fn triangulated_leaf_count(&self) -> (usize, usize) {
+        let (mut stored, mut rings) = (0, 0);
+        self.for_each_triangulation(|t| {
+            rings += 1;
+            stored += usize::from(t > 0);
+        });
+        (stored, rings)
+    }
+
+    /// Number of stored triangles, over all leaves.
+    #[must_use]
+    pub fn stored_triangle_count(&self) -> usize {
+        let mut n = 0;
+        self.for_each_triangulation(|t| n += t);
+        n
+    }
+
+    /// Calls `f` with the stored triangle count of every leaf with rings of a non-convex solid.
+    fn for_each_triangulation(&self, mut f: impl FnMut(usize)) {
+        if !matches!(self.source, Source::Solid(_)) {
+            return;
+        }
+        for &w in &self.nodes {
+            if w & LEAF == 0 {
+                continue;
+            }
+            let mut at = (w & !LEAF) as usize;
+            let h = self.read(at);
+            at += 1;
+            if h < RINGS {
+                continue;
+            }
+            for _ in 0..h - RINGS {
+                at += 1 + self.read(at) as usize;
+            }
+            f(if self.triangulated {
+                self.read(at) as usize
+            } else {
+                0
+            });
+        }
     }
 
     /// Bytes of the precomputed data: nodes, leaf data and splitting planes (the mesh itself,
@@ -751,6 +1021,14 @@ struct Builder<'a> {
     stamp: Vec<u32>,
     memo: Vec<Option<bool>>,
     now: u32,
+    /// Whether leaves with rings get a triangulation section, with the exact coplanarity of
+    /// vertices and face planes for the certificate.
+    triangulate: Option<OnFace>,
+    /// When recording: the cell vertices of each leaf that stores a triangulation.
+    cells: Option<Vec<Vec<DVec3>>>,
+    /// The last triangulation certified per leaf structure (encoded outline), tried first in
+    /// the next cell with that structure (neighbouring cells often share it).
+    last_triangulation: BTreeMap<Vec<u32>, Vec<[u32; 3]>>,
 }
 
 impl<'a> Builder<'a> {
@@ -773,6 +1051,9 @@ impl<'a> Builder<'a> {
             stamp: Vec::new(),
             memo: Vec::new(),
             now: 0,
+            triangulate: None,
+            cells: None,
+            last_triangulation: BTreeMap::new(),
         }
     }
 
@@ -1146,11 +1427,11 @@ impl<'a> Builder<'a> {
         let mut found = None;
         for t in tries {
             if let Ok(o) = outline_with(solid, t, Some(&mut crossed)) {
-                found = Some(o);
+                found = Some((o, t));
                 break;
             }
         }
-        let Some(first) = found else {
+        let Some((first, at)) = found else {
             self.direct_leaves += 1;
             self.leaf_word(&[DIRECT]);
             return;
@@ -1167,8 +1448,14 @@ impl<'a> Builder<'a> {
                 }
             }
         }
+        let corners = self
+            .triangulate
+            .is_some()
+            .then(|| self.snapped_vertices(cell));
         if varying.is_empty() {
-            let payload = encode_outline(&first);
+            // Further points to triangulate at: vertices pulled half-way to the centroid.
+            let samples: Vec<DVec3> = cell.p.iter().take(4).map(|&p| c + (p - c) * 0.5).collect();
+            let payload = self.outline_payload(&first, at, corners.as_ref(), &samples);
             self.leaf_word(&payload);
             return;
         }
@@ -1202,7 +1489,35 @@ impl<'a> Builder<'a> {
             }
             samples.push((p, bits));
         }
-        self.triple_tree(solid, &varying, 0, samples);
+        self.triple_tree(solid, &varying, 0, samples, corners.as_ref());
+    }
+
+    /// A leaf's data for the outline `o` found at the point `at`: [`encode_outline`], and when
+    /// building triangulations (`cell` given) and `o` has rings, its triangle section, with a
+    /// triangulation certified over `cell` (tried at `at`, then at `samples`) or none.
+    fn outline_payload(
+        &mut self,
+        o: &Outline,
+        at: DVec3,
+        cell: Option<&CellCorners>,
+        samples: &[DVec3],
+    ) -> Vec<u32> {
+        let mut payload = encode_outline(o);
+        if let (Some(on_face), Some(cell), Outline::Rings { arcs, ends }) =
+            (&self.triangulate, cell, o)
+        {
+            let hint = self.last_triangulation.get(&payload).map(Vec::as_slice);
+            let extra = Extra { samples, hint };
+            let tris = certified_triangulation(self.mesh, arcs, ends, at, cell, on_face, extra);
+            if let Some(t) = &tris {
+                self.last_triangulation.insert(payload.clone(), t.clone());
+            }
+            push_triangles(&mut payload, tris.as_deref().unwrap_or(&[]));
+            if let (Some(cells), Some(_)) = (&mut self.cells, &tris) {
+                cells.push(cell.p.clone());
+            }
+        }
+        payload
     }
 
     /// The decision subtree over the signs of `varying[k..]` for the `samples` (points with
@@ -1213,6 +1528,7 @@ impl<'a> Builder<'a> {
         varying: &[[u32; 3]],
         k: usize,
         mut samples: Vec<(DVec3, u32)>,
+        cell: Option<&CellCorners>,
     ) {
         if samples.is_empty() {
             self.direct_leaves += 1;
@@ -1220,9 +1536,13 @@ impl<'a> Builder<'a> {
             return;
         }
         if k == varying.len() {
-            for &(p, _) in &samples {
+            for (i, &(p, _)) in samples.iter().enumerate() {
                 if let Ok(o) = outline(solid, p) {
-                    let payload = encode_outline(&o);
+                    // The triangulation is certified over the whole cell (condition 1 of the
+                    // certificate holds on any part of it); condition 3 is the query's own
+                    // check, since the part with these signs may be disconnected.
+                    let others: Vec<DVec3> = samples[i + 1..].iter().take(4).map(|s| s.0).collect();
+                    let payload = self.outline_payload(&o, p, cell, &others);
                     self.leaf_word(&payload);
                     return;
                 }
@@ -1243,13 +1563,136 @@ impl<'a> Builder<'a> {
             plane: id,
             right: 0,
         });
-        self.triple_tree(solid, varying, k + 1, samples);
+        self.triple_tree(solid, varying, k + 1, samples, cell);
         let right = self.nodes.len() as u32;
         self.nodes[node] = BuildNode::Inner { plane: id, right };
-        self.triple_tree(solid, varying, k + 1, pos);
+        self.triple_tree(solid, varying, k + 1, pos, cell);
     }
 
-    fn finish(self, source: Source, lo: DVec3, hi: DVec3) -> Result<SilhouetteBsp, GeomError> {
+    /// The cell's vertices, each snapped to a mesh vertex `m` where it is the intersection of
+    /// planes that all contain `m` exactly (three of them with independent normals, so that
+    /// their intersection is `m`) and lies within [`SNAP_REL`] of the box's size of it: such
+    /// corners (cells touching the solid) are where the triangulation certificate evaluates
+    /// affine functions that vanish at `m`, whose sign at the rounded vertex would be noise.
+    fn snapped_vertices(&self, cell: &Cell) -> CellCorners {
+        let verts = self.mesh.vertices();
+        let tris = self.mesh.triangles();
+        let points = |plane: u32| -> Option<[u32; 3]> {
+            match self.planes[plane as usize] {
+                SplitPlane::Face(f) => Some(tris[f as usize]),
+                SplitPlane::Through(s) => Some(s),
+                SplitPlane::Triple(_) => None,
+            }
+        };
+        let reach = SNAP_REL * (self.hi - self.lo).max_element();
+        let mut out = CellCorners {
+            p: Vec::with_capacity(cell.p.len()),
+            faces: Vec::with_capacity(cell.p.len()),
+        };
+        for (p, tags) in cell.p.iter().zip(&cell.tag) {
+            let planes: SmallVec<[[u32; 3]; 6]> = tags
+                .iter()
+                .filter(|&&t| t >= 6)
+                .filter_map(|&t| points(t - 6))
+                .collect();
+            let mut snapped = *p;
+            if planes.len() >= 3 {
+                let found = planes.iter().flatten().copied().find(|&m| {
+                    let q = verts[m as usize];
+                    (q - *p).length() <= reach
+                        && planes.iter().all(|s| {
+                            s.contains(&m)
+                                || orient3d(
+                                    c3(verts[s[0] as usize]),
+                                    c3(verts[s[1] as usize]),
+                                    c3(verts[s[2] as usize]),
+                                    c3(q),
+                                ) == 0.0
+                        })
+                        && independent(verts, &planes)
+                });
+                if let Some(m) = found {
+                    snapped = verts[m as usize];
+                }
+            }
+            out.p.push(snapped);
+            out.faces.push(
+                tags.iter()
+                    .filter(|&&t| t >= 6)
+                    .filter_map(|&t| match self.planes[(t - 6) as usize] {
+                        SplitPlane::Face(f) => Some(f),
+                        _ => None,
+                    })
+                    .collect(),
+            );
+        }
+        out
+    }
+
+    /// Packs the leaves' triangle sections (see [`packs`]) once the width of everything else
+    /// is known, moving the leaves' data offsets; returns that width.
+    fn pack_triangles(&mut self) -> u8 {
+        // The leaves' data in order (their offsets increase with the node order).
+        let leaves: Vec<usize> = self
+            .nodes
+            .iter()
+            .filter_map(|n| match n {
+                BuildNode::Leaf(off) => Some(*off as usize),
+                BuildNode::Inner { .. } => None,
+            })
+            .collect();
+        // Per leaf with rings: where its triangle count is, its corners and its triangles.
+        let parse = |at: usize| -> Option<(usize, usize, usize)> {
+            let h = self.data[at];
+            if h < RINGS {
+                return None;
+            }
+            let (mut p, mut n) = (at + 1, 0usize);
+            for _ in 0..h - RINGS {
+                let len = self.data[p] as usize;
+                n += len;
+                p += 1 + len;
+            }
+            Some((p, n, self.data[p] as usize))
+        };
+        let mut max = 0u32;
+        for &at in &leaves {
+            let end = parse(at).map_or(at + 1, |(p, _, _)| p + 1);
+            max = max.max(self.data[at..end].iter().copied().max().unwrap_or(0));
+        }
+        let width = width_of(max);
+        let mut out: Vec<u32> = Vec::with_capacity(self.data.len());
+        let mut moved: Vec<u32> = Vec::with_capacity(leaves.len());
+        for &at in &leaves {
+            moved.push(out.len() as u32);
+            match parse(at) {
+                None => out.push(self.data[at]),
+                Some((p, n, t)) => {
+                    out.extend_from_slice(&self.data[at..=p]);
+                    for k in 0..t {
+                        let tri = &self.data[p + 1 + 3 * k..p + 4 + 3 * k];
+                        if packs(n, width) {
+                            let n = n as u32;
+                            out.push(tri[0] + n * (tri[1] + n * tri[2]));
+                        } else {
+                            out.extend_from_slice(tri);
+                        }
+                    }
+                }
+            }
+        }
+        let mut k = 0;
+        for node in &mut self.nodes {
+            if let BuildNode::Leaf(off) = node {
+                *off = moved[k];
+                k += 1;
+            }
+        }
+        self.data = out;
+        width
+    }
+
+    fn finish(mut self, source: Source, lo: DVec3, hi: DVec3) -> Result<SilhouetteBsp, GeomError> {
         let n = self.nodes.len() as u64;
         let child_bits = (64 - n.max(2).leading_zeros()).max(1);
         let plane_bits = 64 - (self.planes.len() as u64).max(1).leading_zeros();
@@ -1260,6 +1703,7 @@ impl<'a> Builder<'a> {
                 limit: f64::from(LEAF),
             });
         }
+        let packed = self.triangulate.is_some().then(|| self.pack_triangles());
         let nodes: Vec<u32> = self
             .nodes
             .iter()
@@ -1268,14 +1712,8 @@ impl<'a> Builder<'a> {
                 BuildNode::Inner { plane, right } => (plane << child_bits) | right,
             })
             .collect();
-        let max = self.data.iter().copied().max().unwrap_or(0);
-        let width: u8 = if max < 1 << 8 {
-            1
-        } else if max < 1 << 16 {
-            2
-        } else {
-            4
-        };
+        let width =
+            packed.unwrap_or_else(|| width_of(self.data.iter().copied().max().unwrap_or(0)));
         let mut data = Vec::with_capacity(self.data.len() * width as usize);
         for &x in &self.data {
             data.extend_from_slice(&x.to_le_bytes()[..width as usize]);
@@ -1291,8 +1729,49 @@ impl<'a> Builder<'a> {
             hi,
             leaves: self.leaves,
             direct_leaves: self.direct_leaves,
+            triangulated: self.triangulate.is_some(),
         })
     }
+}
+
+/// The narrowest data width (bytes) that holds `max`.
+fn width_of(max: u32) -> u8 {
+    if max < 1 << 8 {
+        1
+    } else if max < 1 << 16 {
+        2
+    } else {
+        4
+    }
+}
+
+/// Whether a leaf with `n` corners stores each triangle as one word `i + n (j + n k)` at data
+/// width `width`: when `n^3` fits the width.
+fn packs(n: usize, width: u8) -> bool {
+    (n as u64).pow(3) <= 1u64 << (8 * u32::from(width))
+}
+
+/// Whether three of the planes through the given vertex triples have clearly independent normals
+/// (the determinant of their unit normals beyond `1e-6`), so that they meet in one point.
+fn independent(verts: &[DVec3], planes: &[[u32; 3]]) -> bool {
+    let normals: SmallVec<[DVec3; 6]> = planes
+        .iter()
+        .filter_map(|s| {
+            let [a, b, c] = s.map(|i| verts[i as usize]);
+            (b - a).cross(c - a).try_normalize()
+        })
+        .collect();
+    let n = normals.len();
+    for i in 0..n {
+        for j in i + 1..n {
+            for k in j + 1..n {
+                if normals[i].dot(normals[j].cross(normals[k])).abs() > 1e-6 {
+                    return true;
+                }
+            }
+        }
+    }
+    false
 }
 
 /// Leaf data of a convex polyhedron seen from `x`: `[len, vertex indices]` of the silhouette
@@ -1322,6 +1801,14 @@ fn convex_ring(mesh: &TriangleMesh, x: DVec3, dist: &mut Vec<f64>) -> Vec<u32> {
             out
         }
         None => vec![0],
+    }
+}
+
+/// Appends a leaf's triangle section: the count, then the index triples.
+fn push_triangles(payload: &mut Vec<u32>, tris: &[[u32; 3]]) {
+    payload.push(tris.len() as u32);
+    for t in tris {
+        payload.extend_from_slice(t);
     }
 }
 

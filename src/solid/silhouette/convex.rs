@@ -9,7 +9,10 @@ use smallvec::SmallVec;
 use crate::GeomError;
 use crate::solid::facing::Side;
 use crate::solid::{ConvexPolyhedron, ShadingFrame};
-use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon, order_directed_edges};
+use crate::sphere::{
+    ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon,
+    order_directed_edges,
+};
 
 /// The region a convex polyhedron covers, seen from the frame's origin, in the local frame.
 ///
@@ -89,6 +92,29 @@ pub fn convex_silhouette(
         if spaced {
             let ends: SmallVec<[u32; 2]> = smallvec::smallvec![n as u32];
             return Ok(SphericalPolygon::from_parts(out, ends));
+        }
+        // Vertices closer than the general path's merge tolerance: a polyhedron seen from far
+        // away (1e-9 rad across at 1e9 of its sizes) or an edge seen nearly end-on. Merging would
+        // collapse the ring, but the walk's order is exact, so the ring stands whenever it is a
+        // valid polygon (the sphere layer's validation resolves such tiny polygons exactly),
+        // once the ends of edges seen end-on, the same direction within rounding, are one
+        // vertex (which moves the boundary by less than COINCIDENT_TOLERANCE).
+        let mut ring: Vec<DVec3> = Vec::with_capacity(n);
+        for &u in &out {
+            if ring
+                .last()
+                .is_none_or(|&l| (u - l).length() > COINCIDENT_TOLERANCE)
+            {
+                ring.push(u);
+            }
+        }
+        while ring.len() > 1 && (ring[0] - ring[ring.len() - 1]).length() <= COINCIDENT_TOLERANCE {
+            ring.pop();
+        }
+        if ring.len() >= 3
+            && let Ok(p) = SphericalPolygon::new(alloc::vec![ring])
+        {
+            return Ok(p);
         }
     }
     order_edges_of(&contour, verts, frame)

@@ -7,6 +7,7 @@ mod bsp;
 mod convex;
 mod nonconvex;
 mod triangle;
+mod triangulated;
 
 pub use bsp::{DEFAULT_REGION_RADII, SilhouetteBsp};
 pub(crate) use convex::chain_by_index;
@@ -16,6 +17,7 @@ pub use nonconvex::nonconvex_silhouette;
 pub(crate) use nonconvex::{Arc, Outline, evaluate_rings, outline};
 pub(crate) use triangle::clipped_triangle_polygon;
 pub use triangle::{TriangleRole, triangle_polygon};
+pub use triangulated::{SilhouetteSampler, TriangleSource};
 
 #[cfg(test)]
 mod tests {

@@ -690,6 +690,39 @@ impl<'a> Coverage<'a> {
     }
 }
 
+/// The start and end vertices of an arc's mesh edge in the arc's direction, as vectors from the
+/// frame's point in the local frame.
+#[inline]
+fn arc_ends(mesh: &TriangleMesh, arc: &Arc, frame: &ShadingFrame) -> (DVec3, DVec3) {
+    let e = mesh.edges()[arc.edge as usize];
+    let (s, t) = if arc.forward { (e.a, e.b) } else { (e.b, e.a) };
+    let verts = mesh.vertices();
+    (
+        frame.to_local(verts[s as usize]),
+        frame.to_local(verts[t as usize]),
+    )
+}
+
+/// Where arc `k` of a ring starts, as a vector from the frame's point in the local frame: its
+/// edge's start vertex, or the point of its edge seen in line with the previous arc's edge
+/// ([`crossing_point`], always on the edge). [`evaluate_rings`] and the BSP's stored
+/// triangulations both take their vertices from here, so they share them bit for bit.
+pub(crate) fn arc_start(
+    mesh: &TriangleMesh,
+    ring: &[Arc],
+    k: usize,
+    frame: &ShadingFrame,
+) -> DVec3 {
+    let n = ring.len();
+    let (s, t) = arc_ends(mesh, &ring[k], frame);
+    if ring[k].from_crossing {
+        let (ps, pt) = arc_ends(mesh, &ring[(k + n - 1) % n], frame);
+        crossing_point(s, t, ps.cross(pt))
+    } else {
+        s
+    }
+}
+
 /// The rings of directions (local frame) of an outline's arcs seen from the frame's point. Arcs
 /// that subtend more than 120 degrees get an extra vertex at the foot of the perpendicular from
 /// the point to their edge, so that no ring edge comes near half a great circle.
@@ -699,32 +732,13 @@ pub(crate) fn evaluate_rings(
     ends: &[u32],
     frame: &ShadingFrame,
 ) -> Result<Vec<Vec<DVec3>>, GeomError> {
-    let verts = mesh.vertices();
-    let edges = mesh.edges();
-    let ends_of = |a: &Arc| {
-        let e = edges[a.edge as usize];
-        let (s, t) = if a.forward { (e.a, e.b) } else { (e.b, e.a) };
-        (
-            frame.to_local(verts[s as usize]),
-            frame.to_local(verts[t as usize]),
-        )
-    };
     let mut rings = Vec::with_capacity(ends.len());
     let mut start = 0usize;
     for &end in ends {
         let ring = &arcs[start..end as usize];
         let n = ring.len();
         // Start point of each arc (vectors from the point, local frame).
-        let mut starts: Vec<DVec3> = Vec::with_capacity(n);
-        for k in 0..n {
-            let (s, t) = ends_of(&ring[k]);
-            if ring[k].from_crossing {
-                let (ps, pt) = ends_of(&ring[(k + n - 1) % n]);
-                starts.push(crossing_point(s, t, ps.cross(pt)));
-            } else {
-                starts.push(s);
-            }
-        }
+        let starts: Vec<DVec3> = (0..n).map(|k| arc_start(mesh, ring, k, frame)).collect();
         let mut out = Vec::with_capacity(n + 2);
         for k in 0..n {
             let u = starts[k]
@@ -735,7 +749,7 @@ pub(crate) fn evaluate_rings(
             if u.dot(w) < -0.5 * w.length() {
                 // The foot of the perpendicular from the point to the edge's line lies between
                 // the two ends of an arc wider than 90 degrees.
-                let (s, t) = ends_of(&ring[k]);
+                let (s, t) = arc_ends(mesh, &ring[k], frame);
                 if let Some(f) = foot_point(s, t).try_normalize() {
                     out.push(f);
                 }

@@ -96,8 +96,39 @@ fn covered_region(local: &[DVec3], side: Side) -> Result<Option<SphericalPolygon
             | GeomError::CoincidentVertices { .. }
             | GeomError::TooFewVertices { .. },
         ) => Ok(None),
+        // Rounding can also make the ring of a triangle seen nearly edge-on look
+        // self-intersecting (three vertices cannot cross otherwise). Its solid angle, by Van
+        // Oosterom and Strackee's formula on edge differences, is then far below anything the
+        // layer resolves: it covers nothing. The formula is trusted only where its denominator
+        // is well away from zero (no two corners nearly opposite, which a point close to the
+        // triangle's edge line makes, and where the triangle can cover a quarter of the sphere).
+        Err(GeomError::SelfIntersecting { .. })
+            if keep.len() == 3
+                && edge_on_triangle([ordered[keep[0]], ordered[keep[1]], ordered[keep[2]]]) =>
+        {
+            Ok(None)
+        }
         Err(e) => Err(e.give_up("a projected triangle is degenerate within rounding")),
     }
+}
+
+/// Whether the spherical triangle of directions `ring` (any lengths) has a solid angle below
+/// `1e-12` sr, certified: Van Oosterom and Strackee's `tan(Omega / 2) = det / den` with the
+/// determinant on edge differences (absolute error below `64 eps` for unit vectors, whose
+/// differences are at most 2 long) and a denominator of at least `0.5`, where
+/// `|Omega| <= 2 |det| / den`. That is below the rounding of the integrals of any region the
+/// triangle is subtracted from.
+fn edge_on_triangle(ring: [DVec3; 3]) -> bool {
+    let (Some(a), Some(b), Some(c)) = (
+        ring[0].try_normalize(),
+        ring[1].try_normalize(),
+        ring[2].try_normalize(),
+    ) else {
+        return false;
+    };
+    let det = a.dot((b - a).cross(c - a));
+    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    den >= 0.5 && 2.0 * (det.abs() + 64.0 * f64::EPSILON) / den <= 1e-12
 }
 
 /// The region covered, seen from the frame's origin, by the part of blocker triangle `i` of

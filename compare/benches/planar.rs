@@ -22,13 +22,13 @@
 //! - `valid`: the simple star of the boolean groups, which needs no resolving: `with_fill_rule`
 //!   against `Shape::new` (the strict constructor) and the same references.
 //!
-//! Run: `cargo bench --bench planar`; results are summarized in BENCHMARKS.md.
+//! Run: `cargo bench -p arealight-compare --bench planar`; results are summarized in BENCHMARKS.md.
 
 use std::hint::black_box;
 use std::time::Duration;
 
-// The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
-#[path = "../tests/support/mod.rs"]
+// The inputs are shared with the tests (the crate's tests/planar_fast.rs checks that they take the fast path).
+#[path = "../../tests/support/mod.rs"]
 mod support;
 
 use arealight::glam::DVec2;
@@ -138,9 +138,9 @@ fn bench_resolve(c: &mut Criterion) {
             let cr: Vec<(f64, f64)> = ring.iter().map(|p| (p.x, p.y)).collect();
             g.bench_with_input(BenchmarkId::new("clipper2", n), &n, |bch, _| {
                 bch.iter(|| {
-                    let subject: clipper2::Paths<support::planar::Fine> =
+                    let subject: clipper2::Paths<arealight_compare::Fine> =
                         vec![black_box(&cr).clone()].into();
-                    let none: clipper2::Paths<support::planar::Fine> =
+                    let none: clipper2::Paths<arealight_compare::Fine> =
                         Vec::<Vec<(f64, f64)>>::new().into();
                     clipper2::union(subject, none, clipper2::FillRule::NonZero).unwrap()
                 })

@@ -16,11 +16,14 @@
 //! area identities hold with a second resolved shape). 64 cases per property by default,
 //! `PLANAR_CASES=N` for more.
 
+// The crate's shared test helpers (generators, text format), from the package next door.
+#[path = "../../tests/support/mod.rs"]
 mod support;
 
 use arealight::GeomError;
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, FillRule, SNAP_REL, Shape, boolean};
+use arealight_compare::*;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
 use i_overlay::float::single::SingleFloatOverlay;

@@ -18,12 +18,15 @@
 //!   `"expected"`: an object from operation (`intersection`, `union`, `difference`, `xor`) to
 //!   contours.
 
+// The crate's shared test helpers (generators, text format), from the package next door.
+#[path = "../../tests/support/mod.rs"]
 mod support;
 
 use std::collections::BTreeMap;
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, FillRule, Shape, boolean};
+use arealight_compare::*;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::simplify::SimplifyShape;
 use i_overlay::float::single::SingleFloatOverlay;

@@ -2,12 +2,12 @@
 //! implementation on one benchmark input `iters` times, so that
 //! `(callgrind count at 1001 iterations - count at 1) / 1000` is the cost of one call.
 //!
-//! Usage: `cargo run --release --example planar_count -- IMPL OP SHAPE N ITERS` with IMPL one of
+//! Usage: `cargo run --release -p arealight-compare --example planar_count -- IMPL OP SHAPE N ITERS` with IMPL one of
 //! `arealight`, `clipper2`, `i_overlay`; OP `difference` or `intersection`; SHAPE `convex` or
 //! `star`. Inputs are those of `benches/planar.rs`.
 
-// The inputs are shared with the tests (tests/planar_fast.rs checks that they take the fast path).
-#[path = "../tests/support/mod.rs"]
+// The inputs are shared with the tests (the crate's tests/planar_fast.rs checks that they take the fast path).
+#[path = "../../tests/support/mod.rs"]
 mod support;
 
 use std::hint::black_box;

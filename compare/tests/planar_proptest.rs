@@ -3,12 +3,16 @@
 //!
 //! Every property runs a fixed 256 cases. Failures are persisted by proptest under
 //! `proptest-regressions/` and each one is also turned into a named test in
-//! `tests/planar_regressions.rs`.
+//! the crate's `tests/planar_regressions.rs` (their reference checks in this package's
+//! `tests/planar_regressions.rs`).
 
+// The crate's shared test helpers (generators, text format), from the package next door.
+#[path = "../../tests/support/mod.rs"]
 mod support;
 
 use arealight::glam::DVec2;
 use arealight::planar::{BoolOp, Shape, boolean};
+use arealight_compare::*;
 use proptest::prelude::*;
 use proptest::test_runner::FileFailurePersistence;
 use support::planar::*;
@@ -49,7 +53,7 @@ fn check(a: &Shape, b: &Shape) -> Result<(), TestCaseError> {
         // clipper2 is the second reference. Where it disagrees with i_overlay too, i_overlay
         // decides: clipper2's union fills a hole that touches the boundary at a single point
         // (found by this property; see `vertex_at_edge_midpoint_union` in
-        // tests/planar_regressions.rs, whose areas are checked by hand there).
+        // the crate's tests/planar_regressions.rs, whose areas are checked by hand there).
         let ca = clipper_area(a, b, *op);
         let ia = ioverlay_area(&ioverlay(&to_paths(a), &to_paths(b), *op));
         let refs_agree = (ca - ia).abs() <= REF_TOL * norm;

@@ -1,0 +1,47 @@
+//! Helpers shared by the scene-file examples (`scene_file`, `bake`): output folder, tone mapping
+//! and PNG, camera and ray casting, progress line, argument parsing.
+#![allow(dead_code)]
+
+pub mod image;
+pub mod progress;
+pub mod trace;
+
+use arealight::glam::DVec3;
+
+/// The published Cornell box camera (metres): eye, target, up, vertical field of view
+/// (35 mm focal length on 25 mm film: `2 atan(12.5 / 35)`).
+pub fn cornell_camera() -> (DVec3, DVec3, DVec3, f64) {
+    (
+        DVec3::new(0.278, 0.273, -0.8),
+        DVec3::new(0.278, 0.273, 0.0),
+        DVec3::Y,
+        2.0 * (12.5f64 / 35.0).atan().to_degrees(),
+    )
+}
+
+/// `x,y,z` as a vector.
+pub fn parse_vec(s: &str) -> Result<DVec3, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().map_err(|e| format!("{s:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(*x, *y, *z)),
+        _ => Err(format!("{s:?}: expected x,y,z")),
+    }
+}
+
+/// Runs `f` on a rayon pool of `threads` workers (0: rayon's global pool, all cores).
+pub fn with_threads<T: Send>(
+    threads: usize,
+    f: impl FnOnce() -> Result<T, String> + Send,
+) -> Result<T, String> {
+    if threads == 0 {
+        return f();
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?
+        .install(f)
+}

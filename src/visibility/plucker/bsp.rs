@@ -1,0 +1,405 @@
+//! The lazily built BSP of occluder equivalence classes in Pluecker space (seed 002 section 4,
+//! Alg. 1 lines 1-13 and 31-35): occluder insertion by Theorem 1 and the merge of an occluder's
+//! own classes at an undefined leaf. The query that drives the growth is in `query.rs`.
+//!
+//! Every inner node holds the line of an occluder edge; its hyperplane splits Pluecker space
+//! into the lines with a positive and a negative side operator. A leaf is a class of lines:
+//! visible (it stabs none of the occluders merged above it), invisible (it stabs one), or
+//! undefined, with the occluders that may still block some of its lines.
+//!
+//! Lines here are the query lines of one tree: from a shading point through the tree's light
+//! polygon, oriented towards the light, stabbing an occluder only between the point and the
+//! light (the tile setup clips occluders so that this holds, see `tile.rs`).
+
+use alloc::vec::Vec;
+use core::mem::size_of;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use super::line::{Orienter, Sign};
+
+/// Most vertices of a clipped occluder: a triangle cut by two planes.
+pub(crate) const MAX_OCCLUDER_VERTICES: usize = 5;
+
+/// The index of the one invisible leaf every chain ends in (invisible leaves never change, so
+/// they are shared).
+pub(crate) const INVISIBLE: u32 = 0;
+
+/// Which sign of the side operator, with its own edges, a query line has when it crosses an
+/// occluder: fixed by the side of the occluder's plane the light lies on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Crossing {
+    /// The light lies on the side the occluder's winding normal points to: query lines cross
+    /// it along the normal and have a positive side with every edge.
+    Positive,
+    /// The light lies behind the occluder's plane: negative with every edge.
+    Negative,
+    /// The light straddles the occluder's plane: either.
+    Both,
+}
+
+/// A convex occluder polygon in the tree's coordinates (a blocker triangle clipped to the part
+/// that can lie between a shading point of the tile and the light), its vertices in the
+/// triangle's winding order.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Occluder {
+    verts: [DVec3; MAX_OCCLUDER_VERTICES],
+    len: u8,
+    crossing: Crossing,
+}
+
+impl Occluder {
+    /// The occluder with vertices `v` (3 to [`MAX_OCCLUDER_VERTICES`], in order) crossed by the
+    /// query lines as `crossing` says.
+    pub(crate) fn new(v: &[DVec3], crossing: Crossing) -> Occluder {
+        let mut verts = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
+        verts[..v.len()].copy_from_slice(v);
+        Occluder {
+            verts,
+            len: v.len() as u8,
+            crossing,
+        }
+    }
+
+    /// The vertices.
+    #[inline]
+    pub(crate) fn vertices(&self) -> &[DVec3] {
+        &self.verts[..self.len as usize]
+    }
+
+    /// Edge `i`, from vertex `i` to the next (its line, oriented by the winding).
+    #[inline]
+    pub(crate) fn edge(&self, i: u8) -> (DVec3, DVec3) {
+        let n = self.len;
+        (self.verts[i as usize], self.verts[((i + 1) % n) as usize])
+    }
+}
+
+/// A node of the tree.
+#[derive(Debug, Clone)]
+pub(crate) enum Node {
+    /// The hyperplane of edge `edge` of occluder `occ`: lines with a positive side operator go
+    /// to `pos`, negative to `neg`; lines with side zero (all of a fragment, which happens only
+    /// when the shading point lies on the edge's line) go to `pos` when `zero_pos`, else `neg`:
+    /// always the child where that edge does not close the occluder's invisible class.
+    Inner {
+        occ: u32,
+        edge: u8,
+        pos: u32,
+        neg: u32,
+        zero_pos: bool,
+    },
+    /// A class of lines that stab no occluder.
+    Visible,
+    /// A class of lines that stab an occluder.
+    Invisible,
+    /// A class not yet decided, with the occluders that may block some of its lines.
+    Undefined(Vec<u32>),
+}
+
+/// Counters of one tree's growth.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TreeCounters {
+    /// Occluders merged at undefined leaves (seed 002 Alg. 1 line 32).
+    pub merges: u64,
+    /// Orientation tests of an occluder's vertex-to-vertex lines against a node (Alg. 1 lines
+    /// 6-13).
+    pub insertion_tests: u64,
+}
+
+/// The lazily built tree of one light polygon and one set of occluders.
+#[derive(Debug, Clone)]
+pub(crate) struct Tree {
+    /// The light polygon's vertices: one end of the vertex-to-vertex lines of the occluders
+    /// and the light.
+    light: SmallVec<[DVec3; 8]>,
+    /// The tile's corners (one point for a single query): one end of the vertex-to-vertex
+    /// lines of the tile and the occluders.
+    cell: SmallVec<[DVec3; 4]>,
+    occluders: Vec<Occluder>,
+    nodes: Vec<Node>,
+    /// Occluder ids held by undefined leaves.
+    listed: usize,
+    rng: u64,
+    peak_bytes: usize,
+    pub(crate) counters: TreeCounters,
+}
+
+impl Tree {
+    /// The tree of a single undefined leaf holding every occluder (Alg. 2 line 8), for query
+    /// lines from the convex hull of `cell` through the convex hull of `light`.
+    pub(crate) fn new(
+        cell: &[DVec3],
+        light: &[DVec3],
+        occluders: Vec<Occluder>,
+        seed: u64,
+    ) -> Tree {
+        let mut t = Tree {
+            light: light.iter().copied().collect(),
+            cell: cell.iter().copied().collect(),
+            occluders,
+            nodes: Vec::new(),
+            listed: 0,
+            rng: seed | 1,
+            peak_bytes: 0,
+            counters: TreeCounters::default(),
+        };
+        t.reset();
+        t
+    }
+
+    /// Back to the root leaf with every occluder (the fallback when the tree outgrows its cap,
+    /// and the "modified version" of seed 002 section 5.1 that forgets between queries).
+    pub(crate) fn reset(&mut self) {
+        self.nodes.clear();
+        self.nodes.push(Node::Invisible);
+        let all: Vec<u32> = (0..self.occluders.len() as u32).collect();
+        self.listed = all.len();
+        self.nodes.push(if all.is_empty() {
+            Node::Visible
+        } else {
+            Node::Undefined(all)
+        });
+        self.note_size();
+    }
+
+    /// The root node.
+    pub(crate) const ROOT: u32 = 1;
+
+    /// The node at `i`.
+    #[inline]
+    pub(crate) fn node(&self, i: u32) -> &Node {
+        &self.nodes[i as usize]
+    }
+
+    /// The occluder `i`.
+    #[inline]
+    pub(crate) fn occluder(&self, i: u32) -> &Occluder {
+        &self.occluders[i as usize]
+    }
+
+    /// Number of occluders the tree was built with.
+    pub(crate) fn occluder_count(&self) -> usize {
+        self.occluders.len()
+    }
+
+    /// Number of nodes (leaves included).
+    pub(crate) fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The memory the tree holds, in bytes (nodes, leaf lists, occluders; allocator slack not
+    /// counted).
+    pub(crate) fn bytes(&self) -> usize {
+        self.nodes.len() * size_of::<Node>()
+            + self.listed * size_of::<u32>()
+            + self.occluders.len() * size_of::<Occluder>()
+    }
+
+    /// The largest [`Tree::bytes`] so far.
+    pub(crate) fn peak_bytes(&self) -> usize {
+        self.peak_bytes
+    }
+
+    fn note_size(&mut self) {
+        self.peak_bytes = self.peak_bytes.max(self.bytes());
+    }
+
+    /// A pseudo-random index below `n` (xorshift64): the occluder merged at a leaf is chosen at
+    /// random (seed 002 section 4.3, as the pivot of quicksort).
+    fn pick(&mut self, n: usize) -> usize {
+        let mut x = self.rng;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.rng = x;
+        ((x >> 11) % n as u64) as usize
+    }
+
+    /// Develops the undefined leaf `n` (Alg. 1 lines 31-35): a random occluder `ro` of its list
+    /// replaces the leaf by its own classes (`bsp(ro)`, [`Tree::merge`]), and the others are
+    /// inserted into them ([`Tree::insert`]). `n` becomes the root of `bsp(ro)`.
+    pub(crate) fn expand(&mut self, n: u32) {
+        let Node::Undefined(mut list) =
+            core::mem::replace(&mut self.nodes[n as usize], Node::Visible)
+        else {
+            return;
+        };
+        self.listed -= list.len();
+        if list.is_empty() {
+            return;
+        }
+        let k = self.pick(list.len());
+        let ro = list.swap_remove(k);
+        self.merge(n, ro);
+        self.counters.merges += 1;
+        if !list.is_empty() {
+            self.insert(n, list);
+        }
+        self.note_size();
+    }
+
+    /// Writes `bsp(o)` (seed 002 Fig. 4) with its root at node `at`: a chain over the occluder's
+    /// edges whose last strict step is the invisible class and whose other exits are visible
+    /// leaves.
+    ///
+    /// For a one-sided crossing with sign `s`, node `i` sends sign `s` on to edge `i + 1` (after
+    /// the last edge: invisible) and everything else, side zero included, to a visible leaf. For
+    /// [`Crossing::Both`] the root (edge 0) splits into a positive chain over edges `1..k` and a
+    /// negative chain over edges `1..k` and then edge 0 again; side zero at the root takes the
+    /// negative chain, whose final strict test of edge 0 lets it out to a visible leaf. A line
+    /// with side zero for any edge never reaches the invisible class: it passes through the
+    /// occluder's boundary or plane, not its interior (the open-occluder rule of `mod.rs`).
+    fn merge(&mut self, at: u32, o: u32) {
+        let k = self.occluders[o as usize].len;
+        match self.occluders[o as usize].crossing {
+            Crossing::Positive => self.chain(at, o, (0..k).collect(), true),
+            Crossing::Negative => self.chain(at, o, (0..k).collect(), false),
+            Crossing::Both => {
+                let p = self.push(Node::Visible);
+                let m = self.push(Node::Visible);
+                self.nodes[at as usize] = Node::Inner {
+                    occ: o,
+                    edge: 0,
+                    pos: p,
+                    neg: m,
+                    zero_pos: false,
+                };
+                self.chain(p, o, (1..k).collect(), true);
+                let mut edges: SmallVec<[u8; 8]> = (1..k).collect();
+                edges.push(0);
+                self.chain(m, o, edges, false);
+            }
+        }
+    }
+
+    /// The chain of nodes over `edges` of occluder `o` starting at node `first`, passing lines
+    /// with the strict sign `positive` on and sending the others to fresh visible leaves.
+    fn chain(&mut self, first: u32, o: u32, edges: SmallVec<[u8; 8]>, positive: bool) {
+        let mut at = first;
+        for (i, &e) in edges.iter().enumerate() {
+            let next = if i + 1 == edges.len() {
+                INVISIBLE
+            } else {
+                self.push(Node::Visible)
+            };
+            let leaf = self.push(Node::Visible);
+            let (pos, neg) = if positive { (next, leaf) } else { (leaf, next) };
+            self.nodes[at as usize] = Node::Inner {
+                occ: o,
+                edge: e,
+                pos,
+                neg,
+                zero_pos: !positive,
+            };
+            at = next;
+        }
+    }
+
+    fn push(&mut self, node: Node) -> u32 {
+        self.nodes.push(node);
+        (self.nodes.len() - 1) as u32
+    }
+
+    /// Inserts `list` into the subtree at `n` (Alg. 1 lines 1-13): at an inner node, by the
+    /// orientation of each occluder's vertex-to-vertex lines (Theorem 1,
+    /// [`Tree::orientation`]): strictly positive to `pos`, strictly negative to `neg`, anything
+    /// else to both (conservative). At a leaf: a visible class becomes undefined with the list,
+    /// an undefined one adds it, an invisible one ignores it.
+    fn insert(&mut self, n: u32, list: Vec<u32>) {
+        let (occ, edge, pos, neg) = match &mut self.nodes[n as usize] {
+            Node::Invisible => return,
+            Node::Undefined(l) => {
+                l.extend_from_slice(&list);
+                self.listed += list.len();
+                return;
+            }
+            Node::Visible => {
+                self.listed += list.len();
+                self.nodes[n as usize] = Node::Undefined(list);
+                return;
+            }
+            &mut Node::Inner {
+                occ,
+                edge,
+                pos,
+                neg,
+                ..
+            } => (occ, edge, pos, neg),
+        };
+        let (ha, hb) = self.occluders[occ as usize].edge(edge);
+        let from_light: SmallVec<[Orienter; 8]> = self
+            .light
+            .iter()
+            .map(|&a| Orienter::new(ha, hb, a))
+            .collect();
+        let from_cell: SmallVec<[Orienter; 4]> = self
+            .cell
+            .iter()
+            .map(|&c| Orienter::new(ha, hb, c))
+            .collect();
+        let (mut to_pos, mut to_neg) = (Vec::new(), Vec::new());
+        for &o in &list {
+            let side = match self.orientation(o, &from_cell, false) {
+                Sign::Zero => self.orientation(o, &from_light, true),
+                strict => strict,
+            };
+            match side {
+                Sign::Positive => to_pos.push(o),
+                Sign::Negative => to_neg.push(o),
+                Sign::Zero => {
+                    to_pos.push(o);
+                    to_neg.push(o);
+                }
+            }
+        }
+        self.counters.insertion_tests += list.len() as u64;
+        drop(list);
+        if !to_pos.is_empty() {
+            self.insert(pos, to_pos);
+        }
+        if !to_neg.is_empty() {
+            self.insert(neg, to_neg);
+        }
+    }
+
+    /// The orientation of the lines occluder `o` blocks, relative to a node's line, bounded by
+    /// vertex-to-vertex lines (seed 002 Theorem 1): `Positive` / `Negative` when all are strictly
+    /// so, `Zero` for "mixed" (some of each, or one with side zero).
+    ///
+    /// Signs are the filter's strict ones only: a value within rounding of zero counts as
+    /// mixed, which is conservative (the occluder goes to both children) and certified (a strict
+    /// answer is never wrong), so insertion needs no exact arithmetic.
+    ///
+    /// A blocked query line passes through the tile, then the occluder, then the light, so it
+    /// stabs both the pair (occluder, light), the paper's bound, and the pair (tile, occluder):
+    /// either vvset may decide, and the tile's is the tighter one for tiles smaller than the
+    /// light (for a single point it is exact). The lines run towards the light: `c -> b` from a
+    /// tile corner through an occluder vertex, `b -> a` from an occluder vertex to a light
+    /// vertex. `orienters[k]` evaluates `det[p - o_k, h_a - o_k, h_b - o_k]`, the side of the
+    /// line `o_k -> p`: as is for the tile (`reverse` false), reversed for the light.
+    fn orientation(&self, o: u32, orienters: &[Orienter], reverse: bool) -> Sign {
+        let (mut pos, mut neg) = (false, false);
+        for or in orienters {
+            for &b in self.occluders[o as usize].vertices() {
+                let Some(s) = or.strict_sign(b) else {
+                    return Sign::Zero;
+                };
+                match if reverse { s.flip() } else { s } {
+                    Sign::Positive => pos = true,
+                    Sign::Negative => neg = true,
+                    Sign::Zero => return Sign::Zero,
+                }
+                if pos && neg {
+                    return Sign::Zero;
+                }
+            }
+        }
+        match (pos, neg) {
+            (true, false) => Sign::Positive,
+            (false, true) => Sign::Negative,
+            _ => Sign::Zero,
+        }
+    }
+}

@@ -1,0 +1,520 @@
+//! The visibility query of seed 002 Alg. 1 (lines 15-37): which fragments of a light polygon a
+//! point sees, found by walking the lazy BSP with the polygon and splitting it by the plane
+//! through the point and each node's line, developing undefined leaves on the way.
+//!
+//! For a point `x` and a node line `h`, the lines from `x` through a light point `e` have side
+//! `det[e - x, h_a - x, h_b - x]` with `h`: the side of `e` relative to the plane through `x`
+//! and `h` (seed 002 Fig. 6). So the light polygon goes whole to one child when its vertices
+//! are all on one side, and is cut by that plane otherwise. Fragments stay convex; each one
+//! that reaches a visible leaf is a visible part of the light.
+//!
+//! A fragment vertex whose side the error-bounded filter cannot certify is taken to lie on the
+//! plane (it joins both parts of a split) when the plane is well conditioned: it is then within
+//! `2e-12` of its distance from the point of the plane (`line.rs`, `WELL_CONDITIONED`). Such a
+//! vertex is a computed cut point, typically the shadow of an occluder vertex that two node
+//! planes share, whose own rounding is of that order, so an exact sign of the rounded point
+//! would be no truer; taking it as on the plane avoids a sliver fragment and an adaptive
+//! evaluation per shadow corner. For an ill-conditioned plane (the point near the node's line)
+//! the exact sign decides, so that the two parts of a split never overlap by more than that
+//! rounding. A fragment with every vertex on the plane goes to the node's zero child.
+
+use alloc::vec::Vec;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use super::bsp::{Node, Tree};
+use super::line::{Orienter, Sign};
+use crate::GeomError;
+use crate::solid::ShadingFrame;
+use crate::sphere::SphericalPolygon;
+
+/// A convex planar polygon on the light, in a tree's coordinates.
+pub(crate) type Fragment = SmallVec<[DVec3; 8]>;
+
+/// The tree outgrew its memory cap during a query.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct CapExceeded;
+
+/// Where a fragment lies relative to a node's plane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Class {
+    /// Every vertex on the positive side or on the plane, one strictly positive.
+    Pos,
+    /// Every vertex on the negative side or on the plane, one strictly negative.
+    Neg,
+    /// Every vertex on the plane: the point lies on the node's line.
+    Zero,
+    /// Vertices strictly on both sides.
+    Split,
+}
+
+/// Buffers a query reuses: fragments live in one pool of vertices (a fragment is a range of
+/// it), so that splits append instead of moving polygons around.
+#[derive(Debug, Default, Clone)]
+pub(crate) struct Scratch {
+    /// Node, start in `pool`, vertex count.
+    stack: Vec<(u32, u32, u32)>,
+    pool: Vec<DVec3>,
+}
+
+fn classify(or: &Orienter, frag: &[DVec3], vals: &mut SmallVec<[(f64, Sign); 8]>) -> Class {
+    vals.clear();
+    let (mut pos, mut neg) = (false, false);
+    for &e in frag {
+        let (v, sign) = or.eval_near(e);
+        match sign {
+            Sign::Positive => pos = true,
+            Sign::Negative => neg = true,
+            Sign::Zero => {}
+        }
+        vals.push((v, sign));
+    }
+    match (pos, neg) {
+        (true, true) => Class::Split,
+        (true, false) => Class::Pos,
+        (false, true) => Class::Neg,
+        (false, false) => Class::Zero,
+    }
+}
+
+/// Appends `p` unless it repeats the last point.
+fn push_point(out: &mut Fragment, p: DVec3) {
+    if out.last() != Some(&p) {
+        out.push(p);
+    }
+}
+
+/// The parts of `frag` on the positive and on the negative side of the plane whose values at
+/// its vertices are `vals` (certified signs decide the sides; the `f64` values only place the
+/// cut points, clamped to their edge). Vertices on the plane belong to both parts. A part with
+/// fewer than three distinct points is `None`.
+fn split(frag: &[DVec3], vals: &[(f64, Sign)]) -> (Option<Fragment>, Option<Fragment>) {
+    let n = frag.len();
+    let (mut pos, mut neg) = (Fragment::new(), Fragment::new());
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b) = (frag[i], frag[j]);
+        let ((va, sa), (vb, sb)) = (vals[i], vals[j]);
+        if sa != Sign::Negative {
+            push_point(&mut pos, a);
+        }
+        if sa != Sign::Positive {
+            push_point(&mut neg, a);
+        }
+        if matches!(
+            (sa, sb),
+            (Sign::Positive, Sign::Negative) | (Sign::Negative, Sign::Positive)
+        ) {
+            let p = cut_point(a, b, va, vb);
+            push_point(&mut pos, p);
+            push_point(&mut neg, p);
+        }
+    }
+    let close = |mut f: Fragment| {
+        while f.len() > 1 && f.first() == f.last() {
+            f.pop();
+        }
+        (f.len() >= 3).then_some(f)
+    };
+    (close(pos), close(neg))
+}
+
+/// Appends to `pool` the part of the fragment `pool[s..s + n]` on the positive (`positive`) or
+/// negative side, as [`split`] does, and returns its range, or `None` for fewer than three
+/// distinct points (the pool is then left as it was).
+fn split_part(
+    pool: &mut Vec<DVec3>,
+    s: usize,
+    n: usize,
+    vals: &[(f64, Sign)],
+    positive: bool,
+) -> Option<(u32, u32)> {
+    let start = pool.len();
+    let (keep, drop) = if positive {
+        (Sign::Positive, Sign::Negative)
+    } else {
+        (Sign::Negative, Sign::Positive)
+    };
+    let push = |pool: &mut Vec<DVec3>, p: DVec3| {
+        if pool.len() == start || pool[pool.len() - 1] != p {
+            pool.push(p);
+        }
+    };
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b) = (pool[s + i], pool[s + j]);
+        let ((va, sa), (vb, sb)) = (vals[i], vals[j]);
+        if sa != drop {
+            push(pool, a);
+        }
+        if (sa == keep && sb == drop) || (sa == drop && sb == keep) {
+            push(pool, cut_point(a, b, va, vb));
+        }
+    }
+    while pool.len() > start + 1 && pool[start] == pool[pool.len() - 1] {
+        pool.pop();
+    }
+    if pool.len() - start < 3 {
+        pool.truncate(start);
+        return None;
+    }
+    Some((start as u32, (pool.len() - start) as u32))
+}
+
+/// The point where the edge `a -> b` crosses a plane, from the plane's values `va`, `vb` at its
+/// ends (of opposite certified signs), clamped to the edge. Both parts of a split compute it
+/// the same way, so they share it bit for bit.
+///
+/// It is interpolated from the end nearer the plane: its error is then the rounding of that
+/// end's offset, not of the whole edge's, which matters when the plane passes a hair from a
+/// vertex (a blocker cut by the tangent plane of a point `1e-6` from it: from the far end, the
+/// cut edge sat `1e-16` off the plane and left a `1e-10` rad horizon sliver unblocked).
+#[inline]
+fn cut_point(a: DVec3, b: DVec3, va: f64, vb: f64) -> DVec3 {
+    let (near, far, vn, vf) = if va.abs() <= vb.abs() {
+        (a, b, va, vb)
+    } else {
+        (b, a, vb, va)
+    };
+    let den = vn - vf;
+    let t = if den != 0.0 && (vn / den).is_finite() {
+        (vn / den).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    near + (far - near) * t
+}
+
+/// Seed 002 Alg. 1 `BSP_query`: appends to `out` the fragments of `poly` (a convex polygon on
+/// the tree's light, relative to the point: `p - x` in world coordinates) that the point `x`
+/// (in the tree's coordinates) sees, growing the tree where it is undefined. Fragments are
+/// relative to the point too, so they are the same numbers whatever the tree's origin: the
+/// point's tangent-plane cut and the directions of light points very close to it (a point
+/// within a few `1e-11` of a face plane) do not pick up the rounding of the tile's offset. Stops with [`CapExceeded`] as soon as the tree's size passes `cap` bytes
+/// (the tree is then valid but larger; the caller resets it).
+pub(crate) fn query(
+    tree: &mut Tree,
+    x: DVec3,
+    poly: &[DVec3],
+    cap: usize,
+    out: &mut Vec<Fragment>,
+    scratch: &mut Scratch,
+) -> Result<(), CapExceeded> {
+    let mut vals: SmallVec<[(f64, Sign); 8]> = SmallVec::new();
+    let Scratch { stack, pool } = scratch;
+    stack.clear();
+    pool.clear();
+    pool.extend_from_slice(poly);
+    stack.push((Tree::ROOT, 0, poly.len() as u32));
+    while let Some((mut n, mut s, mut len)) = stack.pop() {
+        loop {
+            match *tree.node(n) {
+                Node::Inner {
+                    occ,
+                    edge,
+                    pos,
+                    neg,
+                    zero_pos,
+                } => {
+                    let (ha, hb) = tree.occluder(occ).edge(edge);
+                    // The fragment is relative to the point: the node's line is moved there
+                    // instead, so that light points close to the point keep their precision.
+                    let or = Orienter::new(ha - x, hb - x, DVec3::ZERO);
+                    let frag = &pool[s as usize..(s + len) as usize];
+                    match classify(&or, frag, &mut vals) {
+                        Class::Pos => n = pos,
+                        Class::Neg => n = neg,
+                        Class::Zero => n = if zero_pos { pos } else { neg },
+                        Class::Split => {
+                            let (su, lu) = (s as usize, len as usize);
+                            if let Some((ms, ml)) = split_part(pool, su, lu, &vals, false) {
+                                stack.push((neg, ms, ml));
+                            }
+                            match split_part(pool, su, lu, &vals, true) {
+                                Some((ps, pl)) => {
+                                    (s, len) = (ps, pl);
+                                    n = pos;
+                                }
+                                None => break,
+                            }
+                        }
+                    }
+                }
+                Node::Visible => {
+                    out.push(
+                        pool[s as usize..(s + len) as usize]
+                            .iter()
+                            .copied()
+                            .collect(),
+                    );
+                    break;
+                }
+                Node::Invisible => break,
+                Node::Undefined(_) => {
+                    tree.expand(n);
+                    if tree.bytes() > cap {
+                        return Err(CapExceeded);
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Corners of a fragment's spherical polygon closer than this (chord length) are merged before
+/// the polygon is built, as for projected triangles in `solid::silhouette`: far below any
+/// feature the sphere layer resolves, above the rounding of a cut point.
+const MERGE_TOLERANCE: f64 = 1e-13;
+
+/// Drops the vertices of a convex polygon that repeat their predecessor within `1e-12` of the
+/// longest edge or [`WELD_MAGNITUDE`] of the largest coordinate (cut points a rounding away
+/// from a corner): a node line through two such points would be an ill-defined plane.
+pub(crate) fn weld(poly: &mut Fragment) {
+    let n = poly.len();
+    let longest = (0..n)
+        .map(|i| (poly[(i + 1) % n] - poly[i]).length())
+        .fold(0.0, f64::max);
+    let magnitude = poly
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f64::max);
+    let tol = (1e-12 * longest).max(WELD_MAGNITUDE * magnitude);
+    let mut out = Fragment::new();
+    for &p in poly.iter() {
+        if out.last().is_none_or(|&q: &DVec3| (p - q).length() > tol) {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && (out[0] - out[out.len() - 1]).length() <= tol {
+        out.pop();
+    }
+    *poly = out;
+}
+
+/// Points of a polygon closer than this times its largest coordinate are one point for
+/// [`weld`]: a cut point is rounded at `1.1e-16` of its coordinates, so two computed points
+/// that close are the same point within a few roundings. Without it, a blocker cut by the
+/// tangent plane through one of its vertices (the vertex a rounding above the plane) left a
+/// triangle of three points a few ulps apart, whose edges' lines are rounding noise; its
+/// node planes made the query hide the whole light behind it.
+const WELD_MAGNITUDE: f64 = 1e-14;
+
+/// Relative area below which a fragment is a sliver: twice its area at most this times its
+/// squared perimeter (the threshold below which the sphere layer calls a ring zero-area).
+const SLIVER: f64 = 1e-12;
+
+/// Whether the convex fragment `frag` is a sliver ([`SLIVER`]): splits by planes passing within
+/// rounding of a vertex leave such pieces, nearly collinear, which cover no area.
+pub(crate) fn is_sliver(frag: &[DVec3]) -> bool {
+    let mut twice_area = DVec3::ZERO;
+    let mut perimeter = 0.0;
+    for i in 0..frag.len() {
+        let j = (i + 1) % frag.len();
+        perimeter += (frag[j] - frag[i]).length();
+        if i >= 1 && j != 0 {
+            twice_area += (frag[i] - frag[0]).cross(frag[j] - frag[0]);
+        }
+    }
+    !(twice_area.length() > SLIVER * perimeter * perimeter)
+}
+
+/// The spherical polygon a fragment covers seen from `x` (both in the same tree coordinates), in
+/// the shading frame: the fragment lies on a front face of the light and runs counter-clockwise
+/// about the face's normal, so seen from `x` its ring is reversed. Directions a rounding below
+/// the horizon (the fragment was clipped to the point's tangent plane) are lifted onto it.
+///
+/// `None` when the fragment covers no area within rounding (a sliver the sphere layer rejects
+/// as zero-area or with coincident corners).
+///
+/// # Errors
+///
+/// [`GeomError::Undecidable`] for any other rejection of [`SphericalPolygon::new`].
+pub(crate) fn fragment_polygon(
+    frag: &[DVec3],
+    x: DVec3,
+    frame: &ShadingFrame,
+) -> Result<Option<SphericalPolygon>, GeomError> {
+    if is_sliver(frag) {
+        return Ok(None);
+    }
+    let mut units: SmallVec<[DVec3; 8]> = SmallVec::new();
+    let mut dirs: SmallVec<[DVec3; 8]> = SmallVec::new();
+    for &e in frag.iter().rev() {
+        let mut d = frame.dir_to_local(e - x);
+        d.z = d.z.max(0.0);
+        let Some(u) = d.try_normalize() else {
+            return Ok(None);
+        };
+        if units
+            .last()
+            .is_some_and(|&w: &DVec3| (w - u).length() <= MERGE_TOLERANCE)
+        {
+            continue;
+        }
+        units.push(u);
+        dirs.push(d);
+    }
+    while units.len() > 1 && (units[0] - units[units.len() - 1]).length() <= MERGE_TOLERANCE {
+        units.pop();
+        dirs.pop();
+    }
+    if dirs.len() < 3 {
+        return Ok(None);
+    }
+    match SphericalPolygon::new(alloc::vec![dirs.to_vec()]) {
+        Ok(p) => Ok(Some(p)),
+        Err(
+            GeomError::ZeroArea { .. }
+            | GeomError::CoincidentVertices { .. }
+            | GeomError::TooFewVertices { .. },
+        ) => Ok(None),
+        Err(e) => Err(e.give_up("a visible light fragment is degenerate within rounding")),
+    }
+}
+
+/// The part of the convex polygon `poly` on the closed positive side of a plane, given the signed
+/// distances `vals` of its vertices (Sutherland–Hodgman against one plane), or `None` when no
+/// vertex is strictly on that side (nothing with area is left).
+pub(crate) fn keep_positive(poly: &[DVec3], vals: &[(f64, Sign)]) -> Option<Fragment> {
+    if vals.iter().all(|v| v.1 != Sign::Positive) {
+        return None;
+    }
+    if vals.iter().all(|v| v.1 != Sign::Negative) {
+        return (poly.len() >= 3).then(|| poly.iter().copied().collect());
+    }
+    split(poly, vals).0
+}
+
+/// The part of the convex polygon `poly` on the closed positive side of the plane through `p0`
+/// with normal `n`, or `None` when less than a polygon is left ([`keep_positive`]).
+pub(crate) fn clip_above(poly: &[DVec3], p0: DVec3, n: DVec3) -> Option<Fragment> {
+    let vals: SmallVec<[(f64, Sign); 8]> = poly
+        .iter()
+        .map(|&p| {
+            let d = n.dot(p - p0);
+            (d, Sign::of(d))
+        })
+        .collect();
+    keep_positive(poly, &vals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::visibility::plucker::bsp::{Crossing, Occluder};
+
+    fn area(poly: &[DVec3]) -> f64 {
+        let mut s = DVec3::ZERO;
+        for i in 1..poly.len().saturating_sub(1) {
+            s += (poly[i] - poly[0]).cross(poly[i + 1] - poly[0]);
+        }
+        s.length() / 2.0
+    }
+
+    fn occluder(v: &[DVec3], crossing: Crossing) -> Occluder {
+        Occluder::new(v, crossing)
+    }
+
+    /// The 3D area of what `x` sees of `light` past the occluder `occ`.
+    fn seen(x: DVec3, light: &[DVec3], occ: Occluder) -> f64 {
+        let mut tree = Tree::new(&[x], light, alloc::vec![occ], 7);
+        let mut out = Vec::new();
+        let relative: Vec<DVec3> = light.iter().map(|&p| p - x).collect();
+        query(
+            &mut tree,
+            x,
+            &relative,
+            usize::MAX,
+            &mut out,
+            &mut Scratch::default(),
+        )
+        .unwrap();
+        out.iter().map(|f| area(f)).sum()
+    }
+
+    #[test]
+    fn a_point_on_an_occluders_edge_line_sees_past_it() {
+        // The open-occluder rule (mod.rs): from a point in the occluder's plane on the line of
+        // one of its edges (on the edge, at a vertex, on the edge's extension) every line meets
+        // the occluder only at that point, so nothing is hidden. The fragments reach the node
+        // of that edge with side zero everywhere and must take its zero child, for a light on
+        // one side of the occluder's plane (one-sided chain) and across it (two-sided chain,
+        // the edge at the root and later). A point off the plane, under the occluder, sees the
+        // shadow removed.
+        let tri = [
+            DVec3::new(-1.0, -1.0, 1.0),
+            DVec3::new(1.0, -1.0, 1.0),
+            DVec3::new(0.0, 1.0, 1.0),
+        ];
+        let above = [
+            DVec3::new(-0.5, -0.5, 2.0),
+            DVec3::new(0.5, -0.5, 2.0),
+            DVec3::new(0.5, 0.5, 2.0),
+            DVec3::new(-0.5, 0.5, 2.0),
+        ];
+        let across = [
+            DVec3::new(-0.5, 2.0, 0.5),
+            DVec3::new(0.5, 2.0, 0.5),
+            DVec3::new(0.5, 2.0, 1.5),
+            DVec3::new(-0.5, 2.0, 1.5),
+        ];
+        let on_lines = [
+            DVec3::new(0.0, -1.0, 1.0),
+            DVec3::new(3.0, -1.0, 1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+            DVec3::new(0.5, 0.0, 1.0),
+            DVec3::new(-0.25, 0.5, 1.0),
+        ];
+        for (light, crossing) in [(&above, Crossing::Positive), (&across, Crossing::Both)] {
+            // Rotations of the vertex list put each edge at the root of the chain.
+            for r in 0..3 {
+                let v = [tri[r], tri[(r + 1) % 3], tri[(r + 2) % 3]];
+                for &x in &on_lines {
+                    let a = seen(x, light, occluder(&v, crossing));
+                    assert!(
+                        (a - area(light)).abs() <= 1e-12,
+                        "{crossing:?} r {r} x {x}: {a}"
+                    );
+                }
+            }
+        }
+        // Under the occluder the light above is partly hidden.
+        let hidden = seen(
+            DVec3::new(0.0, -0.2, 0.2),
+            &above,
+            occluder(&tri, Crossing::Positive),
+        );
+        assert!(hidden < 0.9 * area(&above), "{hidden}");
+    }
+
+    #[test]
+    fn split_parts_tile_the_fragment() {
+        // The two parts of a split cover the fragment (areas add up), lie on their sides, and
+        // vertices on the plane join both.
+        let square: Fragment = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+        ]
+        .into_iter()
+        .collect();
+        for (n, d) in [
+            (DVec3::new(1.0, 0.3, 0.0), 0.4),
+            (DVec3::new(1.0, 1.0, 0.0), 1.0),
+            (DVec3::new(0.0, 1.0, 0.0), 0.25),
+        ] {
+            let vals: SmallVec<[(f64, Sign); 8]> = square
+                .iter()
+                .map(|&p| (n.dot(p) - d, Sign::of(n.dot(p) - d)))
+                .collect();
+            let (p, m) = split(&square, &vals);
+            let (p, m) = (p.unwrap(), m.unwrap());
+            assert!((area(&p) + area(&m) - 1.0).abs() < 1e-15, "{n}");
+            assert!(p.iter().all(|&q| n.dot(q) - d >= -1e-15));
+            assert!(m.iter().all(|&q| n.dot(q) - d <= 1e-15));
+        }
+    }
+}

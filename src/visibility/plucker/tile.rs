@@ -1,0 +1,471 @@
+//! Trees per light and receiver tile (seed 002 Alg. 2): the scene's blocker triangles in a
+//! bounding-volume hierarchy, shaft culling of them against a tile and a light polygon, and the
+//! clipping that turns each remaining triangle into an occluder of the tree.
+//!
+//! A tile is a convex piece of one plane (the receiver's tangent plane, normal `n`) holding the
+//! shading points that share the tree; a single shading point is the smallest tile. Three cuts
+//! make the tree exact for every point `x` of the tile (see `mod.rs` for the rule):
+//!
+//! - the light face's plane: a blocker hides a face direction only by its part strictly on the
+//!   point's side (`H_f`), cut with the facing predicate's snapped distances exactly as the
+//!   clipping backend does;
+//! - the tile plane: the part of a line behind `x` lies below the tangent plane, the part between
+//!   `x` and the light above it, so keeping the blockers' parts above the plane makes "the line
+//!   stabs a kept blocker" equivalent to "a blocker lies on the segment from `x` to the light";
+//! - the shaft: the convex hull of the tile and the light polygon holds every such segment, so a
+//!   triangle outside one of its supporting planes can hide nothing (seed 002 Alg. 2 line 7).
+//!
+//! A blocker triangle whose plane passes through the point within the facing tolerance is seen
+//! edge-on and hides nothing (as in the clipping backend). Triangles edge-on from every point of
+//! the tile are dropped; those edge-on from some points, or whose plane passes within
+//! [`NEAR_BAND`] of the tile, are listed as `near`, and a query from a point that sees one of
+//! them edge-on, or lies that close to its plane, does not use the shared tree.
+
+use alloc::vec::Vec;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use super::Blocker;
+use super::bsp::{Crossing, MAX_OCCLUDER_VERTICES, Occluder, Tree};
+use super::line::{Orienter, Sign};
+use super::query::{clip_above, is_sliver, keep_positive, weld};
+use crate::solid::TriangleMesh;
+use crate::solid::facing::{Side, face_side, snapped_distance};
+
+/// A triangle of a blocker (an occluder, or a light's geometry).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BlockerTri {
+    pub(crate) v: [DVec3; 3],
+    pub(crate) owner: Blocker,
+    pub(crate) tri: u32,
+}
+
+/// A plane bounding a shaft: points with `n . p > d` are outside.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Plane {
+    n: DVec3,
+    d: f64,
+}
+
+impl Plane {
+    #[inline]
+    fn outside(&self, p: DVec3) -> bool {
+        self.n.dot(p) > self.d
+    }
+
+    /// Whether the box `[lo, hi]` lies entirely outside.
+    #[inline]
+    fn box_outside(&self, lo: DVec3, hi: DVec3) -> bool {
+        let c = (lo + hi) * 0.5;
+        let h = (hi - lo) * 0.5;
+        self.n.dot(c) - self.n.abs().dot(h) > self.d
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct BvhNode {
+    lo: DVec3,
+    hi: DVec3,
+    /// Leaf: first triangle; inner: index of the second child (the first follows the node).
+    first: u32,
+    /// Leaf: number of triangles (> 0); inner: 0.
+    count: u32,
+}
+
+/// Triangles per leaf of the hierarchy.
+const LEAF_SIZE: usize = 4;
+
+/// A bounding-volume hierarchy over every blocker triangle of a scene (median splits along the
+/// longest axis of the centroids), for the shaft culling.
+#[derive(Debug, Clone)]
+pub(crate) struct Bvh {
+    nodes: Vec<BvhNode>,
+    tris: Vec<BlockerTri>,
+}
+
+impl Bvh {
+    pub(crate) fn new(mut tris: Vec<BlockerTri>) -> Bvh {
+        let mut nodes = Vec::with_capacity(2 * tris.len() / LEAF_SIZE + 1);
+        if !tris.is_empty() {
+            let n = tris.len();
+            build(&mut nodes, &mut tris, 0, n);
+        }
+        Bvh { nodes, tris }
+    }
+
+    /// The triangle at `i` (an index from [`Bvh::cull`]).
+    pub(crate) fn tri(&self, i: u32) -> &BlockerTri {
+        &self.tris[i as usize]
+    }
+
+    /// Appends to `out` the triangles not entirely outside some plane of `planes`.
+    pub(crate) fn cull(&self, planes: &[Plane], out: &mut Vec<u32>) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack: SmallVec<[u32; 64]> = SmallVec::new();
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let node = self.nodes[i as usize];
+            if planes.iter().any(|p| p.box_outside(node.lo, node.hi)) {
+                continue;
+            }
+            if node.count == 0 {
+                stack.push(node.first);
+                stack.push(i + 1);
+                continue;
+            }
+            for t in node.first..node.first + node.count {
+                let v = self.tris[t as usize].v;
+                if !planes.iter().any(|p| v.iter().all(|&q| p.outside(q))) {
+                    out.push(t);
+                }
+            }
+        }
+    }
+}
+
+fn build(nodes: &mut Vec<BvhNode>, tris: &mut [BlockerTri], start: usize, end: usize) -> u32 {
+    let slice = &tris[start..end];
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    let (mut clo, mut chi) = (lo, hi);
+    for t in slice {
+        for &v in &t.v {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+        let c = centroid(t);
+        clo = clo.min(c);
+        chi = chi.max(c);
+    }
+    let me = nodes.len() as u32;
+    nodes.push(BvhNode {
+        lo,
+        hi,
+        first: start as u32,
+        count: (end - start) as u32,
+    });
+    if end - start <= LEAF_SIZE {
+        return me;
+    }
+    let ext = chi - clo;
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    let mid = (end - start) / 2;
+    tris[start..end]
+        .select_nth_unstable_by(mid, |a, b| centroid(a)[axis].total_cmp(&centroid(b)[axis]));
+    build(nodes, tris, start, start + mid);
+    let right = build(nodes, tris, start + mid, end);
+    nodes[me as usize].first = right;
+    nodes[me as usize].count = 0;
+    me
+}
+
+fn centroid(t: &BlockerTri) -> DVec3 {
+    (t.v[0] + t.v[1] + t.v[2]) / 3.0
+}
+
+/// The planes of the convex hull of `cell` and `light` that pass through an edge of one and a
+/// vertex of the other, or through three points of one, each kept only if it supports the
+/// whole set, and moved outwards by a margin of `1e-9` of the set's size (so that rounding
+/// never culls a triangle touching the hull). A triangle outside one of them meets no segment
+/// from the cell to the light.
+pub(crate) fn shaft_planes(cell: &[DVec3], light: &[DVec3], out: &mut Vec<Plane>) {
+    out.clear();
+    let all: SmallVec<[DVec3; 16]> = cell.iter().chain(light).copied().collect();
+    if all.is_empty() {
+        return;
+    }
+    let c = all.iter().copied().sum::<DVec3>() / all.len() as f64;
+    let r = all.iter().map(|&p| (p - c).length()).fold(0.0, f64::max);
+    let mut candidate = |p: DVec3, q: DVec3, s: DVec3| {
+        let n = (q - p).cross(s - p);
+        let len = n.length();
+        if !(len > 0.0) || !len.is_finite() {
+            return;
+        }
+        let tol = 1e-12 * len * r;
+        let (mut above, mut below) = (false, false);
+        for &a in &all {
+            let d = n.dot(a - p);
+            above |= d > tol;
+            below |= d < -tol;
+        }
+        let margin = 1e-9 * len * r;
+        if !above {
+            out.push(Plane {
+                n,
+                d: n.dot(p) + margin,
+            });
+        } else if !below {
+            out.push(Plane {
+                n: -n,
+                d: -n.dot(p) + margin,
+            });
+        }
+    };
+    for (i, &a) in light.iter().enumerate() {
+        for &b in &light[i + 1..] {
+            for &x in cell {
+                candidate(a, b, x);
+            }
+        }
+    }
+    for (i, &a) in cell.iter().enumerate() {
+        for &b in &cell[i + 1..] {
+            for &l in light {
+                candidate(a, b, l);
+            }
+        }
+    }
+    for pts in [light, cell] {
+        if let Some((a, b, s)) = widest_triple(pts) {
+            candidate(a, b, s);
+        }
+    }
+}
+
+/// Three of `pts` spanning the largest triangle among those with the first point (enough to
+/// give the plane of a planar convex set), if any span one.
+fn widest_triple(pts: &[DVec3]) -> Option<(DVec3, DVec3, DVec3)> {
+    let a = *pts.first()?;
+    let mut best = None;
+    let mut area = 0.0;
+    for (i, &b) in pts.iter().enumerate().skip(1) {
+        for &s in &pts[i + 1..] {
+            let w = (b - a).cross(s - a).length();
+            if w > area {
+                area = w;
+                best = Some((a, b, s));
+            }
+        }
+    }
+    best
+}
+
+/// Which blockers a tree holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Owners {
+    /// Everything but the light itself, whose own triangles count only when `own` (a
+    /// non-planar mesh light can hide itself).
+    All { light: usize, own: bool },
+    /// The light's own triangles only (the unoccluded region of a self-hiding light).
+    Own { light: usize },
+}
+
+impl Owners {
+    fn keeps(self, b: Blocker) -> bool {
+        match (self, b) {
+            (Owners::All { light, own }, Blocker::Light(k)) if k == light => own,
+            (Owners::All { .. }, _) => true,
+            (Owners::Own { light }, Blocker::Light(k)) => k == light,
+            (Owners::Own { .. }, _) => false,
+        }
+    }
+}
+
+/// The tile of a tree: points of the plane through `p0` with unit normal `n`, within the convex
+/// polygon `cell` (one point for a single query), in world coordinates; `origin` is where the
+/// tree's coordinates are centred.
+#[derive(Debug, Clone)]
+pub(crate) struct TileGeometry {
+    pub(crate) origin: DVec3,
+    pub(crate) p0: DVec3,
+    pub(crate) n: DVec3,
+    pub(crate) cell: SmallVec<[DVec3; 4]>,
+}
+
+/// Relative half-width of the band about a blocker's plane in which a point does not use its
+/// tile's shared tree: `1e-5` of the tile's coordinate magnitude plus its size.
+///
+/// A shared tree is exact for points on its tile plane, in coordinates centred on the tile.
+/// A point of the tile differs from that by the rounding of its world coordinates (about
+/// `1e-16` of their magnitude `|x|`) and by the offset the tile accepts between its plane and
+/// the point (`1e-14 (|x| + size)`, `PluckerContext`). Seen from a point at distance `d` from a
+/// blocker, a blocker cut or placed that much off moves its shadow's edge by that over `d`
+/// radians; outside the band (`d` above `1e-5 (|x| + size)`) that is below `1e-9`. Points in
+/// the band get a tree of their own, centred on them, which has no such term.
+pub(crate) const NEAR_BAND: f64 = 1e-5;
+
+/// A blocker triangle whose plane passes through, or within [`NEAR_BAND`] of, a tile.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Near {
+    pub(crate) owner: Blocker,
+    pub(crate) tri: u32,
+    /// The plane: unit normal and offset (`n . p = d` on it).
+    n: DVec3,
+    d: f64,
+}
+
+/// A tree with the blocker triangles whose planes pass through or close to its tile, and the
+/// half-width of that band.
+#[derive(Debug, Clone)]
+pub(crate) struct GroupTree {
+    pub(crate) tree: Tree,
+    near: Vec<Near>,
+    band: f64,
+}
+
+impl GroupTree {
+    /// Whether the point `x` must not use the shared tree: it sees a blocker of the tile edge-on
+    /// (by the facing predicate, as the clipping backend), or lies within the band of one's
+    /// plane.
+    pub(crate) fn excludes<'m>(
+        &self,
+        x: DVec3,
+        mesh_of: &dyn Fn(Blocker) -> &'m TriangleMesh,
+    ) -> bool {
+        self.near.iter().any(|b| {
+            (b.n.dot(x) - b.d).abs() <= self.band
+                || face_side(mesh_of(b.owner), b.tri as usize, x) == Side::On
+        })
+    }
+}
+
+/// What a tree is built from besides the tile: the light's faces that share one plane (the
+/// group) and a representative face for that plane's side.
+pub(crate) struct GroupSource<'a> {
+    pub(crate) mesh: &'a TriangleMesh,
+    pub(crate) faces: &'a [u32],
+    pub(crate) rep: usize,
+}
+
+/// Builds the tree of one face group of a light for one tile (seed 002 Alg. 2 lines 7-8): the
+/// group's triangles cut to the tile plane's upper side are the light polygon (its vertices are
+/// the light's end of every vertex-to-vertex line); the blocker triangles that pass the shaft
+/// culling, the owner filter and the edge-on test are cut to `H_f` and above the tile plane and
+/// become the occluders, all in one undefined root leaf.
+///
+/// `None` when nothing of the group lies above the tile plane.
+pub(crate) fn build_group_tree<'m>(
+    bvh: &Bvh,
+    mesh_of: &dyn Fn(Blocker) -> &'m TriangleMesh,
+    group: &GroupSource<'_>,
+    owners: Owners,
+    tile: &TileGeometry,
+    seed: u64,
+    scratch: &mut Vec<u32>,
+) -> Option<GroupTree> {
+    let o = tile.origin;
+    let p0 = tile.p0 - o;
+    let mut light: SmallVec<[DVec3; 8]> = SmallVec::new();
+    for &f in group.faces {
+        let tri = group.mesh.triangle(f as usize).map(|v| v - o);
+        if let Some(part) = clip_above(&tri, p0, tile.n) {
+            for p in part {
+                if !light.contains(&p) {
+                    light.push(p);
+                }
+            }
+        }
+    }
+    if light.len() < 3 {
+        return None;
+    }
+    let cell_local: SmallVec<[DVec3; 4]> = tile.cell.iter().map(|&c| c - o).collect();
+    let size = tile
+        .cell
+        .iter()
+        .flat_map(|&a| tile.cell.iter().map(move |&b| (a - b).length()))
+        .fold(0.0, f64::max);
+    let magnitude = tile
+        .cell
+        .iter()
+        .map(|c| c.abs().max_element())
+        .fold(0.0, f64::max);
+    let band = NEAR_BAND * (magnitude + size);
+    let mut planes = Vec::new();
+    shaft_planes(&cell_local, &light, &mut planes);
+    for p in &mut planes {
+        p.d += p.n.dot(o);
+    }
+    scratch.clear();
+    bvh.cull(&planes, scratch);
+    let mut occluders = Vec::new();
+    let mut near = Vec::new();
+    for &i in scratch.iter() {
+        let bt = bvh.tri(i);
+        if !owners.keeps(bt.owner) {
+            continue;
+        }
+        // Cut 1: H_f, with the facing predicate's snapped distances (as the clipping backend).
+        let df = bt.v.map(|v| snapped_distance(group.mesh, group.rep, v));
+        if df.iter().all(|&d| d <= 0.0) {
+            continue;
+        }
+        // Edge-on from the tile's points: everywhere (drop), somewhere (near), nowhere.
+        let owner_mesh = mesh_of(bt.owner);
+        let (mut front, mut behind, mut on) = (false, false, false);
+        for &c in &tile.cell {
+            match face_side(owner_mesh, bt.tri as usize, c) {
+                Side::Front => front = true,
+                Side::Behind => behind = true,
+                Side::On => on = true,
+            }
+        }
+        if !front && !behind {
+            continue;
+        }
+        // The plane's distance is affine over the (convex) cell: its extremes are at corners.
+        let tn = owner_mesh.triangle_normal(bt.tri as usize);
+        let td = tn.dot(bt.v[0]);
+        let (lo, hi) = tile
+            .cell
+            .iter()
+            .map(|&c| tn.dot(c) - td)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                (l.min(v), h.max(v))
+            });
+        let near_somewhere = on || (front && behind) || (lo <= band && hi >= -band);
+        let local = bt.v.map(|v| v - o);
+        let vals: SmallVec<[(f64, Sign); 8]> = df.iter().map(|&d| (d, Sign::of(d))).collect();
+        let Some(cut) = keep_positive(&local, &vals) else {
+            continue;
+        };
+        // Cut 2: above the tile plane.
+        let Some(mut cut) = clip_above(&cut, p0, tile.n) else {
+            continue;
+        };
+        // Cut points a rounding away from a corner would make edges without a line; a sliver
+        // left by the cuts covers no area.
+        weld(&mut cut);
+        if cut.len() > MAX_OCCLUDER_VERTICES || cut.len() < 3 || is_sliver(&cut) {
+            continue;
+        }
+        let plane = Orienter::new(local[1], local[2], local[0]);
+        let (mut pos, mut neg) = (false, false);
+        for &e in &light {
+            match plane.sign(e) {
+                Sign::Positive => pos = true,
+                Sign::Negative => neg = true,
+                Sign::Zero => {}
+            }
+        }
+        let crossing = match (pos, neg) {
+            (true, false) => Crossing::Positive,
+            (false, true) => Crossing::Negative,
+            (true, true) => Crossing::Both,
+            (false, false) => continue,
+        };
+        occluders.push(Occluder::new(&cut, crossing));
+        if near_somewhere {
+            near.push(Near {
+                owner: bt.owner,
+                tri: bt.tri,
+                n: tn,
+                d: td,
+            });
+        }
+    }
+    Some(GroupTree {
+        tree: Tree::new(&cell_local, &light, occluders, seed),
+        near,
+        band,
+    })
+}

@@ -1,0 +1,604 @@
+//! The one-pass union of blocker projections (`Method::Silhouette`, `visibility/union.rs`)
+//! against the per-triangle path (`Method::PerTriangle`: every object one spherical triangle per
+//! triangle, subtracted in turn by spherical booleans), and the culling that feeds it (`Bvh`,
+//! `Shaft`) against brute force.
+//!
+//! The scenes are where the shortcuts of the one-pass path could go wrong: open triangle soups
+//! with shared, coplanar, touching and repeated triangles (non-manifold), terrain patches,
+//! closed solids (where the path leaves back faces out when the point is outside the box),
+//! inside-out solids and shells with cavities (where it must not), overlapping boxes merged
+//! into one self-intersecting mesh, points on and within 1e-9 of occluder surfaces and inside
+//! solids, and quad, convex and closed non-convex (torus) lights. The visible solid angle of the
+//! two paths must agree to 1e-10 sr; either path may give up (`Undecidable`) on at most 1% of the
+//! points. `PROPTEST_CASES=n` runs `n` scenes instead of the default.
+
+use arealight::glam::DVec3;
+use arealight::internals::{Shaft, bumpy_sphere, torus};
+use arealight::shade::{Body, ConvexPolyhedron, Light, Method, Scene, ShadingFrame, TriangleMesh};
+use arealight::solid::{BoundingSphere, Bvh};
+use arealight::sphere::SphericalPolygon;
+use arealight::visibility::Visibility;
+use support::Rng;
+use support::shade::{point_on_mesh, view_above};
+
+mod support;
+
+/// `mesh` scaled by `s` about the origin, turned about `z` by `turn`, moved by `d`, and with
+/// every triangle reversed when `flip`.
+fn placed(mesh: &TriangleMesh, s: f64, turn: f64, d: DVec3, flip: bool) -> TriangleMesh {
+    let (sn, cs) = turn.sin_cos();
+    let v = mesh
+        .vertices()
+        .iter()
+        .map(|&p| DVec3::new(cs * p.x - sn * p.y, sn * p.x + cs * p.y, p.z) * s + d)
+        .collect();
+    let t = mesh
+        .triangles()
+        .iter()
+        .map(|t| if flip { [t[0], t[2], t[1]] } else { *t })
+        .collect();
+    TriangleMesh::new(v, t).unwrap()
+}
+
+/// A random point in the slab between the ground and the lights.
+fn in_between(rng: &mut Rng) -> DVec3 {
+    DVec3::new(
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+        rng.range(0.6, 2.2),
+    )
+}
+
+/// An open soup of triangles over a pool of shared vertices: triangles share vertices and edges
+/// (touching), some lie in one common plane (coplanar, overlapping), some are repeated or
+/// reversed copies (non-manifold edges).
+fn soup(rng: &mut Rng) -> TriangleMesh {
+    let c = in_between(rng);
+    let pool: Vec<DVec3> = (0..rng.below(12) + 6)
+        .map(|_| {
+            c + DVec3::new(
+                rng.range(-0.6, 0.6),
+                rng.range(-0.6, 0.6),
+                rng.range(-0.4, 0.4),
+            )
+        })
+        .collect();
+    let mut vertices = pool.clone();
+    // A plane through c holding several triangles.
+    let plane_z = c.z + rng.range(-0.1, 0.1);
+    let flat: Vec<u32> = (0..5)
+        .map(|_| {
+            vertices.push(DVec3::new(
+                c.x + rng.range(-0.6, 0.6),
+                c.y + rng.range(-0.6, 0.6),
+                plane_z,
+            ));
+            (vertices.len() - 1) as u32
+        })
+        .collect();
+    let mut tris: Vec<[u32; 3]> = Vec::new();
+    for _ in 0..rng.below(20) + 3 {
+        let from = |rng: &mut Rng| rng.below(pool.len()) as u32;
+        tris.push([from(rng), from(rng), from(rng)]);
+    }
+    for _ in 0..3 {
+        let f = |rng: &mut Rng| flat[rng.below(flat.len())];
+        tris.push([f(rng), f(rng), f(rng)]);
+    }
+    if let Some(&t) = tris.first() {
+        tris.push(t); // repeated
+        tris.push([t[0], t[2], t[1]]); // reversed: with t, a closed two-sided sheet
+    }
+    // Drop degenerate triples (repeated index or zero area) the pool draws produce.
+    let ok = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        t[0] != t[1]
+            && t[1] != t[2]
+            && t[0] != t[2]
+            && (b - a).cross(c - a).length() > 1e-6 * (b - a).length_squared().max(1e-12)
+    };
+    tris.retain(ok);
+    if tris.is_empty() {
+        tris.push([0, 1, 2]);
+        vertices[2] = vertices[0] + DVec3::new(0.3, 0.1, 0.05);
+        vertices[1] = vertices[0] + DVec3::new(0.0, 0.3, -0.02);
+    }
+    TriangleMesh::new(vertices, tris).unwrap()
+}
+
+/// A terrain patch: an open height field over `[-a, a]^2`, `k x k` cells, two triangles each.
+fn terrain(rng: &mut Rng) -> TriangleMesh {
+    let k = rng.below(6) + 3;
+    let a = rng.range(0.5, 1.5);
+    let z0 = rng.range(0.5, 1.8);
+    let d = DVec3::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), 0.0);
+    let mut v = Vec::new();
+    for j in 0..=k {
+        for i in 0..=k {
+            let (x, y) = (
+                -a + 2.0 * a * i as f64 / k as f64,
+                -a + 2.0 * a * j as f64 / k as f64,
+            );
+            v.push(DVec3::new(x, y, z0 + rng.range(-0.3, 0.3)) + d);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (k + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..k {
+        for i in 0..k {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    TriangleMesh::new(v, t).unwrap()
+}
+
+/// A box as a mesh (outward normals unless `flip`).
+fn box_mesh(c: DVec3, h: DVec3, flip: bool) -> TriangleMesh {
+    let b = ConvexPolyhedron::cuboid(c, h).unwrap();
+    placed(b.mesh(), 1.0, 0.0, DVec3::ZERO, flip)
+}
+
+/// One random occluder and a name for messages.
+fn occluder(rng: &mut Rng) -> (&'static str, Body) {
+    let kind = rng.below(10);
+    occluder_kind(rng, kind)
+}
+
+/// An occluder of the given kind (see [`occluder`]).
+fn occluder_kind(rng: &mut Rng, kind: usize) -> (&'static str, Body) {
+    match kind {
+        0 => ("soup", soup(rng).into()),
+        1 => ("terrain", terrain(rng).into()),
+        2 | 3 => {
+            let m = bumpy_sphere(1 + rng.below(2) as u32, 0.2, rng.next_u64()).unwrap();
+            let s = rng.range(0.2, 0.5);
+            (
+                "bumpy sphere",
+                placed(&m, s, rng.range(0.0, 6.3), in_between(rng), false).into(),
+            )
+        }
+        4 => {
+            let m = bumpy_sphere(1, 0.2, rng.next_u64()).unwrap();
+            (
+                "inside-out bumpy sphere",
+                placed(&m, 0.4, 0.0, in_between(rng), true).into(),
+            )
+        }
+        5 => {
+            let m = torus(0.3, 0.1, 12, 6).unwrap();
+            let t = placed(
+                &m,
+                rng.range(0.8, 1.6),
+                rng.range(0.0, 6.3),
+                in_between(rng),
+                false,
+            );
+            ("torus", t.into())
+        }
+        6 => {
+            // A shell with a cavity: the inner box's normals point into the cavity.
+            let c = in_between(rng);
+            let outer = box_mesh(c, DVec3::splat(0.4), false);
+            let inner = box_mesh(c, DVec3::splat(0.2), true);
+            ("shell", outer.merged(&inner).unwrap().into())
+        }
+        7 => {
+            // Two boxes that overlap: closed, but not the boundary of a solid.
+            let c = in_between(rng);
+            let a = box_mesh(c, DVec3::new(0.3, 0.2, 0.25), false);
+            let b = box_mesh(c + DVec3::new(0.2, 0.1, 0.1), DVec3::splat(0.2), false);
+            ("overlapping boxes", a.merged(&b).unwrap().into())
+        }
+        8 => {
+            // Turned boxes standing on the ground, some overlapping, as one closed mesh: ground
+            // points lie inside some boxes' bounding boxes without being inside the boxes.
+            let mut m = box_mesh(DVec3::new(9.0, 9.0, 0.5), DVec3::splat(0.1), false);
+            for _ in 0..6 {
+                let h = DVec3::new(
+                    rng.range(0.05, 0.3),
+                    rng.range(0.05, 0.3),
+                    rng.range(0.2, 1.0),
+                );
+                let b = box_mesh(DVec3::new(0.0, 0.0, h.z), h, false);
+                let c = DVec3::new(rng.range(-1.2, 1.2), rng.range(-1.2, 1.2), 0.0);
+                m = m
+                    .merged(&placed(&b, 1.0, rng.range(0.0, 6.3), c, false))
+                    .unwrap();
+            }
+            ("turned boxes", m.into())
+        }
+        _ => {
+            let c = in_between(rng);
+            let h = DVec3::new(
+                rng.range(0.1, 0.4),
+                rng.range(0.1, 0.4),
+                rng.range(0.1, 0.4),
+            );
+            ("convex box", ConvexPolyhedron::cuboid(c, h).unwrap().into())
+        }
+    }
+}
+
+/// One random light, 2.5 to 3.5 above the ground.
+fn light(rng: &mut Rng) -> (&'static str, Light) {
+    let c = DVec3::new(
+        rng.range(-0.5, 0.5),
+        rng.range(-0.5, 0.5),
+        rng.range(2.5, 3.5),
+    );
+    let body: (&str, Body) = match rng.below(4) {
+        0 | 1 => {
+            let t = rng.range(-0.3, 0.3);
+            let q = TriangleMesh::quad(
+                c,
+                DVec3::Y * rng.range(0.3, 0.8),
+                DVec3::new(t.cos(), 0.0, t.sin()) * rng.range(0.3, 0.8),
+            )
+            .unwrap();
+            ("quad", q.into())
+        }
+        2 => (
+            "icosphere",
+            ConvexPolyhedron::icosphere(c, rng.range(0.2, 0.5), 1)
+                .unwrap()
+                .into(),
+        ),
+        _ => {
+            let m = torus(0.5, 0.15, 12, 6).unwrap();
+            (
+                "torus light",
+                placed(&m, 1.0, rng.range(0.0, 6.3), c, false).into(),
+            )
+        }
+    };
+    (body.0, Light::new(body.1, DVec3::ONE).unwrap())
+}
+
+/// Total solid angle of region pieces.
+fn solid_angle(pieces: &[SphericalPolygon]) -> f64 {
+    pieces.iter().map(SphericalPolygon::solid_angle).sum()
+}
+
+/// Shading points for a scene: ground points, points on an occluder's surface (with its
+/// normal), points 1e-9 off an occluder triangle's plane, and the centre of an occluder.
+fn points(rng: &mut Rng, occ: &[Body], k: usize) -> Vec<(DVec3, DVec3)> {
+    let mut out = Vec::new();
+    for i in 0..k {
+        let o = occ[rng.below(occ.len())].mesh();
+        let p = match i % 5 {
+            0 | 1 => (
+                DVec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), 0.0),
+                DVec3::Z,
+            ),
+            2 => point_on_mesh(rng, o),
+            3 => {
+                let (x, n) = point_on_mesh(rng, o);
+                let off = if rng.f64() < 0.5 { 1e-9 } else { -1e-9 };
+                (x + n * off, if off > 0.0 { n } else { -n })
+            }
+            _ => (o.bounding_sphere().center, rng.dir()),
+        };
+        out.push(p);
+    }
+    out
+}
+
+#[test]
+fn one_pass_agrees_with_per_triangle() {
+    let scenes = support::cases(160) as u64;
+    let (mut compared, mut gave_up, mut partial, mut worst) = (0usize, 0usize, 0usize, 0.0f64);
+    let mut names = std::collections::BTreeMap::<&str, usize>::new();
+    for seed in 0..scenes {
+        let mut rng = Rng::new(0x5CA1E + seed);
+        let (lname, l) = light(&mut rng);
+        let occ: Vec<(&str, Body)> = (0..rng.below(3) + 1).map(|_| occluder(&mut rng)).collect();
+        let bodies: Vec<Body> = occ.iter().map(|o| o.1.clone()).collect();
+        let scene = Scene::new(vec![l], bodies.clone()).unwrap();
+        let reference = scene.clone().with_method(Method::PerTriangle);
+        let sequential = scene.clone().with_method(Method::Sequential);
+        for (x, n) in points(&mut rng, &bodies, 6) {
+            let v = view_above(&mut rng, n, 0.2);
+            let Ok(frame) = ShadingFrame::new(x, n, v) else {
+                continue;
+            };
+            let (a, b, c) = (
+                scene.visible_region(0, &frame),
+                reference.visible_region(0, &frame),
+                sequential.visible_region(0, &frame),
+            );
+            let (a, b, c) = match (a, b, c) {
+                (Ok(a), Ok(b), Ok(c)) => (solid_angle(&a), solid_angle(&b), solid_angle(&c)),
+                (a, b, c) => {
+                    for r in [&a, &b, &c] {
+                        if let Err(e) = r {
+                            assert!(e.is_undecidable(), "seed {seed}: {e:?}");
+                        }
+                    }
+                    gave_up += 1;
+                    continue;
+                }
+            };
+            compared += 1;
+            let lit = solid_angle(&scene.visibility().unoccluded_region(0, &frame).unwrap());
+            if a > 1e-6 * lit && a < lit * (1.0 - 1e-6) {
+                partial += 1;
+            }
+            let what: Vec<&str> = occ.iter().map(|o| o.0).collect();
+            for o in &what {
+                *names.entry(o).or_default() += 1;
+            }
+            let d = (a - b).abs().max((c - b).abs());
+            worst = worst.max(d);
+            assert!(
+                d <= 1e-10,
+                "seed {seed}, {lname} over {what:?}, point {x} normal {n}: one pass {a}, \
+                 per triangle {b}, sequential {c}"
+            );
+        }
+    }
+    println!(
+        "{compared} points compared ({partial} in a penumbra), {gave_up} gave up, worst \
+         difference {worst:e}: {names:?}"
+    );
+    // The scenes must exercise the union: most compared points see part of the light hidden.
+    assert!(
+        partial * 5 >= compared,
+        "only {partial} of {compared} points in a penumbra"
+    );
+    assert!(
+        gave_up * 100 <= compared + gave_up,
+        "{gave_up} give-ups in {}",
+        compared + gave_up
+    );
+}
+
+/// Whether `p` lies in the exact shaft from `x` (unit normal `n`) to the ball `s`: above the
+/// tangent plane, and in the convex hull of `x` and the ball (the ball itself, or the cone from
+/// `x` around it up to the tangent length `sqrt(d^2 - r^2)`, along which every ray is inside the
+/// hull).
+fn in_exact_shaft(p: DVec3, x: DVec3, n: DVec3, s: BoundingSphere) -> bool {
+    if n.dot(p - x) < 0.0 {
+        return false;
+    }
+    if (p - s.center).length() <= s.radius {
+        return true;
+    }
+    let (to, d) = (s.center - x, (s.center - x).length());
+    if d <= s.radius {
+        return false; // x inside the ball: the hull is the ball
+    }
+    let q = p - x;
+    let cos_angle = q.dot(to) / (q.length() * d);
+    let cos_alpha = (1.0 - (s.radius / d).powi(2)).sqrt();
+    cos_angle >= cos_alpha && q.length() <= (d * d - s.radius * s.radius).sqrt()
+}
+
+#[test]
+fn shaft_culling_keeps_every_triangle_that_meets_the_shaft() {
+    // Many small triangles, most of them straddling the shaft's boundary (the cone's sides, the
+    // horizon, the ball's far side), some anywhere; a hierarchy over them; the triangles the
+    // hierarchy and the per-triangle test keep must include every triangle with a sample point
+    // in the exact shaft.
+    let (mut checked, mut kept_total, mut meeting_total) = (0usize, 0usize, 0usize);
+    for seed in 0..support::cases(40) as u64 {
+        let mut rng = Rng::new(0x5AF7 + seed);
+        let x = DVec3::new(
+            rng.range(-2.0, 2.0),
+            rng.range(-2.0, 2.0),
+            rng.range(-0.5, 0.5),
+        );
+        let n = if rng.f64() < 0.5 { DVec3::Z } else { rng.dir() };
+        let light = BoundingSphere {
+            center: DVec3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(1.0, 4.0),
+            ),
+            radius: if seed % 7 == 0 {
+                5.0
+            } else {
+                rng.range(0.05, 1.0)
+            }, // x inside, sometimes
+        };
+        let (to, d) = (light.center - x, (light.center - x).length());
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::new();
+        for k in 0..600 {
+            // A point on the shaft's boundary: on the cone's side, the tangent plane, or the
+            // ball, then a small triangle around it.
+            let c = match k % 4 {
+                0 if d > light.radius => {
+                    let alpha = (light.radius / d).asin();
+                    let (e1, e2) = to.normalize().any_orthonormal_pair();
+                    let phi = rng.range(0.0, std::f64::consts::TAU);
+                    let dir = to.normalize() * alpha.cos()
+                        + (e1 * phi.cos() + e2 * phi.sin()) * alpha.sin();
+                    x + dir * rng.range(0.0, (d * d - light.radius * light.radius).sqrt())
+                }
+                1 => {
+                    let (e1, e2) = n.any_orthonormal_pair();
+                    x + (e1 * rng.range(-3.0, 3.0) + e2 * rng.range(-3.0, 3.0))
+                }
+                2 => light.center + rng.dir() * light.radius,
+                _ => {
+                    x + (light.center - x) * rng.range(-0.5, 1.5) + rng.dir() * rng.range(0.0, 2.0)
+                }
+            };
+            let size = 10f64.powf(rng.range(-6.0, -1.0));
+            let base = vertices.len() as u32;
+            for _ in 0..3 {
+                vertices.push(c + rng.dir() * size);
+            }
+            triangles.push([base, base + 1, base + 2]);
+        }
+        let Ok(mesh) = TriangleMesh::new(vertices, triangles) else {
+            continue;
+        };
+        let bvh = Bvh::build(&mesh);
+        let shaft = Shaft::to_sphere(x, n, light);
+        let mut kept = vec![false; mesh.triangle_count()];
+        bvh.for_each(
+            |lo, hi| shaft.may_meet_box(lo, hi),
+            |t| kept[t as usize] |= shaft.may_meet_triangle(&mesh.triangle(t as usize)),
+        );
+        for (t, &k) in kept.iter().enumerate() {
+            let [a, b, c] = mesh.triangle(t);
+            let steps = 12;
+            let meets = (0..=steps).any(|i| {
+                (0..=steps - i).any(|j| {
+                    let (u, v) = (i as f64 / steps as f64, j as f64 / steps as f64);
+                    in_exact_shaft(a + (b - a) * u + (c - a) * v, x, n, light)
+                })
+            });
+            meeting_total += usize::from(meets);
+            kept_total += usize::from(k);
+            assert!(
+                k || !meets,
+                "seed {seed}: triangle {t} meets the shaft from {x} (normal {n}) to {light:?} \
+                 but was culled: {:?}",
+                mesh.triangle(t)
+            );
+            checked += 1;
+        }
+    }
+    println!("{checked} triangles, {meeting_total} meet the shaft, {kept_total} kept");
+    // The culling must cull: most triangles that do not meet the shaft are dropped.
+    assert!(kept_total < meeting_total + (checked - meeting_total) / 2);
+}
+
+#[test]
+fn bvh_visits_every_triangle_whose_box_passes() {
+    for seed in 0..support::cases(20) as u64 {
+        let mut rng = Rng::new(0xB74 + seed);
+        let m = soup(&mut rng).merged(&terrain(&mut rng)).unwrap();
+        let m = m
+            .merged(&placed(&m, 3.0, 1.0, rng.dir() * 1e3, false))
+            .unwrap();
+        let bvh = Bvh::build(&m);
+        assert_eq!(bvh.triangle_count(), m.triangle_count());
+        assert!(bvh.byte_size() <= 40 * m.triangle_count() + 200);
+        for q in 0..40 {
+            let h = DVec3::new(rng.f64(), rng.f64(), rng.f64()) * 10f64.powf(rng.range(-6.0, 0.5));
+            let (qlo, qhi) = if q % 2 == 0 {
+                let c =
+                    m.vertices()[rng.below(m.vertices().len())] + rng.dir() * rng.range(0.0, 1.0);
+                (c - h, c + h)
+            } else {
+                // Touching one triangle's box at a corner from outside (the stored boxes must
+                // round outwards, not to nearest).
+                let [a, b, c] = m.triangle(rng.below(m.triangle_count()));
+                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                if q % 4 == 1 {
+                    (hi, hi + h)
+                } else {
+                    (lo - h, lo)
+                }
+            };
+            let mut seen = vec![0u32; m.triangle_count()];
+            bvh.for_each(
+                |lo, hi| lo.cmple(qhi).all() && qlo.cmple(hi).all(),
+                |t| seen[t as usize] += 1,
+            );
+            for (t, &s) in seen.iter().enumerate() {
+                let [a, b, c] = m.triangle(t);
+                let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+                let overlaps = lo.cmple(qhi).all() && qlo.cmple(hi).all();
+                assert!(s <= 1, "seed {seed}: triangle {t} visited {s} times");
+                assert!(!overlaps || s == 1, "seed {seed}: triangle {t} missed");
+            }
+        }
+    }
+}
+
+/// Scenes of many mesh triangles shaded by the one-pass path against the Monte Carlo reference
+/// (exact ray-triangle visibility, the LTC BRDF so that both compute the same integral): a quad
+/// light over a 320-triangle bumpy sphere and an open soup, and a torus light over turned boxes
+/// merged into one closed mesh. Per point and channel `|analytic - mc| <= 4.5 sigma_hat + 1e-6`
+/// over 2048 samples (6.8e-6 per check for a normal deviate; 2 x 60 x 3 checks keep the chance
+/// of a false alarm in this test near 0.25%), a point that fails re-estimated once with 16
+/// times the samples on an independent stream (a sliver no sample of 2048 hits has
+/// `sigma_hat = 0`), and the mean z-score within `4 / sqrt(points)`.
+#[test]
+fn one_pass_agrees_with_monte_carlo() {
+    use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
+    let m = Material::new(DVec3::new(0.6, 0.5, 0.4), DVec3::splat(0.04), 0.45).unwrap();
+    let mc = MonteCarlo::new(2048, ReferenceBrdf::Ltc);
+    let mc16 = MonteCarlo::new(16 * 2048, ReferenceBrdf::Ltc);
+    let mut rng = Rng::new(0x3C_5CA1E);
+    let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5);
+    let bumpy = placed(
+        &bumpy_sphere(2, 0.2, 5).unwrap(),
+        0.45,
+        0.0,
+        DVec3::new(0.0, 0.0, 1.5),
+        false,
+    );
+    let scenes = [
+        Scene::new(
+            vec![Light::new(quad.unwrap(), DVec3::ONE).unwrap()],
+            vec![bumpy.into(), soup(&mut rng).into()],
+        )
+        .unwrap(),
+        Scene::new(vec![light_torus()], vec![occluder_kind(&mut rng, 8).1]).unwrap(),
+    ];
+    let (mut zsum, mut zn, mut partial, mut gave_up) = (0.0, 0usize, 0usize, 0usize);
+    let mut failures = Vec::new();
+    for (k, scene) in scenes.iter().enumerate() {
+        let lit = Scene::new(scene.lights().to_vec(), vec![]).unwrap();
+        for i in 0..60 {
+            let x = DVec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), 0.0);
+            let v = view_above(&mut rng, DVec3::Z, 0.2);
+            let a = match scene.shade(x, DVec3::Z, v, &m) {
+                Ok(a) => a,
+                Err(e) if e.is_undecidable() => {
+                    gave_up += 1;
+                    continue;
+                }
+                Err(e) => panic!("{e:?}"),
+            };
+            let full = lit.shade(x, DVec3::Z, v, &m).unwrap();
+            if a.y > 1e-3 * full.y && a.y < 0.999 * full.y {
+                partial += 1;
+            }
+            let seed = (k * 1000 + i) as u64;
+            let e = mc.estimate(scene, x, DVec3::Z, v, &m, seed).unwrap();
+            let agrees = |e: &arealight::shade::Estimate, c: usize| {
+                (a[c] - e.mean[c]).abs() <= 4.5 * e.std_error[c] + 1e-6
+            };
+            if e.std_error.y > 0.0 {
+                zsum += (a.y - e.mean.y) / e.std_error.y;
+                zn += 1;
+            }
+            if (0..3).all(|c| agrees(&e, c)) {
+                continue;
+            }
+            let e2 = mc16.estimate(scene, x, DVec3::Z, v, &m, !seed).unwrap();
+            for c in (0..3).filter(|&c| !agrees(&e2, c)) {
+                failures.push(format!(
+                    "scene {k} point {i} {x} channel {c}: analytic {} mc {} +- {}, then {} +- {}",
+                    a[c], e.mean[c], e.std_error[c], e2.mean[c], e2.std_error[c]
+                ));
+            }
+        }
+    }
+    let zmean = zsum / zn.max(1) as f64;
+    println!("{zn} points, {partial} in a penumbra, {gave_up} gave up, mean z {zmean:.3}");
+    assert!(failures.is_empty(), "{failures:#?}");
+    assert!(gave_up <= 1, "{gave_up} give-ups in 120 points");
+    assert!(
+        zmean.abs() <= 4.0 / (zn as f64).sqrt(),
+        "mean z-score {zmean}: a bias"
+    );
+    assert!(partial >= 30, "only {partial} points in a penumbra");
+}
+
+/// The torus light of the Monte Carlo scenes (144 triangles), 2.5 above the ground.
+fn light_torus() -> Light {
+    let m = torus(0.6, 0.18, 12, 6).unwrap();
+    Light::new(
+        placed(&m, 1.0, 0.3, DVec3::new(0.0, 0.0, 2.5), false),
+        DVec3::ONE,
+    )
+    .unwrap()
+}
