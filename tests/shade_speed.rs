@@ -516,3 +516,285 @@ fn points_on_surfaces_and_bad_input() {
         }
     }
 }
+
+/// The same scene at scales from `1e-60` to `1e70`, and offset far from the origin: the fast
+/// path's tolerances are relative to the objects' sizes and distances, so its value must not
+/// depend on the scene's scale beyond rounding, and must agree with the spherical path at every
+/// scale. (Meshes of this scene cannot be built much beyond these scales: their triangles'
+/// areas overflow or underflow near `1e76` and `1e-77`.)
+#[test]
+fn scene_scale_does_not_matter() {
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
+    let mut rng = Rng::new(40);
+    let points: Vec<(DVec3, DVec3)> = (0..40)
+        .map(|_| {
+            let x = DVec3::new(rng.range(-0.6, 0.8), rng.range(-0.5, 0.6), 0.0);
+            (x, view_above(&mut rng, DVec3::Z, 0.2))
+        })
+        .collect();
+    let mut reference: Vec<DVec3> = Vec::new();
+    for (k, (scale, offset)) in [
+        (1.0, 0.0),
+        (1e40, 0.0),
+        (1e-40, 0.0),
+        (1e70, 0.0),
+        (1e-60, 0.0),
+        (1.0, 1e6),
+        (1e30, 3e35),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let at = |p: DVec3| p * scale + DVec3::splat(offset);
+        let quad = TriangleMesh::quad(
+            at(DVec3::new(0.0, 0.0, 2.0)),
+            DVec3::Y * 0.5 * scale,
+            DVec3::X * 0.5 * scale,
+        )
+        .unwrap();
+        let occ: Vec<Body> = vec![
+            ConvexPolyhedron::cuboid(at(DVec3::new(0.0, 0.0, 1.0)), DVec3::splat(0.25 * scale))
+                .unwrap()
+                .into(),
+            ConvexPolyhedron::icosphere(at(DVec3::new(0.3, 0.3, 1.4)), 0.15 * scale, 0)
+                .unwrap()
+                .into(),
+        ];
+        let scene = Scene::new(vec![Light::new(quad, DVec3::ONE).unwrap()], occ).unwrap();
+        let mut ctx = ShadeContext::new();
+        for (i, &(x, v)) in points.iter().enumerate() {
+            let got = scene.shade_in(&mut ctx, at(x), DVec3::Z, v, &m).unwrap();
+            let frame = ShadingFrame::new(at(x), DVec3::Z, v).unwrap();
+            if let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) {
+                let err = (got - want).abs().max_element();
+                assert!(
+                    err <= 1e-12 * (unoccluded.max_element() + ABS_FLOOR),
+                    "scale {scale}, offset {offset}, point {i}: {got} vs {want}"
+                );
+            }
+            if k == 0 {
+                reference.push(got);
+            } else if offset == 0.0 {
+                // A pure scaling changes the directions by rounding only.
+                let err = (got - reference[i]).abs().max_element();
+                assert!(
+                    err <= 1e-13,
+                    "scale {scale}, point {i}: {got} vs {}",
+                    reference[i]
+                );
+            }
+        }
+        assert_eq!(ctx.spherical_lights(), 0, "scale {scale}: declined");
+    }
+}
+
+/// Light `i`'s radiance at the point from the spherical path's region, integrated here, and the
+/// same for the light's whole region (the tolerance's scale), both from the backend that holds
+/// the light facing the point (`Scene::visible_region`, `Scene::light_region`: a two-sided light
+/// seen from behind is turned around). `None` where the spherical path gives up.
+fn spherical_facing(
+    scene: &Scene,
+    i: usize,
+    f: &ShadingFrame,
+    m: &Material,
+) -> Option<(DVec3, DVec3)> {
+    let light = &scene.lights()[i];
+    let value = |pieces: Vec<arealight::sphere::SphericalPolygon>| -> Option<DVec3> {
+        let d: f64 = pieces.iter().map(clamped_cosine_integral).sum();
+        let l = lookup(f.view().z, m.alpha()).ok()?;
+        let mut s = 0.0;
+        for p in &pieces {
+            s += ltc_integral(p, l.m_inv).ok()?;
+        }
+        let f0 = m.f0();
+        let scale = DVec3::new(
+            l.specular_scale(f0.x),
+            l.specular_scale(f0.y),
+            l.specular_scale(f0.z),
+        );
+        Some((m.albedo() * d + scale * s) * light.radiance())
+    };
+    let shadowed = value(scene.visible_region(i, f).ok()?)?;
+    let whole = value(scene.light_region(i, f).ok()?)?;
+    Some((shadowed, whole))
+}
+
+/// The rules of the spherical path that the fast path must follow or leave to it, each on a
+/// scene built to exercise it, with the value of `Scene::shade_in` checked against the spherical
+/// path's region integrated here:
+///
+/// - a blocker with a vertex in the plane of a light triangle is never subtracted whole (a box
+///   hanging from a quad light, a flat quad beside the light in its plane, a box reaching the
+///   plane of a box lamp's side face): the fast path must decline wherever such a blocker is
+///   among the blockers of a point that sees some of the light;
+/// - a point inside a convex light or on its surface receives nothing from it;
+/// - a two-sided quad light is shaded from both sides (the turned-around backend from behind),
+///   with occluders on both sides, on the fast path;
+/// - a mesh occluder large enough for a hierarchy is left to the one-pass union (the fast path
+///   declines wherever it is among the blockers, as for touching blockers).
+#[test]
+fn main_rules_hold_on_the_fast_path() {
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5).unwrap();
+    let lamp =
+        ConvexPolyhedron::cuboid(DVec3::new(0.1, 0.0, 2.2), DVec3::new(0.4, 0.3, 0.1)).unwrap();
+    let cube = |c: DVec3, h: DVec3| -> Body { ConvexPolyhedron::cuboid(c, h).unwrap().into() };
+    // A quad in the light's plane beside it, facing up.
+    let beside =
+        TriangleMesh::quad(DVec3::new(0.8, 0.0, 2.0), DVec3::X * 0.2, DVec3::Y * 0.4).unwrap();
+    // 80 triangles: at least `BVH_MIN_TRIANGLES`, so it has a hierarchy.
+    let ball = Body::Mesh(
+        ConvexPolyhedron::icosphere(DVec3::new(-0.2, 0.1, 1.2), 0.2, 1)
+            .unwrap()
+            .mesh()
+            .clone(),
+    );
+    assert!(ball.mesh().triangle_count() >= arealight::visibility::BVH_MIN_TRIANGLES);
+    struct Case {
+        name: &'static str,
+        lights: Vec<Light>,
+        occluders: Vec<Body>,
+        /// Occluders whose presence among the blockers forbids the fast path.
+        forbidden: Vec<usize>,
+    }
+    let cases = [
+        Case {
+            name: "box hanging from the quad",
+            lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap()],
+            occluders: vec![
+                cube(DVec3::new(0.1, 0.0, 1.75), DVec3::splat(0.25)),
+                cube(DVec3::new(-0.3, 0.3, 1.0), DVec3::splat(0.1)),
+            ],
+            forbidden: vec![0],
+        },
+        Case {
+            name: "quad beside the light in its plane",
+            lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap()],
+            occluders: vec![
+                beside.clone().into(),
+                cube(DVec3::ZERO.with_z(1.0), DVec3::splat(0.2)),
+            ],
+            forbidden: vec![0],
+        },
+        Case {
+            name: "box reaching a lamp face's plane",
+            lights: vec![Light::new(lamp.clone(), DVec3::ONE).unwrap()],
+            occluders: vec![cube(
+                DVec3::new(0.35, -0.3, 1.35),
+                DVec3::new(0.15, 0.1, 0.05),
+            )],
+            forbidden: vec![0],
+        },
+        Case {
+            name: "mesh occluder with a hierarchy",
+            lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap()],
+            occluders: vec![ball, cube(DVec3::new(0.3, -0.2, 1.0), DVec3::splat(0.1))],
+            forbidden: vec![0],
+        },
+        Case {
+            name: "two-sided quad",
+            lights: vec![Light::two_sided(quad.clone(), DVec3::ONE).unwrap()],
+            occluders: vec![
+                cube(DVec3::new(0.1, 0.0, 1.0), DVec3::splat(0.2)),
+                cube(DVec3::new(-0.1, 0.1, 3.0), DVec3::splat(0.2)),
+            ],
+            forbidden: vec![],
+        },
+    ];
+    let mut rng = Rng::new(1717);
+    let mut pieces = Pieces::new();
+    let mut failures = Vec::new();
+    for case in cases {
+        let scene = Scene::new(case.lights, case.occluders).unwrap();
+        let two_sided = scene.lights()[0].is_two_sided();
+        let mut ctx = ShadeContext::new();
+        let (mut checked, mut forbidden_seen, mut behind) = (0, 0, 0);
+        for k in 0..300 {
+            // Ground points and, for the two-sided light, points above it looking down; points
+            // on the occluders' surfaces.
+            let (x, n) = if k % 3 == 2 {
+                let o = &scene.occluders()[rng.below(scene.occluders().len())];
+                support::shade::point_on_mesh(&mut rng, o.mesh())
+            } else if two_sided && k % 2 == 1 {
+                behind += 1;
+                (
+                    DVec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), 4.0),
+                    -DVec3::Z,
+                )
+            } else {
+                (support::shade::ground_point(&mut rng, 1.5), DVec3::Z)
+            };
+            let v = view_above(&mut rng, n, 0.2);
+            let f = ShadingFrame::new(x, n, v).unwrap();
+            let took = scene
+                .visibility()
+                .visible_pieces(0, &f, true, &mut pieces)
+                .unwrap();
+            let listed = scene
+                .occluders_between(0, &f)
+                .any(|o| case.forbidden.contains(&o));
+            if listed {
+                forbidden_seen += 1;
+                // An empty region (the light below the horizon, or seen edge-on) needs no
+                // blocker.
+                if took && !pieces.is_empty() {
+                    failures.push(format!("{}: {x} took the fast path", case.name));
+                }
+            }
+            let got = scene.shade_in(&mut ctx, x, n, v, &m);
+            let Some((want, whole)) = spherical_facing(&scene, 0, &f, &m) else {
+                continue;
+            };
+            let got = got.unwrap();
+            checked += 1;
+            if (got - want).abs().max_element() > 1e-12 * (whole.max_element() + ABS_FLOOR) {
+                failures.push(format!("{}: {x} n {n}: {got} vs {want}", case.name));
+            }
+        }
+        assert!(
+            checked >= 250,
+            "{}: only {checked} points checked",
+            case.name
+        );
+        if !case.forbidden.is_empty() {
+            assert!(
+                forbidden_seen >= 30,
+                "{}: the blocker under test was listed for {forbidden_seen} points",
+                case.name
+            );
+        }
+        if two_sided {
+            // Both sides took the fast path (ground points see the front, points above the back).
+            assert!(
+                ctx.fast_lights() as usize >= 300 - 100 - behind / 4,
+                "{}: {} of 300 on the fast path",
+                case.name,
+                ctx.fast_lights()
+            );
+        }
+    }
+    // Inside a convex light and on its surface: nothing, on either path.
+    let scene = Scene::new(vec![Light::new(lamp.clone(), DVec3::ONE).unwrap()], vec![]).unwrap();
+    for k in 0..100 {
+        let (x, n) = if k % 2 == 0 {
+            let c = DVec3::new(0.1, 0.0, 2.2);
+            (
+                c + DVec3::new(
+                    rng.range(-0.39, 0.39),
+                    rng.range(-0.29, 0.29),
+                    rng.range(-0.09, 0.09),
+                ),
+                rng.dir(),
+            )
+        } else {
+            support::shade::point_on_mesh(&mut rng, lamp.mesh())
+        };
+        let v = view_above(&mut rng, n, 0.2);
+        let got = scene.shade(x, n, v, &m).unwrap();
+        if got != DVec3::ZERO {
+            failures.push(format!("inside or on the lamp, {x}: {got}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
