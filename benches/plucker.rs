@@ -268,8 +268,8 @@ fn run(c: &mut Criterion, name: &str, cases: Vec<Case>) {
             s.peak_cached_bytes / 1024,
             s.fragments as f64 / s.queries as f64,
         );
-        // The clipping backend gives up (`Undecidable`) on a few terrain points (the sphere
-        // layer's horizon clip, tests/visibility_known_failures.rs); a give-up is timed as an
+        // The clipping backend may give up (`Undecidable`) on a few terrain points (the sphere
+        // layer's horizon clip, tests/visibility_backend_regressions.rs); a give-up is timed as an
         // answer.
         let gave_up = frames
             .iter()

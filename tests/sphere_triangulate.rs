@@ -466,3 +466,83 @@ fn fuzz_sliver_area_resolution() {
     ]]);
     run("fuzz: sliver", &p);
 }
+
+/// The complement of a set operation's result whose vertices 5, 6, 12 and 13 lie on one great
+/// circle within 1e-18 (two collinear edges of the subtrahend): in every chart the planar hull
+/// keeps a sliver that is inverted on the sphere, which the repair flips with its fan triangle
+/// (it made the chart fail and cost 8 extra vertices in octant cuts).
+#[test]
+fn regression_collinear_hull_vertices_of_a_difference_complement() {
+    let v = [
+        [
+            -0.062043575692327047,
+            0.9593862262287458,
+            0.2751884147958929,
+        ],
+        [0.2472818353003587, 0.8936776456228601, 0.3744221676723583],
+        [0.41860756013973116, 0.7140411545367752, 0.5611710436414644],
+        [0.2829570949062304, 0.5429908152794021, 0.7906302909479478],
+        [-0.0294828493263179, 0.564253987851959, 0.8250746625541007],
+        [
+            -0.41411144637903935,
+            0.48630470529616765,
+            0.7694279976610335,
+        ],
+        [-0.47085212592710923, 0.6641354486493213, 0.5807085166908491],
+        [-0.40238054558448116, 0.5746998577491305, 0.7126078655461673],
+        [-0.21063232952568214, 0.5569423337918336, 0.8033985677041565],
+        [0.0699370670200307, 0.6535603463151644, 0.7536363051107864],
+        [0.0676122725504371, 0.8131153709533159, 0.5781625845037165],
+        [
+            -0.24943425599723865,
+            0.8727853562550602,
+            0.41955723547786855,
+        ],
+        [-0.4929650255599981, 0.777691115439531, 0.3901051301137277],
+        [-0.4934415863438572, 0.7825026871350936, 0.37974326260358543],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    let r = run("complement with collinear hull vertices", &p);
+    assert!(r.extra_vertices <= 1);
+}
+
+/// A ring within 5e-9 rad above the equator whose vertices 1 and 3 are antipodal (a silhouette
+/// of the extruded cube seen from a point in its BSP cell): a triangle on the diagonal 1-3 has
+/// `det` and Van Oosterom-Strackee's denominator both below 1e-8, so rounding decided its area
+/// (the triangles summed to 7.5e-8 sr above the region). The certificate refuses such triangles
+/// and another candidate triangulates.
+#[test]
+fn regression_antipodal_diagonal_of_a_hemisphere_sized_ring() {
+    let v = [
+        [
+            -0.7071067796528793,
+            -0.7071067827202158,
+            2.286257697225603e-9,
+        ],
+        [
+            0.3162277648737091,
+            -0.9486832984315569,
+            1.7040758758475341e-9,
+        ],
+        [
+            0.9899494931499438,
+            -0.14142135981586887,
+            2.2862577038372615e-9,
+        ],
+        [
+            -0.3162277694462245,
+            0.9486832969073848,
+            5.112227676822987e-9,
+        ],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    let r = run("hemisphere-sized ring with antipodal vertices", &p);
+    // The region lies above the ring: the hemisphere minus a band under 5.2e-9 rad, so its area
+    // is within 2 pi * 5.2e-9 below 2 pi; the triangles' sum agrees with the polygon's area.
+    let area = p.solid_angle();
+    assert!(
+        area < 2.0 * PI && area > 2.0 * PI * (1.0 - 5.2e-9),
+        "{area}"
+    );
+    assert!(r.area_error <= 1e-12, "{}", r.area_error);
+}

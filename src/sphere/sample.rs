@@ -403,20 +403,44 @@ impl PolygonSampler {
 /// denominator cancels to rounding noise for a thin triangle from a point to a far, tiny edge,
 /// as in a fan from the antipode of a tiny polygon.)
 pub(crate) fn signed_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let det = a.dot(shorter(b - a, b + a).cross(shorter(c - a, c + a)));
+    signed_solid_angle_with_error(a, b, c).0
+}
+
+/// [`signed_solid_angle`] and a bound on its rounding error. `det` is a dot product of short
+/// vectors, off by a few `eps |u| |v|`; the denominator is an exact integer plus half-chords
+/// squared, off by a few `eps` times their magnitudes (not its value: they can cancel); the
+/// angle `2 atan2(det, den)` moves by `2 (|den| d_det + |det| d_den) / (det^2 + den^2)`. The
+/// bound is large only where both terms vanish together: nearly antipodal vertices nearly on a
+/// great circle, whose area rounding decides at will.
+pub(crate) fn signed_solid_angle_with_error(a: DVec3, b: DVec3, c: DVec3) -> (f64, f64) {
+    let (u, v) = (shorter(b - a, b + a), shorter(c - a, c + a));
+    let det = a.dot(u.cross(v));
     let mut constant = 1.0;
     let mut small = 0.0;
+    let mut magnitude = 0.0;
     for (x, y) in [(a, b), (b, c), (c, a)] {
         let (d, s) = ((x - y).length_squared(), (x + y).length_squared());
         if d <= s {
             constant += 1.0;
             small -= 0.5 * d;
+            magnitude += 0.5 * d;
         } else {
             constant -= 1.0;
             small += 0.5 * s;
+            magnitude += 0.5 * s;
         }
     }
-    2.0 * atan2(det, constant + small)
+    let den = constant + small;
+    let eps = f64::EPSILON;
+    let d_det = 8.0 * eps * crate::math::sqrt(u.length_squared() * v.length_squared());
+    let d_den = 8.0 * eps * magnitude + eps * den.abs();
+    let norm = det * det + den * den;
+    let err = if norm > 0.0 {
+        2.0 * (den.abs() * d_det + det.abs() * d_den) / norm
+    } else {
+        f64::INFINITY
+    };
+    (2.0 * atan2(det, den), err)
 }
 
 /// The shorter of two vectors (the first on a tie).

@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 use super::gnomonic::enclosing_cap;
 use super::polygon::SphericalPolygon;
 use super::predicates::{AXES, normalize_any, orient, tangent_frame};
-use super::sample::{SphericalTriangle, signed_solid_angle};
+use super::sample::{SphericalTriangle, signed_solid_angle, signed_solid_angle_with_error};
 use crate::GeomError;
 use crate::planar::{Cdt, constrained_delaunay};
 
@@ -149,7 +149,7 @@ fn fan_from_first(ring: &[DVec3]) -> Option<Vec<SphericalTriangle>> {
     let mut sum = 0.0;
     for w in ring[1..].windows(2) {
         let (b, c) = (w[0], w[1]);
-        if orient(apex, b, c) != 1 {
+        if orient(apex, b, c) != 1 || !well_conditioned(apex, b, c) {
             return None;
         }
         match SphericalTriangle::from_unit(apex, b, c) {
@@ -388,13 +388,7 @@ fn chart(ix: &mut Indexed, c: DVec3, complement: bool) -> Result<Vec<[u32; 3]>, 
             DVec2::new((d.dot(u) + cu) / w, (d.dot(v) + cv) / w)
         })
         .collect();
-    let (tris, inside) = planar_triangles(ix, &pts)?;
-    let mut out: Vec<[u32; 3]> = tris
-        .iter()
-        .zip(&inside)
-        .filter(|(_, k)| **k)
-        .map(|(t, _)| *t)
-        .collect();
+    let (mut tris, mut inside) = planar_triangles(ix, &pts)?;
     if complement {
         let mut directed: Vec<[u32; 2]> = tris
             .iter()
@@ -417,10 +411,24 @@ fn chart(ix: &mut Indexed, c: DVec3, complement: bool) -> Result<Vec<[u32; 3]>, 
         let apex = ix.verts.len() as u32;
         ix.verts.push(apex_dir);
         for &[i, j] in &hull {
-            out.push([apex, j, i]);
+            tris.push([apex, j, i]);
+            inside.push(true);
         }
     }
-    Ok(out)
+    // After the fan: a sliver on the hull between vertices that set operations left on one
+    // great circle can be inverted on the sphere, and is repaired by a flip with its fan
+    // triangle.
+    flip_inverted(&ix.verts, &mut tris, &inside, &ix.edges)?;
+    Ok(kept(&tris, &inside))
+}
+
+/// The triangles with `inside` set.
+fn kept(tris: &[[u32; 3]], inside: &[bool]) -> Vec<[u32; 3]> {
+    tris.iter()
+        .zip(inside)
+        .filter(|(_, k)| **k)
+        .map(|(t, _)| *t)
+        .collect()
 }
 
 /// Smallest chord from a stereographic pole to every vertex: the projection's coordinates stay
@@ -523,13 +531,9 @@ fn stereographic_chart(ix: &Indexed, pole: DVec3) -> Result<Vec<[u32; 3]>, GeomE
             DVec2::new(x + along * du, y + along * dv)
         })
         .collect();
-    let (tris, inside) = planar_triangles(ix, &pts)?;
-    Ok(tris
-        .iter()
-        .zip(&inside)
-        .filter(|(_, k)| **k)
-        .map(|(t, _)| *t)
-        .collect())
+    let (mut tris, inside) = planar_triangles(ix, &pts)?;
+    flip_inverted(&ix.verts, &mut tris, &inside, &ix.edges)?;
+    Ok(kept(&tris, &inside))
 }
 
 /// Repairs planar triangles that are not positively oriented on the sphere (exact `orient3d`)
@@ -538,9 +542,9 @@ fn stereographic_chart(ix: &Indexed, pole: DVec3) -> Result<Vec<[u32; 3]>, GeomE
 /// it (vertices that set operations placed on edges), and a stereographic chart's straight
 /// edges are not the images of arcs. A flip replaces the triangles `(a, b, c)` and `(b, a, d)`
 /// of edge `ab` by `(c, a, d)` and `(d, b, c)`, taken only when both are positive on the sphere;
-/// the triangles keep covering the same planar region, so labelling is unaffected.
-///
-/// Returns whether any edge was flipped.
+/// the triangles keep covering the same planar region, so labelling is unaffected. Only triangles
+/// with `inside` set are repaired (`ab` is not a polygon edge, so its other triangle is inside
+/// too): the others are not part of the result.
 ///
 /// # Errors
 ///
@@ -550,8 +554,9 @@ fn stereographic_chart(ix: &Indexed, pole: DVec3) -> Result<Vec<[u32; 3]>, GeomE
 fn flip_inverted(
     verts: &[DVec3],
     tris: &mut [[u32; 3]],
+    inside: &[bool],
     edges: &[[u32; 2]],
-) -> Result<bool, GeomError> {
+) -> Result<(), GeomError> {
     let positive = |t: [u32; 3]| {
         orient(
             verts[t[0] as usize],
@@ -559,9 +564,11 @@ fn flip_inverted(
             verts[t[2] as usize],
         ) == 1
     };
-    let mut queue: Vec<usize> = (0..tris.len()).filter(|&k| !positive(tris[k])).collect();
+    let mut queue: Vec<usize> = (0..tris.len())
+        .filter(|&k| inside[k] && !positive(tris[k]))
+        .collect();
     if queue.is_empty() {
-        return Ok(false);
+        return Ok(());
     }
     let fail = GeomError::Undecidable("a chart's triangle is inverted on the sphere");
     let mut constraint: Vec<[u32; 2]> = edges
@@ -596,7 +603,7 @@ fn flip_inverted(
         if constraint.binary_search(&key).is_ok() {
             return Err(fail);
         }
-        let Some(&m) = owner.get(&[b, a]) else {
+        let Some(&m) = owner.get(&[b, a]).filter(|&&m| inside[m]) else {
             return Err(fail); // the convex hull
         };
         let u = tris[m];
@@ -620,7 +627,7 @@ fn flip_inverted(
             }
         }
     }
-    Ok(true)
+    Ok(())
 }
 
 /// A directed edge `i -> j` as one integer, for sorting and searching.
@@ -630,8 +637,10 @@ fn edge_key(i: u32, j: u32) -> u64 {
 }
 
 /// The planar constrained Delaunay triangulation of the chart points `pts` (indexed as
-/// `ix.verts`) with the polygon's edges as constraints, repaired where it is inverted on the
-/// sphere ([`flip_inverted`]), and which of its triangles lie in the region ([`label`]).
+/// `ix.verts`) with the polygon's edges as constraints, and which of its triangles lie in the
+/// region ([`label`]). The labels come from the plane, where the sides of the constraint edges
+/// are consistent by construction; the caller repairs the kept triangles that rounding made
+/// inverted on the sphere ([`flip_inverted`]).
 fn planar_triangles(ix: &Indexed, pts: &[DVec2]) -> Result<(Vec<[u32; 3]>, Vec<bool>), GeomError> {
     let segs: Vec<[usize; 2]> = ix
         .edges
@@ -640,31 +649,10 @@ fn planar_triangles(ix: &Indexed, pts: &[DVec2]) -> Result<(Vec<[u32; 3]>, Vec<b
         .collect();
     let Cdt {
         tris,
-        mut across,
-        mut constraint,
+        across,
+        constraint,
     } = constrained_delaunay(pts, &segs)?;
-    let mut tris: Vec<[u32; 3]> = tris.into_iter().map(|t| t.map(|i| i as u32)).collect();
-    if flip_inverted(&ix.verts, &mut tris, &ix.edges)? {
-        // Flips change the adjacency: rebuilt from the sorted directed edges, every edge a
-        // possible polygon edge.
-        let mut half: Vec<(u64, u32)> = Vec::with_capacity(3 * tris.len());
-        for (k, t) in tris.iter().enumerate() {
-            for s in 0..3 {
-                half.push((edge_key(t[s], t[(s + 1) % 3]), k as u32));
-            }
-        }
-        half.sort_unstable();
-        for (k, t) in tris.iter().enumerate() {
-            for s in 0..3 {
-                let back = edge_key(t[(s + 1) % 3], t[s]);
-                across[k][s] = match half.binary_search_by(|h| h.0.cmp(&back)) {
-                    Ok(at) => half[at].1,
-                    Err(_) => Cdt::HULL,
-                };
-            }
-            constraint[k] = 0b111;
-        }
-    }
+    let tris: Vec<[u32; 3]> = tris.into_iter().map(|t| t.map(|i| i as u32)).collect();
     let inside = label(&tris, &across, &constraint, &ix.edges)?;
     Ok((tris, inside))
 }
@@ -742,6 +730,17 @@ fn label(
     Ok(state.into_iter().map(|s| s == 1).collect())
 }
 
+/// Largest rounding error of a result triangle's area (sr) that the certificate accepts: a
+/// triangle with nearly antipodal vertices nearly on one great circle (a diagonal across a region
+/// about a hemisphere wide) has an area that rounding decides at will; another candidate avoids
+/// that diagonal.
+const MAX_AREA_ERROR: f64 = 1e-11;
+
+/// Whether the triangle's area is computed to within [`MAX_AREA_ERROR`].
+fn well_conditioned(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    signed_solid_angle_with_error(a, b, c).1 <= MAX_AREA_ERROR
+}
+
 /// Whether `tris` tiles exactly the region of solid angle `area` bounded by the directed
 /// `edges` (see [`SphericalPolygon::triangulate`]): every triangle positively oriented (exact)
 /// and at least [`HEMISPHERE_MARGIN`] short of a hemisphere,
@@ -762,7 +761,11 @@ fn certify(verts: &[DVec3], tris: &[[u32; 3]], edges: &[[u32; 2]], area: f64) ->
         let w = if den >= 0.5 {
             2.0 * crate::math::atan2(a.dot((b - a).cross(c - a)), den)
         } else {
-            signed_solid_angle(a, b, c)
+            let (w, err) = signed_solid_angle_with_error(a, b, c);
+            if !(err <= MAX_AREA_ERROR) {
+                return false;
+            }
+            w
         };
         // Triangles within HEMISPHERE_MARGIN of a hemisphere (three vertices nearly on a great
         // circle) are valid but beyond what sampling resolves; another method splits them.
