@@ -3,6 +3,12 @@
 //! face-by-face path of occluders that interpenetrate a light, and issue 15's quad-light scene
 //! (a shaded point against the bare integrals it needs). Fixed inputs; results in BENCHMARKS.md
 //! (sections `shade` and `shade: cost of a point`).
+//!
+//! Besides criterion (`cargo bench -p arealight-benches --bench shade`), the binary has a plain
+//! mode for instruction counts: `SHADE_POINT_CASE=<case> [SHADE_POINT_REPS=n]` shades issue 15's
+//! eight points `n` times (default 1) with no criterion (cases: see `count_case`), so that
+//! `valgrind --tool=callgrind` counts exactly that; run it with `n = 0` too and divide the
+//! difference by `8 n` for the instructions per shading point (scene construction cancels).
 
 use arealight::glam::DVec3;
 use arealight::internals::{DemoConfig, demo_scene};
@@ -12,7 +18,7 @@ use arealight::shade::{
 };
 use arealight::solid::ShadingFrame;
 use arealight::sphere::SphericalPolygon;
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, criterion_group};
 use std::hint::black_box;
 
 fn occluders(c: &mut Criterion) {
@@ -240,6 +246,62 @@ fn quad_light_points(c: &mut Criterion) {
     group.finish();
 }
 
+/// The plain mode for instruction counts (see the module documentation): `case` is
+/// `integrals-diffuse`, `integrals-glossy`, or `shade-K-M` / `shade_in-K-M` with `K` in 0, 1, 3
+/// occluders and `M` in `diffuse`, `glossy`; the eight points of issue 15 are shaded `reps`
+/// times. Returns the sum of the values, which the caller prints so that nothing is optimized
+/// out.
+fn count_case(case: &str, reps: usize) -> f64 {
+    let points = issue15_points();
+    let diffuse = Material::diffuse(DVec3::splat(0.8)).unwrap();
+    let glossy = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    let parts: Vec<&str> = case.split('-').collect();
+    let mut sum = 0.0;
+    match parts.as_slice() {
+        ["integrals", lobe] => {
+            let scene = issue15_scene(0);
+            let m = scene.lights()[0].shape().mesh();
+            let quads: Vec<(SphericalPolygon, f64)> = points
+                .iter()
+                .map(|&(x, v)| {
+                    let f = ShadingFrame::new(x, DVec3::Z, v).unwrap();
+                    let c = [0, 1, 2, 3].map(|k| f.to_local(m.vertices()[k]));
+                    let ring =
+                        SphericalPolygon::new(vec![c.iter().rev().copied().collect()]).unwrap();
+                    (ring, f.view().z)
+                })
+                .collect();
+            let glossy_lobe = *lobe == "glossy";
+            for _ in 0..reps {
+                for (q, cos_v) in &quads {
+                    sum += clamped_cosine_integral_clip_free(black_box(q));
+                    if glossy_lobe {
+                        let l = lookup(black_box(*cos_v), glossy.alpha()).unwrap();
+                        sum += l.norm * ltc_integral(q, l.m_inv).unwrap();
+                    }
+                }
+            }
+        }
+        [entry, k, lobe] => {
+            let scene = issue15_scene(k.parse().expect("occluder count"));
+            let m = if *lobe == "glossy" { &glossy } else { &diffuse };
+            let mut ctx = ShadeContext::new();
+            for _ in 0..reps {
+                for &(x, v) in &points {
+                    let rgb = if *entry == "shade_in" {
+                        scene.shade_in(&mut ctx, black_box(x), DVec3::Z, v, m)
+                    } else {
+                        scene.shade(black_box(x), DVec3::Z, v, m)
+                    };
+                    sum += rgb.unwrap().x;
+                }
+            }
+        }
+        _ => panic!("unknown SHADE_POINT_CASE {case}"),
+    }
+    sum
+}
+
 criterion_group!(
     benches,
     quad_light_points,
@@ -247,4 +309,16 @@ criterion_group!(
     silhouette_vs_per_triangle,
     interpenetrating
 );
-criterion_main!(benches);
+
+fn main() {
+    if let Ok(case) = std::env::var("SHADE_POINT_CASE") {
+        let reps: usize = std::env::var("SHADE_POINT_REPS")
+            .ok()
+            .and_then(|r| r.parse().ok())
+            .unwrap_or(1);
+        println!("{case} x {reps}: {}", count_case(&case, reps));
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -170,10 +170,11 @@ impl ShadeContext {
 /// The diffuse and LTC integrals of the fast path's pieces, as [`integrals`] of the same region
 /// (up to rounding); `None` only for an LTC map the ring integral declines (never one of the
 /// tables').
-fn piece_integrals(pieces: &Pieces, spec: SpecularSetup) -> Option<(f64, f64)> {
+#[inline(always)]
+fn piece_integrals(pieces: &Pieces, spec: &SpecularSetup) -> Option<(f64, f64)> {
     let diffuse = upper_rings_integral(pieces.rings());
     let specular = match spec {
-        Some((m_inv, _)) => ltc_rings_integral(pieces.rings(), m_inv)?,
+        Some((m_inv, _)) => ltc_rings_integral(pieces.rings(), *m_inv)?,
         None => 0.0,
     };
     Some((diffuse, specular))
@@ -200,11 +201,12 @@ pub(super) fn integrals(
 /// ([`Visibility::visible_pieces`]) where it has one that applies, else from its spherical
 /// polygons ([`Visibility::visible_region`], [`Visibility::unoccluded_region`]). Counted in
 /// `ctx`.
+#[inline(always)]
 pub(super) fn region_integrals<V: Visibility + ?Sized>(
     vis: &V,
     i: usize,
     frame: &ShadingFrame,
-    spec: SpecularSetup,
+    spec: &SpecularSetup,
     blocked: bool,
     ctx: &mut ShadeContext,
 ) -> Result<(f64, f64), GeomError> {
@@ -221,7 +223,7 @@ pub(super) fn region_integrals<V: Visibility + ?Sized>(
     } else {
         vis.unoccluded_region(i, frame)?
     };
-    integrals(&region, spec)
+    integrals(&region, *spec)
 }
 
 impl Scene {
@@ -292,7 +294,7 @@ impl Scene {
         let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
         for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, spec, ctx)?;
+            total += self.shade_light_in(i, &frame, material, &spec, ctx)?;
         }
         Ok(total)
     }
@@ -346,7 +348,7 @@ impl Scene {
         let mut ctx = ShadeContext::new();
         let mut total = DVec3::ZERO;
         for (i, light) in self.lights().iter().enumerate() {
-            let (diffuse, specular) = region_integrals(vis, i, &frame, spec, true, &mut ctx)?;
+            let (diffuse, specular) = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
             let mut out = material.albedo() * diffuse;
             if let Some((_, scale)) = spec {
                 out += scale * specular;
@@ -372,7 +374,7 @@ impl Scene {
         self.light(light)?;
         let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        self.shade_light_in(light, &frame, material, spec, &mut ShadeContext::new())
+        self.shade_light_in(light, &frame, material, &spec, &mut ShadeContext::new())
     }
 
     /// Every light's share of [`Scene::shade`] at `point` (same arguments), split into the
@@ -419,8 +421,8 @@ impl Scene {
         let mut out = Vec::with_capacity(self.lights().len());
         for (i, light) in self.lights().iter().enumerate() {
             let vis = self.light_visibility(i, &frame);
-            let unshadowed = region_integrals(vis, i, &frame, spec, false, &mut ctx)?;
-            let shadowed = region_integrals(vis, i, &frame, spec, true, &mut ctx)?;
+            let unshadowed = region_integrals(vis, i, &frame, &spec, false, &mut ctx)?;
+            let shadowed = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
             // The two regions may come from different paths (the fast path declines only where a
             // blocker needs the spherical one), which agree to rounding: the visible part of a
             // light never gives more than the whole.
@@ -447,7 +449,7 @@ impl Scene {
         i: usize,
         frame: &ShadingFrame,
         material: &Material,
-        spec: SpecularSetup,
+        spec: &SpecularSetup,
         ctx: &mut ShadeContext,
     ) -> Result<DVec3, GeomError> {
         let light = &self.lights()[i];
@@ -455,7 +457,7 @@ impl Scene {
         let (diffuse, specular) = region_integrals(vis, i, frame, spec, true, ctx)?;
         let mut out = material.albedo() * diffuse;
         if let Some((_, scale)) = spec {
-            out += scale * specular;
+            out += *scale * specular;
         }
         Ok(out * light.radiance())
     }

@@ -193,7 +193,7 @@ impl RatioEstimator {
             let pieces = vis.unoccluded_region(li, frame)?;
             // The analytic factor, as `Scene::shade_per_light` forms it (from the same path,
             // so that the two agree bit for bit).
-            let (d, s) = region_integrals(vis, li, frame, spec, false, &mut ctx)?;
+            let (d, s) = region_integrals(vis, li, frame, &spec, false, &mut ctx)?;
             let rgb = light.radiance();
             let mut unshadowed = material.albedo() * d * rgb;
             if let Some((_, scale)) = spec {

@@ -794,7 +794,10 @@ fn subtract_cut(
 /// when the horizon cuts it.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct Outline {
-    pub(super) loops: Vec<Vec<u32>>,
+    /// The loops' vertex positions, each loop reversed: counter-clockwise about the normal, so
+    /// clockwise seen from the front, which is counter-clockwise on the sphere of directions
+    /// seen from outside (the region on the left of each edge).
+    pub(super) rings: Vec<Vec<DVec3>>,
     pub(super) convex: bool,
 }
 
@@ -824,7 +827,11 @@ impl Outline {
                     (b - a).cross(c - b).dot(n) >= 0.0
                 })
         };
-        Some(Outline { loops, convex })
+        let rings = loops
+            .iter()
+            .map(|lp| lp.iter().rev().map(|&i| v[i as usize]).collect())
+            .collect();
+        Some(Outline { rings, convex })
     }
 }
 

@@ -956,18 +956,19 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                     1.0 / crate::math::sqrt(d2)
                 };
                 let mut cut = false;
-                let verts = m.vertices();
-                for lp in &outline.loops {
-                    // Counter-clockwise seen from the point is clockwise on the sphere seen from
-                    // outside: reversed, so that the region is on the left. Written straight
-                    // into the region; moved out to be clipped where the horizon cuts it.
+                for ring in &outline.rings {
+                    // Written straight into the region; moved out to be clipped where the
+                    // horizon cuts it.
                     let chain = &mut out.bufs[out.cur];
                     let start = chain.pts.len();
                     let mut above = true;
-                    for &i in lp.iter().rev() {
-                        let v = frame.to_local(verts[i as usize]) * scale;
+                    for &p in ring {
+                        let v = frame.to_local(p);
                         above &= v.z > 0.0;
                         chain.pts.push(v);
+                    }
+                    if scale != 1.0 {
+                        chain.pts[start..].iter_mut().for_each(|v| *v *= scale);
                     }
                     if above {
                         chain.close(start);
