@@ -69,9 +69,14 @@ use rayon::prelude::*;
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::time::Instant;
+use trace::{Camera, ray_triangle};
 
 #[path = "common/progress.rs"]
 mod progress;
+// Shared with the scene-file examples; `nearest` is theirs.
+#[allow(dead_code)]
+#[path = "common/trace.rs"]
+mod trace;
 use progress::Progress;
 
 /// Where the examples write their outputs.
@@ -169,58 +174,6 @@ enum Hit {
     Surface(DVec3, DVec3, DVec3, Material),
 }
 
-struct Camera {
-    eye: DVec3,
-    fwd: DVec3,
-    right: DVec3,
-    up: DVec3,
-    tan_half: f64,
-}
-
-impl Camera {
-    fn new(eye: DVec3, target: DVec3, fov_deg: f64) -> Self {
-        let fwd = (target - eye).normalize();
-        let right = fwd.cross(DVec3::Z).normalize();
-        let up = right.cross(fwd);
-        Camera {
-            eye,
-            fwd,
-            right,
-            up,
-            tan_half: (fov_deg.to_radians() / 2.0).tan(),
-        }
-    }
-
-    fn ray(&self, px: f64, py: f64, w: usize, h: usize) -> DVec3 {
-        let aspect = w as f64 / h as f64;
-        let sx = (2.0 * px / w as f64 - 1.0) * self.tan_half * aspect;
-        let sy = (1.0 - 2.0 * py / h as f64) * self.tan_half;
-        (self.fwd + sx * self.right + sy * self.up).normalize()
-    }
-}
-
-fn ray_triangle(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
-    let e1 = b - a;
-    let e2 = c - a;
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-300 {
-        return None;
-    }
-    let s = o - a;
-    let u = s.dot(p) / det;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(e1);
-    let v = d.dot(q) / det;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(q) / det;
-    (t > 1e-9).then_some(t)
-}
-
 /// Nearest hit of the camera ray among lights, occluders and the ground.
 fn trace(demo: &Demo, o: DVec3, d: DVec3) -> Hit {
     let mut best = f64::INFINITY;
@@ -238,7 +191,7 @@ fn trace(demo: &Demo, o: DVec3, d: DVec3) -> Hit {
     for light in scene.lights() {
         let mesh = light.shape().mesh();
         for i in 0..mesh.triangle_count() {
-            if let Some(t) = ray_triangle(o, d, mesh.triangle(i))
+            if let Some(t) = ray_triangle(o, d, mesh.triangle(i)).map(|h| h.0)
                 && t < best
             {
                 best = t;
@@ -250,7 +203,7 @@ fn trace(demo: &Demo, o: DVec3, d: DVec3) -> Hit {
     for (k, occ) in scene.occluders().iter().enumerate() {
         let mesh = occ.mesh();
         for i in 0..mesh.triangle_count() {
-            if let Some(t) = ray_triangle(o, d, mesh.triangle(i))
+            if let Some(t) = ray_triangle(o, d, mesh.triangle(i)).map(|h| h.0)
                 && t < best
             {
                 best = t;
@@ -414,7 +367,12 @@ fn main() {
 fn run(args: &Args) -> Result<(), String> {
     let (w, h) = (args.width, args.height);
     let demo = demo_scene(args.cfg).map_err(|e| e.to_string())?;
-    let cam = Camera::new(DVec3::new(0.3, -4.6, 4.8), DVec3::new(0.0, 0.3, 0.6), 52.0);
+    let cam = Camera::new(
+        DVec3::new(0.3, -4.6, 4.8),
+        DVec3::new(0.0, 0.3, 0.6),
+        DVec3::Z,
+        52.0,
+    );
     std::fs::create_dir_all(&args.out).map_err(|e| e.to_string())?;
 
     // Primary visibility is shared by every method and not timed.

@@ -135,6 +135,15 @@ pub enum GeomError {
     /// wrong value; the string says where. Not a fault of the input: a renderer may fall back
     /// (for example to the Monte Carlo reference, or a slightly moved shading point).
     Undecidable(&'static str),
+    /// A segment of a curved boundary loop (a Bezier-bounded shape) is invalid; `why` says how.
+    InvalidCurve {
+        /// Index of the loop in the input.
+        ring: usize,
+        /// Index of the segment within the loop.
+        segment: usize,
+        /// What is wrong with it.
+        why: &'static str,
+    },
     /// (shade) A mesh triangle refers to a vertex index past the end of the vertex list.
     InvalidIndex {
         /// Index of the triangle.
@@ -271,6 +280,9 @@ impl fmt::Display for GeomError {
                 "valid input, but not decidable within rounding here ({where_}); \
                  fall back to an approximate method for this query"
             ),
+            GeomError::InvalidCurve { ring, segment, why } => {
+                write!(f, "segment {segment} of loop {ring}: {why}")
+            }
             GeomError::InvalidIndex { triangle, index } => write!(
                 f,
                 "triangle {triangle} refers to vertex {index}, past the end of the vertex list"

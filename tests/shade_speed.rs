@@ -22,7 +22,7 @@
 //!
 //! `SHADE_SPEED_SCENES=N` runs `N` scenes instead of the default 120 (about 24 000 pairs).
 
-use arealight::glam::DVec3;
+use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::{clamped_cosine_integral, lookup, ltc_integral};
 use arealight::shade::{
     Body, ConvexPolyhedron, Light, Material, Scene, ShadeContext, ShadingFrame, TriangleMesh,
@@ -631,7 +631,9 @@ fn spherical_facing(
 /// - a two-sided quad light is shaded from both sides (the turned-around backend from behind),
 ///   with occluders on both sides, on the fast path;
 /// - a mesh occluder large enough for a hierarchy is left to the one-pass union (the fast path
-///   declines wherever it is among the blockers, as for touching blockers).
+///   declines wherever it is among the blockers, as for touching blockers);
+/// - a light bounded by Bezier curves blocks another light by its triangulated flattening, on
+///   the fast path (the light itself is flattened per point on the spherical path).
 #[test]
 fn main_rules_hold_on_the_fast_path() {
     let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap();
@@ -651,6 +653,24 @@ fn main_rules_hold_on_the_fast_path() {
             .clone(),
     );
     assert!(ball.mesh().triangle_count() >= arealight::visibility::BVH_MIN_TRIANGLES);
+    // A Bezier-bounded light facing down under the quad: a blocker of the quad by its
+    // triangulated flattening, with too few triangles for a hierarchy.
+    let blob = {
+        use support::bezier::Seg2;
+        let p = DVec2::new;
+        let outline = vec![
+            Seg2::Line(p(-0.2, -0.15), p(0.2, -0.15)),
+            Seg2::Cubic([p(0.2, -0.15), p(0.3, -0.05), p(0.3, 0.05), p(0.2, 0.15)]),
+            Seg2::Line(p(0.2, 0.15), p(-0.2, 0.15)),
+            Seg2::Line(p(-0.2, 0.15), p(-0.2, -0.15)),
+        ];
+        support::bezier::shape(
+            &support::bezier::Plane::new(DVec3::new(-0.15, 0.1, 1.4), -DVec3::Z),
+            &[outline],
+        )
+    };
+    assert!(blob.mesh().triangle_count() < arealight::visibility::BVH_MIN_TRIANGLES);
+    let blob_light = Light::new(blob, DVec3::splat(2.0)).unwrap();
     struct Case {
         name: &'static str,
         lights: Vec<Light>,
@@ -693,6 +713,12 @@ fn main_rules_hold_on_the_fast_path() {
             forbidden: vec![0],
         },
         Case {
+            name: "Bezier light under the quad",
+            lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap(), blob_light],
+            occluders: vec![cube(DVec3::new(0.3, -0.2, 1.0), DVec3::splat(0.1))],
+            forbidden: vec![],
+        },
+        Case {
             name: "two-sided quad",
             lights: vec![Light::two_sided(quad.clone(), DVec3::ONE).unwrap()],
             occluders: vec![
@@ -709,7 +735,7 @@ fn main_rules_hold_on_the_fast_path() {
         let scene = Scene::new(case.lights, case.occluders).unwrap();
         let two_sided = scene.lights()[0].is_two_sided();
         let mut ctx = ShadeContext::new();
-        let (mut checked, mut forbidden_seen, mut behind) = (0, 0, 0);
+        let (mut checked, mut forbidden_seen, mut behind, mut fast_seen) = (0, 0, 0, 0);
         for k in 0..300 {
             // Ground points and, for the two-sided light, points above it looking down; points
             // on the occluders' surfaces.
@@ -742,7 +768,13 @@ fn main_rules_hold_on_the_fast_path() {
                     failures.push(format!("{}: {x} took the fast path", case.name));
                 }
             }
-            let got = scene.shade_in(&mut ctx, x, n, v, &m);
+            // Light 0's share (the only light, except beside the Bezier light).
+            let got = if scene.lights().len() == 1 {
+                scene.shade_in(&mut ctx, x, n, v, &m)
+            } else {
+                fast_seen += usize::from(took && !pieces.is_empty());
+                scene.shade_light(0, x, n, v, &m)
+            };
             let Some((want, whole)) = spherical_facing(&scene, 0, &f, &m) else {
                 continue;
             };
@@ -761,6 +793,14 @@ fn main_rules_hold_on_the_fast_path() {
             assert!(
                 forbidden_seen >= 30,
                 "{}: the blocker under test was listed for {forbidden_seen} points",
+                case.name
+            );
+        }
+        if scene.lights().len() > 1 {
+            // The Bezier light was a blocker the fast path subtracted, not declined.
+            assert!(
+                fast_seen >= 100,
+                "{}: {fast_seen} points on the fast path",
                 case.name
             );
         }

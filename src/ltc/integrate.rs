@@ -9,18 +9,30 @@ use crate::sphere::{HORIZON_TOLERANCE, SphericalPolygon};
 /// A direction of any positive length with its squared length, computed once per vertex because
 /// the horizon test and the rational edge term both need it.
 #[derive(Clone, Copy)]
-struct Ray {
+pub(super) struct Ray {
     v: DVec3,
     len2: f64,
 }
 
 impl Ray {
     #[inline(always)]
-    fn new(v: DVec3) -> Self {
+    pub(super) fn new(v: DVec3) -> Self {
         Self {
             v,
             len2: v.length_squared(),
         }
+    }
+
+    /// The dot product of the two directions' vectors.
+    #[inline(always)]
+    pub(super) fn dot(self, other: Ray) -> f64 {
+        self.v.dot(other.v)
+    }
+
+    /// The squared length.
+    #[inline(always)]
+    pub(super) fn len2(self) -> f64 {
+        self.len2
     }
 }
 
@@ -33,7 +45,7 @@ impl Ray {
 /// state go through memory, and the reloads of separately stored fields stall store-to-load
 /// forwarding (see BENCHMARKS.md, "ltc shading").
 #[inline(always)]
-fn edge_term(a: Ray, b: Ray) -> f64 {
+pub(super) fn edge_term(a: Ray, b: Ray) -> f64 {
     // Invariant under positive scaling of `a` and `b`, so the endpoints need not be unit vectors.
     let (a, b) = (a.v, b.v);
     let c = a.cross(b);

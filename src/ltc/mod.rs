@@ -10,6 +10,9 @@
 //!   ground truth the tables approximate.
 //! - [`Ltc`]: the linearly transformed cosine distribution (\[HDHN16\] §3): density and sampling.
 //! - [`LtcTable`] / [`lookup`]: the fitted GGX tables with bilinear lookup (\[HDHN16\] §4).
+//! - [`curved_clamped_cosine_integral`], [`curved_ltc_integral`], [`ggx_curved_integral`]: the
+//!   same integrals over planar regions bounded by cubic Bezier curves ([`CurveSegment`]), with
+//!   per-point adaptive subdivision and algebraic horizon clipping (seed 004).
 //! - `fit` (feature `fit`): the fitter that generates the tables.
 //!
 //! # Examples
@@ -34,6 +37,7 @@
 //! - \[HDHN16\] E. Heitz, J. Dupuy, S. Hill, D. Neubelt. *Real-time polygonal-light shading with
 //!   linearly transformed cosines.* ACM TOG 35(4), 2016.
 
+mod curved;
 mod distribution;
 #[cfg(feature = "fit")]
 pub mod fit;
@@ -46,6 +50,11 @@ mod table;
 #[allow(clippy::large_const_arrays)]
 mod table_data;
 
+pub use curved::{
+    CURVE_PLANE_TOLERANCE, CurveSegment, CurvedIntegral, DIFFUSE_EPS, INITIAL_INTERVALS, MAX_DEPTH,
+    MAX_UNIFORM, Subdivision, curved_clamped_cosine_integral, curved_ltc_integral,
+    ggx_curved_integral, specular_eps,
+};
 pub use distribution::Ltc;
 pub use ggx::{
     GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight,

@@ -10,6 +10,9 @@
 //! - [`Scene::shade_per_light`]: every light's share, split into diffuse and specular lobes,
 //!   with its unshadowed value ([`LightShading`]), for denoising and ratio estimators.
 //! - [`Material`]: Lambert + GGX with Schlick's Fresnel.
+//! - Lights bounded by Bezier curves ([`BezierShape`], seed 004): in a scene, each point's
+//!   flattening goes through the same visibility as any light, so occluders cast shadows from
+//!   them; [`Light::shade_curved`] shades one unshadowed by the curved integrals directly.
 //! - [`MonteCarlo`]: an estimator of the same radiance (solid-angle sampling of the lights'
 //!   triangulated silhouettes or of their faces, [`LightSampling`]; exact ray-triangle
 //!   visibility), with its standard error, for tests and comparisons.
@@ -65,6 +68,8 @@
 //!   stochastic shadows.* I3D 2018.
 
 mod batch;
+mod curved;
+mod curved_reference;
 pub(crate) mod demo;
 mod material;
 mod query;
@@ -74,11 +79,14 @@ mod scene;
 mod two_sided;
 mod validate;
 
-pub use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
+pub use crate::solid::{
+    BezierSegment, BezierShape, Body, ConvexPolyhedron, ShadingFrame, TriangleMesh,
+};
 pub use crate::visibility::{Blocker, Method};
 pub use batch::BatchResult;
 #[cfg(feature = "rayon")]
 pub use batch::PAR_MIN_RUN;
+pub use curved::{CurvedShading, DEFAULT_DIFFUSE_SUBDIVISION};
 pub use material::Material;
 pub use query::{LightShading, ShadeContext};
 pub use ratio::{LightRatio, RatioEstimator};

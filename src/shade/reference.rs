@@ -18,6 +18,10 @@
 //! hit strictly before the point the ray meets on the light blocks the sample. The estimator
 //! returns its mean and standard error, so tests can state a confidence bound.
 //!
+//! Lights bounded by Bezier curves are sampled uniformly by area over the exact curved region
+//! (rejection from its bounding box; `curved_reference.rs`), whatever the [`LightSampling`], so
+//! that the analytic path's per-point flattening is checked too; visibility as above.
+//!
 //! Only the outer (front) side of a light emits: a shading point inside a closed light sees none
 //! of its triangles from the front and gets nothing here, where the analytic silhouette path
 //! counts the whole sphere (the one configuration where the two differ; no scene meant for
@@ -145,7 +149,7 @@ pub struct MonteCarlo {
 
 /// Relative distance along a ray below which a hit counts as the ray's own start or end point:
 /// rays start on surfaces and end on the light, and both ends must not block themselves.
-const RAY_EPS: f64 = 1e-9;
+pub(super) const RAY_EPS: f64 = 1e-9;
 
 /// How far outside a light triangle (in barycentric coordinates) a ray may pass and still count
 /// as meeting it, when the nearest point of a non-convex mesh light along a sampled direction is
@@ -524,7 +528,7 @@ impl<'a> PointSampler<'a> {
 
     /// Whether another object than light `light` has a triangle on the ray from the shading
     /// point along `w` strictly between its start and `t_light` (relative margins [`RAY_EPS`]).
-    fn blocked(&self, light: usize, w: DVec3, t_light: f64) -> bool {
+    pub(super) fn blocked(&self, light: usize, w: DVec3, t_light: f64) -> bool {
         let x = self.frame.origin();
         let (t_min, t_max) = (t_light * RAY_EPS, t_light * (1.0 - RAY_EPS));
         let own = self.scene.occluders().len() + light;
@@ -584,7 +588,7 @@ fn entry_distance(x: DVec3, w: DVec3, body: &Body, two_sided: bool) -> Option<f6
         Body::Convex(_) => (0..mesh.triangle_count())
             .filter_map(plane_t)
             .fold(f64::NEG_INFINITY, f64::max),
-        Body::Mesh(_) => plane_t(0)?,
+        Body::Mesh(_) | Body::Bezier(_) => plane_t(0)?,
     };
     (t > 0.0 && t.is_finite()).then_some(t)
 }
@@ -630,6 +634,13 @@ impl MonteCarlo {
         let mut var = DVec3::ZERO;
         let mut domain = LightDomain::default();
         for (li, light) in scene.lights().iter().enumerate() {
+            if let Body::Bezier(shape) = light.shape() {
+                let two = light.is_two_sided();
+                let (m, s2) = super::curved_reference::estimate(&ps, li, shape, two, n, &mut rng);
+                mean += m * light.radiance();
+                var += s2 * light.radiance() * light.radiance();
+                continue;
+            }
             ps.domain(li, self.sampling, &mut domain);
             if domain.is_empty() {
                 continue;

@@ -58,8 +58,9 @@ impl Light {
     }
 
     /// A planar light that emits `radiance` from both of its sides: from behind its plane it
-    /// gives what the same light turned around ([`TriangleMesh::flipped`]) would give, in
-    /// front what it gives as built. Its geometry blocks other lights as any light's does.
+    /// gives what the same light turned around ([`TriangleMesh::flipped`], or
+    /// [`BezierShape::flipped`] for a light bounded by curves) would give, in front what it
+    /// gives as built. Its geometry blocks other lights as any light's does.
     ///
     /// Costs nothing per shading point over a one-sided light (one facing test picks the side);
     /// a scene with two-sided lights keeps a second copy of its visibility data for the back
@@ -67,19 +68,22 @@ impl Light {
     ///
     /// # Errors
     ///
-    /// As [`Light::new`]; [`GeomError::Degenerate`] for a body that is not a planar
-    /// [`TriangleMesh`] (a closed light has no second side to show, and a curved open mesh
-    /// would need a facing decision per triangle).
+    /// As [`Light::new`]; [`GeomError::Degenerate`] for a body that is neither a planar
+    /// [`TriangleMesh`] nor a [`BezierShape`] (a closed light has no second side to show, and a
+    /// curved open mesh would need a facing decision per triangle).
     ///
     /// [`TriangleMesh`]: crate::solid::TriangleMesh
     /// [`TriangleMesh::flipped`]: crate::solid::TriangleMesh::flipped
+    /// [`BezierShape`]: crate::solid::BezierShape
+    /// [`BezierShape::flipped`]: crate::solid::BezierShape::flipped
     pub fn two_sided(body: impl Into<Body>, radiance: DVec3) -> Result<Self, GeomError> {
         let mut light = Light::new(body, radiance)?;
         match &light.body {
             Body::Mesh(m) if m.is_planar() => {}
+            Body::Bezier(_) => {}
             _ => {
                 return Err(GeomError::Degenerate(
-                    "a two-sided light must be a planar TriangleMesh",
+                    "a two-sided light must be a planar TriangleMesh or a BezierShape",
                 ));
             }
         }

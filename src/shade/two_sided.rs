@@ -2,13 +2,14 @@
 //!
 //! A planar light's triangles share one plane and one normal, so a shading point sees all of
 //! them from the front, all from behind, or all edge-on. From behind, a two-sided light shows
-//! what the same light turned around ([`TriangleMesh::flipped`]) shows from the front, with every
-//! blocker unchanged: blockers act on either side alike, and a light's geometry blocks the other
-//! lights with both of its sides. So the scene keeps a second visibility backend in which the
+//! what the same light turned around ([`TriangleMesh::flipped`], [`BezierShape::flipped`])
+//! shows from the front, with every blocker unchanged: blockers act on either side alike, and
+//! a light's geometry blocks the other lights with both of its sides. So the scene keeps a second visibility backend in which the
 //! two-sided lights are turned around, and each query of such a light picks the backend by one
 //! call of the facing predicate ([`face_side`]), whose answer for the turned mesh is exactly the
 //! opposite one. Everything below the shading layer keeps seeing one-sided lights.
 
+use alloc::boxed::Box;
 use alloc::vec::Vec;
 
 use super::scene::Light;
@@ -29,6 +30,7 @@ pub(super) fn back_visibility(
         .iter()
         .map(|l| match (l.is_two_sided(), l.shape()) {
             (true, Body::Mesh(m)) => l.with_body(Body::Mesh(m.flipped())),
+            (true, Body::Bezier(b)) => l.with_body(Body::Bezier(Box::new(b.flipped()))),
             _ => l.clone(),
         })
         .collect();

@@ -1,5 +1,6 @@
 //! The geometry of one object of a scene, whichever representation it has.
 
+use super::bezier::BezierShape;
 use super::convex::ConvexPolyhedron;
 use super::mesh::{BoundingSphere, TriangleMesh};
 
@@ -14,6 +15,12 @@ pub enum Body {
     /// Any triangle mesh: one spherical triangle per triangle (seed 000 section 4.4). As a light,
     /// only front faces emit; as an occluder, every triangle blocks.
     Mesh(TriangleMesh),
+    /// A planar shape bounded by cubic Bezier curves (seed 004): as a light, its region is
+    /// flattened per shading point ([`BezierShape::region`]); as a blocker of other lights, and
+    /// for culling and separating planes, it is its triangulated flattening
+    /// ([`BezierShape::mesh`]). Boxed: the shape keeps its flattenings and mesh, far larger than
+    /// the other variants.
+    Bezier(alloc::boxed::Box<BezierShape>),
 }
 
 impl Body {
@@ -23,19 +30,30 @@ impl Body {
         match self {
             Body::Convex(p) => p.mesh(),
             Body::Mesh(m) => m,
+            Body::Bezier(b) => b.mesh(),
         }
     }
 
     /// A sphere holding the body.
     #[must_use]
     pub fn bounding_sphere(&self) -> BoundingSphere {
-        self.mesh().bounding_sphere()
+        match self {
+            // The control points' sphere: it holds the curves, not only their flattening.
+            Body::Bezier(b) => b.bounding_sphere(),
+            _ => self.mesh().bounding_sphere(),
+        }
     }
 }
 
 impl From<ConvexPolyhedron> for Body {
     fn from(p: ConvexPolyhedron) -> Self {
         Body::Convex(p)
+    }
+}
+
+impl From<BezierShape> for Body {
+    fn from(b: BezierShape) -> Self {
+        Body::Bezier(alloc::boxed::Box::new(b))
     }
 }
 

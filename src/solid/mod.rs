@@ -7,7 +7,9 @@
 //!   triangles on either side ([`MeshEdge`]).
 //! - [`ConvexPolyhedron`]: a closed convex mesh, validated or built as a convex hull, and the
 //!   primitives (`cuboid`, `icosphere`, `ellipsoid`, `frustum`; [`TriangleMesh::quad`]).
-//! - [`Body`]: the geometry of one object of a scene, either of the two.
+//! - [`BezierShape`]: a planar shape bounded by cubic Bezier curves and lines (seed 004's
+//!   free-form lights), validated, flattened per shading point.
+//! - [`Body`]: the geometry of one object of a scene.
 //! - [`Bvh`]: a bounding-volume hierarchy over a mesh's triangles, for culling.
 //! - [`ShadingFrame`]: the local frame of a shading point.
 //! - [`face_side`]: the one facing predicate (does a mesh triangle face a point), with its
@@ -21,7 +23,9 @@
 //! - Seed 000: section 3.3 and Alg. 2 (silhouettes of convex objects), section 4.4 (the
 //!   per-triangle method), Fig. 4 (the test scene's primitives).
 //! - Thesis 003: section 4.2 (silhouettes of convex polyhedra oriented by front faces).
+//! - Seed 004: free-form planar lights bounded by cubic Bezier curves.
 
+mod bezier;
 mod body;
 mod bvh;
 mod closed;
@@ -38,6 +42,9 @@ pub use silhouette::{
     DEFAULT_REGION_RADII, SilhouetteBsp, SilhouetteSampler, TriangleSource, nonconvex_silhouette,
 };
 
+pub use bezier::{
+    BEZIER_TOLERANCE, BezierSegment, BezierShape, DEFAULT_FLATTEN_ANGLE, FINEST_FLATNESS,
+};
 pub use body::Body;
 pub use bvh::Bvh;
 pub use closed::ClosedMesh;

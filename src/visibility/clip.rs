@@ -352,7 +352,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ///    its side, minus each triangle of a straddling blocker cut by the face plane to its part
     ///    on `x`'s side (for a convex blocker seen from outside only its front triangles: a ray
     ///    enters it through one of those first), minus, for a non-planar mesh light, its own
-    ///    other triangles cut the same way.
+    ///    other triangles cut the same way. A light bounded by Bezier curves is one face here:
+    ///    its per-point flattening ([`crate::solid::BezierShape::region`]), not its mesh.
     ///
     /// A closed or planar mesh light without straddling blockers keeps the union of its front
     /// faces ([`ClipVisibility::light_region`]): seen from outside a closed surface a ray meets a
@@ -423,8 +424,17 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         let self_blocking = own_blockers && !mesh.is_closed();
         // Step 3: interpenetrating blockers that still act the same on every front face.
         let x = frame.origin();
+        // A light bounded by curves goes face by face as one face, its per-point flattening
+        // (`BezierShape::region`), in the plane of its mesh's first triangle: its mesh is a
+        // fixed flattening, coarser than that one seen from near points.
+        let curved = matches!(body, Body::Bezier(_));
         let faces: SmallVec<[usize; 16]> = if overlapping.is_empty() && !self_blocking {
             SmallVec::new()
+        } else if curved {
+            (face_side(mesh, 0, x) == Side::Front)
+                .then_some(0)
+                .into_iter()
+                .collect()
         } else {
             (0..mesh.triangle_count())
                 .filter(|&t| face_side(mesh, t, x) == Side::Front)
@@ -477,8 +487,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             straddling.iter().map(|_| None).collect();
         let mut out = Vec::new();
         for (fi, &f) in faces.iter().enumerate() {
-            let Some(piece) = triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? else {
-                continue;
+            let (piece, face_bound) = match body {
+                Body::Bezier(b) => (b.region(frame)?, self.light_bounds[light]),
+                _ => match triangle_polygon(mesh, f, frame, TriangleRole::Emitter)? {
+                    Some(p) => (p, triangle_bound(mesh.triangle(f))),
+                    None => continue,
+                },
             };
             let face_part = upper_part(&piece)?;
             let mut piece = subtract_all(face_part.clone(), &whole_regions)?;
@@ -499,13 +513,14 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                     }
                     Reach::Straddles => {
                         let (body, _) = self.blocker(b);
-                        piece = subtract_cut(piece, body, self.bvh(b), true, mesh, f, frame)?;
+                        let cut = (mesh, f, face_bound);
+                        piece = subtract_cut(piece, body, self.bvh(b), true, cut, frame)?;
                     }
                 }
             }
             if own_blockers && !piece.is_empty() {
                 let own = self.bvh(Blocker::Light(light));
-                piece = subtract_cut(piece, body, own, false, mesh, f, frame)?;
+                piece = subtract_cut(piece, body, own, false, (mesh, f, face_bound), frame)?;
             }
             if !piece.is_empty() {
                 // Differences only remove: a piece larger than the face's part it started from
@@ -578,6 +593,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// hemisphere (seed 000 Alg. 1 lines 4-5), as pieces with disjoint interiors:
     ///
     /// - a convex light with [`Method::Silhouette`]: its silhouette, one piece;
+    /// - a Bezier-bounded light ([`crate::solid::BezierShape`]): its flattening within the
+    ///   shape's angular flatness as seen from the point ([`crate::solid::BezierShape::region`]),
+    ///   one piece;
     /// - a convex light with [`Method::PerTriangle`], or a planar mesh light: each front-facing
     ///   triangle, one piece each (seed 000 section 4.4). Their projections cannot overlap, so
     ///   their integrals add up exactly;
@@ -633,6 +651,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         };
         if let (Body::Convex(p), true) = (body, self.silhouettes()) {
             return Ok(one(upper_part(&convex_silhouette(p, frame)?)?));
+        }
+        if let Body::Bezier(b) = body {
+            // A flattening within the shape's angular flatness seen from the point (seed 004
+            // lights), with either method.
+            return Ok(one(upper_part(&b.region(frame)?)?));
         }
         if let (Some(solid), true) = (&self.solids[light], self.silhouettes()) {
             match nonconvex_silhouette(solid, frame) {
@@ -738,22 +761,19 @@ impl<L: AsRef<Body>> Visibility for ClipVisibility<L> {
     }
 }
 
-/// Subtracts from `piece` (part of light face `f` of `light_mesh`) the triangles of `blocker`
-/// cut to their parts strictly on the shading point's side of `f`'s plane (step 4 of
-/// [`ClipVisibility::visible_region`]). `external` is false when the blocker is the light's own
-/// mesh (then `f` itself is skipped).
-#[allow(clippy::too_many_arguments)]
+/// Subtracts from `piece` (part of light face `f` of `light_mesh`, within `face_bound`) the
+/// triangles of `blocker` cut to their parts strictly on the shading point's side of `f`'s
+/// plane (step 4 of [`ClipVisibility::visible_region`]). `external` is false when the blocker
+/// is the light's own mesh (then `f` itself is skipped).
 fn subtract_cut(
     mut piece: SphericalPolygon,
     blocker: &Body,
     bvh: Option<&Bvh>,
     external: bool,
-    light_mesh: &TriangleMesh,
-    f: usize,
+    (light_mesh, f, face_bound): (&TriangleMesh, usize, BoundingSphere),
     frame: &ShadingFrame,
 ) -> Result<SphericalPolygon, GeomError> {
     let (x, up_world) = (frame.origin(), frame.normal());
-    let face_bound = triangle_bound(light_mesh.triangle(f));
     let bm = blocker.mesh();
     // Seen from outside a convex blocker, a ray enters through a front triangle before it can
     // meet a back one, so the back ones add nothing.

@@ -68,7 +68,8 @@
 //! blocker that interpenetrates the light or has a vertex in the plane of one of its triangles,
 //! a mesh blocker with a hierarchy (the one-pass union culls its triangles by shafts, see
 //! `visibility/union.rs`), a point inside a closed light or on its surface (a convex light
-//! without a front face), non-planar mesh lights, a planar light seen
+//! without a front face), non-planar mesh lights, Bezier-bounded lights (flattened per point;
+//! as blockers they are their triangulated flattening, a mesh), a planar light seen
 //! edge-on by some of its triangles and not others, every silhouette that
 //! [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) would not take as one
 //! loop chained by vertex index with well separated vertices (the point inside or on a convex
@@ -887,13 +888,15 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             // Interpenetrating blockers, and blockers with a vertex in the plane of a light
             // triangle (never subtracted whole: the touching part hides nothing), act face by
             // face: the spherical path's business. Meshes large enough for a hierarchy go to
-            // the one-pass union, which culls their triangles by shafts.
+            // the one-pass union, which culls their triangles by shafts. A Bezier-bounded
+            // light blocks others by its triangulated flattening, as on the spherical path.
             let fits = self.separation(light, b).is_some()
                 && !self.touches(light, b)
                 && match self.blocker(b).0 {
                     Body::Convex(p) => convex_planes(p, frame, out) && out.subtract(),
-                    Body::Mesh(m) => {
-                        self.bvh(b).is_none() && self.subtract_triangles(light, m, frame, out)
+                    other => {
+                        self.bvh(b).is_none()
+                            && self.subtract_triangles(light, other.mesh(), frame, out)
                     }
                 };
             if !fits {
@@ -983,6 +986,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 out.simple = out.len() == 1 && (outline.convex || !cut);
                 true
             }
+            // Flattened per point, as its own angular flatness from the point requires: the
+            // spherical path's business.
+            Body::Bezier(_) => false,
         }
     }
 

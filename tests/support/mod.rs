@@ -7,10 +7,13 @@
 //! - [`sphere`]: star-shaped spherical polygons, stratified Monte Carlo solid angles and
 //!   integrals with stated bounds, quadrature over spherical triangles.
 //! - [`ltc`]: quadrature about a pole, histogram checks of samplers.
+//! - [`bezier`]: curved outlines placed in 3D, Green's-theorem and polygonization references for
+//!   their integrals.
 //! - [`shade`]: shading points on meshes and the ground, views above a surface.
 //! - [`visibility`]: an exact ray arbiter between visible regions.
 #![allow(dead_code)]
 
+pub mod bezier;
 pub mod ltc;
 pub mod planar;
 pub mod rng;

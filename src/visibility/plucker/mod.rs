@@ -53,6 +53,16 @@
 //! silhouette path of the clipping backend counts the silhouette instead; see the `shade`
 //! module's limitations).
 //!
+//! # Lights bounded by curves
+//!
+//! A light bounded by Bezier curves ([`BezierShape`](crate::solid::BezierShape)) is seen
+//! through a flattening chosen per shading point, within an angle of its curves
+//! ([`BezierShape::region`](crate::solid::BezierShape::region)); the trees here are built over
+//! a light's fixed faces, and its fixed mesh is within a distance of the curves, not an angle,
+//! so from near points it would be a coarser light than the clipping backend's. Queries of
+//! such a light are answered by the clipping backend held here (same result, no tree, not
+//! counted in [`PluckerStats`]). As a blocker of other lights it is its mesh in both backends.
+//!
 //! # Reuse and memory
 //!
 //! [`Visibility::visible_region`] builds a tree per call for the point alone (the point is the
@@ -301,6 +311,16 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
         mut ctx: Option<&mut PluckerContext>,
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
         let (body, faces) = self.light_faces(light)?;
+        if matches!(body, Body::Bezier(_)) {
+            // The faces here would be the shape's fixed mesh, not the flattening within an
+            // angle of the curves that the clipping backend projects per point (see
+            // "Lights bounded by curves" in the module documentation).
+            return if blocked {
+                self.clip.visible_region(light, frame)
+            } else {
+                self.clip.unoccluded_region(light, frame)
+            };
+        }
         let (x, n) = (frame.origin(), frame.normal());
         if !above_horizon(x, n, body.bounding_sphere()) {
             return Ok(Vec::new());
