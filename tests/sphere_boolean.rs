@@ -553,3 +553,126 @@ fn regression_union_with_vertex_copies_ulps_apart() {
     .unwrap();
     check_identities(&a, &b).unwrap();
 }
+
+#[test]
+fn regression_rings_sharing_an_edge_through_vertex_copies_1e12_apart() {
+    // A light face minus the cut side triangles of a box touching its plane (tests/shade_census.rs,
+    // case 208 at CENSUS_CASES=5): the running difference `a` holds two outer rings (1 and 2)
+    // that share an edge whose two vertex copies lie 1e-12 apart, each an intersection point
+    // computed in another projection. Valid on the sphere, but projected the two edges cross,
+    // which the planar validation rejects in every projection and octant; welding them makes
+    // the rings overlap along the edge. The projected rings are read under the positive fill
+    // rule instead.
+    let v = DVec3::new;
+    let a = SphericalPolygon::new(vec![
+        vec![
+            v(
+                -0.33715148465616496,
+                -0.002970467742793994,
+                0.9414457247847763,
+            ),
+            v(
+                -0.33653860527021756,
+                -0.060341687974531315,
+                0.9397343496197003,
+            ),
+            v(
+                -0.3502376764013839,
+                -0.06279794429339862,
+                0.9345533629608759,
+            ),
+            v(-0.4340368808005864, -0.0604000474259736, 0.8988680772926791),
+            v(
+                -0.41613686146560425,
+                -0.2900589964427813,
+                0.8617980570366605,
+            ),
+            v(-0.2776901932547135, -0.1386184140818011, 0.9506172162587874),
+            v(
+                -0.27877890635351554,
+                -0.10728211204887807,
+                0.9543442092906886,
+            ),
+            v(
+                -0.2559629764347708,
+                -0.09850188838684043,
+                0.9616549967004171,
+            ),
+            v(
+                -0.24018802621516536,
+                -0.09891352929963569,
+                0.9656737677830713,
+            ),
+            v(
+                -0.006554012536182908,
+                0.13833259503210815,
+                0.9903641441769578,
+            ),
+            v(-0.4314312935178255, 0.12479884959194724, 0.8934720399173454),
+            v(-0.43418492385837754, 0.0544827530004199, 0.8991746668582195),
+            v(-0.3503668157425352, 0.05664729668821203, 0.934897950689996),
+            v(-0.3366531713953598, 0.05443007506474083, 0.9400542586031368),
+        ],
+        vec![
+            v(
+                -0.27877890635351554,
+                -0.10728211204887807,
+                0.9543442092906886,
+            ),
+            v(
+                -0.2611572429162339,
+                -0.12105280572484718,
+                0.9576758912589026,
+            ),
+            v(
+                -0.24794593197272838,
+                -0.10708642670405115,
+                0.9628371160450416,
+            ),
+            v(
+                -0.24788224023479263,
+                -0.10653917895127205,
+                0.962914221685696,
+            ),
+        ],
+        vec![
+            v(
+                -0.24788224023375427,
+                -0.10653917895124534,
+                0.9629142216859661,
+            ),
+            v(-0.247945931971412, -0.10708642670266276, 0.9628371160455351),
+            v(
+                -0.24741570366269083,
+                -0.10652717121782244,
+                0.9630355296526834,
+            ),
+        ],
+    ])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(
+            -0.10484602205110993,
+            -0.11109515621675774,
+            0.9882637188145845,
+        ),
+        v(
+            -0.2787789063535155,
+            -0.10728211204887808,
+            0.9543442092906887,
+        ),
+        v(
+            -0.10246725140247803,
+            -0.23801291674799122,
+            0.9658417643957706,
+        ),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    // The difference against containment in the operands, by stratified Monte Carlo.
+    let d = a.boolean(&b, BoolOp::Difference).unwrap();
+    let mut rng = Rng::new(208);
+    let mc = mc_solid_angle(&mut rng, 256, 512, |p| a.contains(p) && !b.contains(p));
+    let cells = crossed_cells(boundary_edges(&a).chain(boundary_edges(&b)), 256, 512);
+    assert_mc_agrees(d.solid_angle(), mc, cells, "a - b");
+}
