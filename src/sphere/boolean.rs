@@ -9,7 +9,7 @@ use smallvec::SmallVec;
 
 use super::clip::HORIZON_TOLERANCE;
 use super::gnomonic::{Gnomonic, enclosing_cap};
-use super::order::order_directed_edges;
+use super::order::{order_directed_edges, order_directed_edges_within};
 use super::polygon::{SphericalPolygon, Verts, close_ring, regularized};
 use super::predicates::tangent_frame;
 use crate::GeomError;
@@ -648,8 +648,26 @@ fn split(
         // Every piece boundary lay on a cut and cancelled: the pieces tile the whole sphere.
         return Ok(SphericalPolygon::full());
     }
-    order_directed_edges(&edges)
+    match order_directed_edges(&edges) {
+        Ok(r) if r.validate().is_ok() => Ok(r),
+        // The pieces' rings join at copies of one vertex a few ulps apart (the octants'
+        // projections round differently), which the silhouette tolerance of
+        // `order_directed_edges` (1e-9) joins; but it also merges distinct vertices of a piece
+        // closer than that (a notch left by a sliver occluder, a crossing 1e-11 from a vertex),
+        // collapsing a valid piece into an edge walked twice. Joined only within
+        // [`SPLIT_MATCH`], such features survive.
+        first => match order_directed_edges_within(&edges, SPLIT_MATCH) {
+            Ok(r) if r.validate().is_ok() => Ok(r),
+            _ => first,
+        },
+    }
 }
+
+/// Chord length within which [`split`] joins piece endpoints when the silhouette tolerance
+/// fails: far above the rounding of a unit vector through an octant's projection and back (a
+/// few `1e-16`), far below the weld tolerance of the pieces' operations ([`WELD_TOLERANCE`]),
+/// so that vertices the pieces keep apart stay apart.
+const SPLIT_MATCH: f64 = 1e-13;
 
 /// Removes the parts of edges lying on the three cut circles that two adjacent octants' pieces
 /// both have (with opposite directions), keeping the net boundary.
