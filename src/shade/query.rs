@@ -422,11 +422,11 @@ impl Scene {
         for (i, light) in self.lights().iter().enumerate() {
             let vis = self.light_visibility(i, &frame);
             let unshadowed = region_integrals(vis, i, &frame, &spec, false, &mut ctx)?;
+            // Exactly what `shade` computes for the light, so that the shares add up to it. The
+            // unshadowed region may come from the other path (the fast path declines only where
+            // a blocker needs the spherical one); the two agree to rounding, so the shadowed
+            // value can exceed the unshadowed one by rounding.
             let shadowed = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
-            // The two regions may come from different paths (the fast path declines only where a
-            // blocker needs the spherical one), which agree to rounding: the visible part of a
-            // light never gives more than the whole.
-            let shadowed = (shadowed.0.min(unshadowed.0), shadowed.1.min(unshadowed.1));
             let rgb = light.radiance();
             let lobes = |(d, s): (f64, f64)| {
                 let specular = spec.map_or(DVec3::ZERO, |(_, scale)| scale * s * rgb);
