@@ -546,3 +546,29 @@ fn regression_antipodal_diagonal_of_a_hemisphere_sized_ring() {
     );
     assert!(r.area_error <= 1e-12, "{}", r.area_error);
 }
+
+/// Found by the `sphere_triangulate` fuzz target: a quadrilateral larger than a hemisphere
+/// (7.75 sr) whose triangles summed to 1.47 sr.
+#[test]
+fn regression_fuzz_quadrilateral_larger_than_a_hemisphere() {
+    let v = [
+        [
+            -0.5773502691896258,
+            -0.5773502691896258,
+            -0.5773502691896258,
+        ],
+        [
+            -0.43973837326775983,
+            0.8717620382325765,
+            0.21601183248240832,
+        ],
+        [
+            0.8928696638805241,
+            0.007631364648551489,
+            0.45025051426453777,
+        ],
+        [-0.7071067811865475, -0.7071067811865475, 0.0],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    run("fuzz quadrilateral larger than a hemisphere", &p);
+}
