@@ -1066,8 +1066,11 @@ fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut 
     let normals = mesh.normals();
     let offsets = mesh.offsets();
     out.contour.clear();
+    if normals.len() <= 64 && p.vertices().len() <= INLINE_VERTICES {
+        return small_silhouette_dirs(p, frame, rel, tol, out);
+    }
     if normals.len() <= 64 {
-        // Front faces as bits: the common small polyhedron, without a buffer.
+        // Front faces as bits, without a buffer.
         let mut front = 0u64;
         for (f, (nf, &d)) in normals.iter().zip(offsets).enumerate() {
             front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
@@ -1135,6 +1138,103 @@ fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut 
         prev = cur;
     }
     true
+}
+
+/// [`convex_silhouette_dirs`] for the common small polyhedron (at most 64 faces and
+/// [`INLINE_VERTICES`] vertices), the same decisions in one pass over the edges and one walk,
+/// without a list of contour edges: front faces as bits, each contour edge written straight
+/// into the successor table the chaining walks, and the spacing of consecutive directions
+/// tested during the walk (a vertex at the point has a zero direction, which no spacing test
+/// passes).
+fn small_silhouette_dirs(
+    p: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    rel: DVec3,
+    tol: f64,
+    out: &mut Pieces,
+) -> bool {
+    const NONE: u32 = u32::MAX;
+    let mesh = p.mesh();
+    let mut front = 0u64;
+    for (f, (nf, &d)) in mesh.normals().iter().zip(mesh.offsets()).enumerate() {
+        front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
+    }
+    if front == 0 {
+        return false;
+    }
+    // Contour edges oriented by their front face (the silhouette on their left), chained by
+    // vertex index: every vertex used has one outgoing edge, and the walk from the first edge's
+    // tail uses all of them (as `chain_by_index` decides it).
+    let mut next = [NONE; INLINE_VERTICES];
+    let (mut count, mut start) = (0usize, NONE);
+    for e in p.edges() {
+        let (f0, f1) = ((front >> e.f0) & 1, (front >> e.f1) & 1);
+        if f0 != f1 {
+            let (a, b) = if f0 == 1 { (e.b, e.a) } else { (e.a, e.b) };
+            if next[a as usize] != NONE {
+                return false;
+            }
+            next[a as usize] = b;
+            if count == 0 {
+                start = a;
+            }
+            count += 1;
+        }
+    }
+    if count < 3 {
+        return false;
+    }
+    // Scaled by the inverse distance to the polyhedron's center, as in `convex_silhouette_dirs`.
+    let dist = rel.length();
+    if !(dist > 0.0) {
+        return false;
+    }
+    let inv = 1.0 / dist;
+    let verts = p.vertices();
+    out.dirs.clear();
+    out.dirs.reserve(count);
+    let first = frame.to_local(verts[start as usize]) * inv;
+    out.dirs.push(first);
+    let (mut prev, mut prev_id, mut at) = (first, start, next[start as usize]);
+    for k in 1..count {
+        if at == NONE || at == start {
+            return false;
+        }
+        let cur = frame.to_local(verts[at as usize]) * inv;
+        if !spaced(prev, cur, verts, frame, prev_id, at) {
+            return false;
+        }
+        out.dirs.push(cur);
+        (prev, prev_id) = (cur, at);
+        at = next[at as usize];
+        if k + 1 == count && at != start {
+            return false;
+        }
+    }
+    spaced(prev, first, verts, frame, prev_id, start)
+}
+
+/// Whether consecutive directions `a` and `b` (of vertices `ia` and `ib`) are further apart than
+/// `MATCH_TOLERANCE` and not antipodal within `ANTIPODAL_TOLERANCE`, as unit vectors: clearly so
+/// where the sine of the angle between them exceeds twice the larger tolerance and the angle is
+/// acute (no root, no division); otherwise decided on the unit vectors `convex_silhouette` uses.
+#[inline(always)]
+fn spaced(a: DVec3, b: DVec3, verts: &[DVec3], frame: &ShadingFrame, ia: u32, ib: u32) -> bool {
+    const TOL2: f64 = 4.0 * MATCH_TOLERANCE * MATCH_TOLERANCE;
+    let clear = a.dot(b) > 0.0
+        && a.cross(b).length_squared() > TOL2 * a.length_squared() * b.length_squared();
+    clear || spaced_ids(verts, frame, ia, ib)
+}
+
+/// The spacing test of [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) on
+/// the unit vectors of vertices `ia` and `ib`.
+#[cold]
+fn spaced_ids(verts: &[DVec3], frame: &ShadingFrame, ia: u32, ib: u32) -> bool {
+    let unit = |i: u32| frame.to_local(verts[i as usize]).try_normalize();
+    let (Some(a), Some(b)) = (unit(ia), unit(ib)) else {
+        return false;
+    };
+    (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
 }
 
 /// The spacing test of [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) on
