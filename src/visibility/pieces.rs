@@ -174,7 +174,7 @@ pub struct Pieces {
     rings: [Ring; 2],
     /// The current blocker: its vertices (directions, counter-clockwise) and the normals of
     /// its half-spaces (`planes[j]` through `kv[j]` and `kv[j + 1]`, `n . v >= 0` inside).
-    kv: SmallVec<[DVec3; 24]>,
+    kv: Ring,
     planes: SmallVec<[DVec3; 24]>,
     /// Contour edges of a convex silhouette, and front-face flags of polyhedra with more than
     /// 64 faces.
@@ -918,7 +918,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ) -> bool {
         match body {
             Body::Convex(p) => {
-                if !convex_silhouette_dirs(p, frame, out) {
+                if !convex_silhouette_dirs(p, frame, out, false) {
                     return false;
                 }
                 // A convex ring stays one simple ring when the horizon cuts it.
@@ -1049,16 +1049,20 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
 }
 
 /// The silhouette of the convex polyhedron `p` seen from the frame's point as directions in the
-/// frame (scaled by one positive factor), in `out.dirs` (counter-clockwise on the sphere: the
-/// silhouette on the left),
-/// exactly where [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the
+/// frame (scaled by one positive factor), in `out.kv` if `to_kv` (a blocker's), else in
+/// `out.dirs` (counter-clockwise on the sphere: the silhouette on the left), exactly where [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the
 /// loop of the same vertices without its general ordering: front faces by the facing predicate
 /// (the same distances and tolerance), contour edges oriented by their front face, chained by
 /// vertex index into one loop whose consecutive directions are further apart than
 /// [`MATCH_TOLERANCE`] and not antipodal within [`ANTIPODAL_TOLERANCE`]. `false` elsewhere: no
 /// face in front (the point inside or on the surface, where that function returns a hemisphere,
 /// a lune or the full sphere) or a loop that needs the general ordering.
-fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -> bool {
+fn convex_silhouette_dirs(
+    p: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    out: &mut Pieces,
+    to_kv: bool,
+) -> bool {
     let mesh = p.mesh();
     let b = mesh.bounding_sphere();
     let rel = frame.origin() - b.center;
@@ -1067,7 +1071,8 @@ fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut 
     let offsets = mesh.offsets();
     out.contour.clear();
     if normals.len() <= 64 && p.vertices().len() <= INLINE_VERTICES {
-        return small_silhouette_dirs(p, frame, rel, tol, out);
+        let dirs = if to_kv { &mut out.kv } else { &mut out.dirs };
+        return small_silhouette_dirs(p, frame, rel, tol, dirs);
     }
     if normals.len() <= 64 {
         // Front faces as bits, without a buffer.
@@ -1137,6 +1142,10 @@ fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut 
         }
         prev = cur;
     }
+    if to_kv {
+        out.kv.clear();
+        out.kv.extend_from_slice(&out.dirs);
+    }
     true
 }
 
@@ -1151,7 +1160,7 @@ fn small_silhouette_dirs(
     frame: &ShadingFrame,
     rel: DVec3,
     tol: f64,
-    out: &mut Pieces,
+    dirs: &mut Ring,
 ) -> bool {
     const NONE: u32 = u32::MAX;
     let mesh = p.mesh();
@@ -1191,10 +1200,10 @@ fn small_silhouette_dirs(
     }
     let inv = 1.0 / dist;
     let verts = p.vertices();
-    out.dirs.clear();
-    out.dirs.reserve(count);
+    dirs.clear();
+    dirs.reserve(count);
     let first = frame.to_local(verts[start as usize]) * inv;
-    out.dirs.push(first);
+    dirs.push(first);
     let (mut prev, mut prev_id, mut at) = (first, start, next[start as usize]);
     for k in 1..count {
         if at == NONE || at == start {
@@ -1204,7 +1213,7 @@ fn small_silhouette_dirs(
         if !spaced(prev, cur, verts, frame, prev_id, at) {
             return false;
         }
-        out.dirs.push(cur);
+        dirs.push(cur);
         (prev, prev_id) = (cur, at);
         at = next[at as usize];
         if k + 1 == count && at != start {
@@ -1316,12 +1325,12 @@ fn chain_contour(
 /// edge (the silhouette is their intersection), and its vertices into `out.kv`; `false` where
 /// [`convex_silhouette_dirs`] declines or the silhouette turns right somewhere.
 fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -> bool {
-    if !convex_silhouette_dirs(p, frame, out) {
+    if !convex_silhouette_dirs(p, frame, out, true) {
         return false;
     }
-    let n = out.dirs.len();
-    out.planes.clear();
-    out.kv.clear();
+    let Pieces { kv, planes, .. } = out;
+    let n = kv.len();
+    planes.clear();
     // The intersection of the half-spaces is the silhouette only where it is convex: at a
     // reflex vertex (a face seen within the facing tolerance of edge-on is left out of the
     // silhouette, which then turns back by the angle that face's sliver would have filled) the
@@ -1329,16 +1338,21 @@ fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -
     // reflex angle times the silhouette's size squared. Every turn must be to the left or
     // straight within its rounding bound (a face exactly edge-on lines up its corners): a
     // reflex angle of a few ulps hides a wedge of a few ulps.
-    let mut prev = out.dirs[n - 1];
+    // Each edge's difference serves both turns at its ends, and its plane.
+    let mut cur = kv[0];
+    let mut d_in = cur - kv[n - 1];
     for k in 0..n {
-        let (cur, next) = (out.dirs[k], out.dirs[if k + 1 == n { 0 } else { k + 1 }]);
-        let turn = left_turn(prev, cur, next);
-        if !(turn > 0.0 || turn > -MARGIN * norm1(cur - prev) * norm1(next - cur) * norm1(cur)) {
+        let next = kv[if k + 1 == n { 0 } else { k + 1 }];
+        let d_out = next - cur;
+        // `left_turn(prev, cur, next)`, the same operations.
+        let turn = d_in.cross(d_out).dot(cur);
+        if !(turn > 0.0 || turn > -MARGIN * norm1(d_in) * norm1(d_out) * norm1(cur)) {
             return false;
         }
-        out.planes.push(unit1(edge_plane(cur, next)));
-        out.kv.push(cur);
-        prev = cur;
+        // `edge_plane(cur, next)`, bit for bit: `cur - next` is `-d_out` exactly, and negating a
+        // cross product's factor negates its products exactly.
+        planes.push(unit1((cur + next).cross(d_out)));
+        (cur, d_in) = (next, d_out);
     }
     true
 }
