@@ -1329,8 +1329,10 @@ fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -
         return false;
     }
     let Pieces { kv, planes, .. } = out;
+    let kv: &[DVec3] = kv;
     let n = kv.len();
     planes.clear();
+    planes.reserve(n);
     // The intersection of the half-spaces is the silhouette only where it is convex: at a
     // reflex vertex (a face seen within the facing tolerance of edge-on is left out of the
     // silhouette, which then turns back by the angle that face's sliver would have filled) the
