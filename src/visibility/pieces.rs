@@ -787,22 +787,20 @@ fn edge_crossings(
         // corner.
         return t_in - e_in > t_out + e_out;
     }
-    let mut push = |t: f64, j: usize, enter: bool| {
-        out.push(Crossing {
-            x: pa + (pb - pa) * t,
-            edge: a as u32,
-            t,
-            ring,
-            j: j as u16,
-            enter,
-            ..Crossing::default()
-        });
+    let crossing = |t: f64, j: usize, enter: bool| Crossing {
+        x: pa + (pb - pa) * t,
+        edge: a as u32,
+        t,
+        ring,
+        j: j as u16,
+        enter,
+        ..Crossing::default()
     };
-    if j_in != usize::MAX {
-        push(t_in, j_in, true);
-    }
-    if j_out != usize::MAX {
-        push(t_out, j_out, false);
+    match (j_in != usize::MAX, j_out != usize::MAX) {
+        (true, true) => out.extend([crossing(t_in, j_in, true), crossing(t_out, j_out, false)]),
+        (true, false) => out.push(crossing(t_in, j_in, true)),
+        (false, true) => out.push(crossing(t_out, j_out, false)),
+        (false, false) => {}
     }
     true
 }
