@@ -483,17 +483,22 @@ impl Pieces {
         // Which vertices lie inside `K` (bit `i`): outside at the first plane with a negative
         // side. Each side that decides is checked against its rounding bound; sides are
         // recomputed where the crossings need them, which is cheaper than storing them.
+        // Also the first plane each vertex outside `K` is outside of: an edge whose ends share
+        // it misses `K`, which the crossings' pass would find at that plane after the same
+        // checks on the same sides.
         let mut inside = 0u64;
+        let mut first_out = [u32::MAX; 64];
         for (i, &v) in pts.iter().enumerate() {
             let v1 = norm1(v);
             let mut all = true;
-            for &n in planes {
+            for (j, &n) in planes.iter().enumerate() {
                 let s = n.dot(v);
                 if s.abs() <= MARGIN * v1 {
                     return false;
                 }
                 if s < 0.0 {
                     all = false;
+                    first_out[i] = j as u32;
                     break;
                 }
             }
@@ -508,7 +513,9 @@ impl Pieces {
             let first = self.crossings.len();
             for a in start..end {
                 let b = if a + 1 == end { start } else { a + 1 };
-                if (inside >> a) & (inside >> b) & 1 == 1 {
+                // Both ends inside `K`, or both outside it first by the same plane (both
+                // inside is the one way to share `u32::MAX`).
+                if (inside >> a) & (inside >> b) & 1 == 1 || first_out[a] == first_out[b] {
                     continue;
                 }
                 if !edge_crossings(
