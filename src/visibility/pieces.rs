@@ -174,7 +174,7 @@ pub struct Pieces {
     rings: [Ring; 2],
     /// The current blocker: its vertices (directions, counter-clockwise) and the normals of
     /// its half-spaces (`planes[j]` through `kv[j]` and `kv[j + 1]`, `n . v >= 0` inside).
-    kv: SmallVec<[DVec3; 24]>,
+    kv: Ring,
     planes: SmallVec<[DVec3; 24]>,
     /// Contour edges of a convex silhouette, and front-face flags of polyhedra with more than
     /// 64 faces.
@@ -483,17 +483,22 @@ impl Pieces {
         // Which vertices lie inside `K` (bit `i`): outside at the first plane with a negative
         // side. Each side that decides is checked against its rounding bound; sides are
         // recomputed where the crossings need them, which is cheaper than storing them.
+        // Also the first plane each vertex outside `K` is outside of: an edge whose ends share
+        // it misses `K`, which the crossings' pass would find at that plane after the same
+        // checks on the same sides.
         let mut inside = 0u64;
+        let mut first_out = [u32::MAX; 64];
         for (i, &v) in pts.iter().enumerate() {
             let v1 = norm1(v);
             let mut all = true;
-            for &n in planes {
+            for (j, &n) in planes.iter().enumerate() {
                 let s = n.dot(v);
                 if s.abs() <= MARGIN * v1 {
                     return false;
                 }
                 if s < 0.0 {
                     all = false;
+                    first_out[i] = j as u32;
                     break;
                 }
             }
@@ -508,7 +513,9 @@ impl Pieces {
             let first = self.crossings.len();
             for a in start..end {
                 let b = if a + 1 == end { start } else { a + 1 };
-                if (inside >> a) & (inside >> b) & 1 == 1 {
+                // Both ends inside `K`, or both outside it first by the same plane (both
+                // inside is the one way to share `u32::MAX`).
+                if (inside >> a) & (inside >> b) & 1 == 1 || first_out[a] == first_out[b] {
                     continue;
                 }
                 if !edge_crossings(
@@ -787,22 +794,20 @@ fn edge_crossings(
         // corner.
         return t_in - e_in > t_out + e_out;
     }
-    let mut push = |t: f64, j: usize, enter: bool| {
-        out.push(Crossing {
-            x: pa + (pb - pa) * t,
-            edge: a as u32,
-            t,
-            ring,
-            j: j as u16,
-            enter,
-            ..Crossing::default()
-        });
+    let crossing = |t: f64, j: usize, enter: bool| Crossing {
+        x: pa + (pb - pa) * t,
+        edge: a as u32,
+        t,
+        ring,
+        j: j as u16,
+        enter,
+        ..Crossing::default()
     };
-    if j_in != usize::MAX {
-        push(t_in, j_in, true);
-    }
-    if j_out != usize::MAX {
-        push(t_out, j_out, false);
+    match (j_in != usize::MAX, j_out != usize::MAX) {
+        (true, true) => out.extend([crossing(t_in, j_in, true), crossing(t_out, j_out, false)]),
+        (true, false) => out.push(crossing(t_in, j_in, true)),
+        (false, true) => out.push(crossing(t_out, j_out, false)),
+        (false, false) => {}
     }
     true
 }
@@ -918,7 +923,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     ) -> bool {
         match body {
             Body::Convex(p) => {
-                if !convex_silhouette_dirs(p, frame, out) {
+                if !convex_silhouette_dirs(p, frame, out, false) {
                     return false;
                 }
                 // A convex ring stays one simple ring when the horizon cuts it.
@@ -1049,16 +1054,20 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
 }
 
 /// The silhouette of the convex polyhedron `p` seen from the frame's point as directions in the
-/// frame (scaled by one positive factor), in `out.dirs` (counter-clockwise on the sphere: the
-/// silhouette on the left),
-/// exactly where [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the
+/// frame (scaled by one positive factor), in `out.kv` if `to_kv` (a blocker's), else in
+/// `out.dirs` (counter-clockwise on the sphere: the silhouette on the left), exactly where [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the
 /// loop of the same vertices without its general ordering: front faces by the facing predicate
 /// (the same distances and tolerance), contour edges oriented by their front face, chained by
 /// vertex index into one loop whose consecutive directions are further apart than
 /// [`MATCH_TOLERANCE`] and not antipodal within [`ANTIPODAL_TOLERANCE`]. `false` elsewhere: no
 /// face in front (the point inside or on the surface, where that function returns a hemisphere,
 /// a lune or the full sphere) or a loop that needs the general ordering.
-fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -> bool {
+fn convex_silhouette_dirs(
+    p: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    out: &mut Pieces,
+    to_kv: bool,
+) -> bool {
     let mesh = p.mesh();
     let b = mesh.bounding_sphere();
     let rel = frame.origin() - b.center;
@@ -1066,8 +1075,12 @@ fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut 
     let normals = mesh.normals();
     let offsets = mesh.offsets();
     out.contour.clear();
+    if normals.len() <= 64 && p.vertices().len() <= INLINE_VERTICES {
+        let dirs = if to_kv { &mut out.kv } else { &mut out.dirs };
+        return small_silhouette_dirs(p, frame, rel, tol, dirs);
+    }
     if normals.len() <= 64 {
-        // Front faces as bits: the common small polyhedron, without a buffer.
+        // Front faces as bits, without a buffer.
         let mut front = 0u64;
         for (f, (nf, &d)) in normals.iter().zip(offsets).enumerate() {
             front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
@@ -1134,7 +1147,108 @@ fn convex_silhouette_dirs(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut 
         }
         prev = cur;
     }
+    if to_kv {
+        out.kv.clear();
+        out.kv.extend_from_slice(&out.dirs);
+    }
     true
+}
+
+/// [`convex_silhouette_dirs`] for the common small polyhedron (at most 64 faces and
+/// [`INLINE_VERTICES`] vertices), the same decisions in one pass over the edges and one walk,
+/// without a list of contour edges: front faces as bits, each contour edge written straight
+/// into the successor table the chaining walks, and the spacing of consecutive directions
+/// tested during the walk (a vertex at the point has a zero direction, which no spacing test
+/// passes).
+fn small_silhouette_dirs(
+    p: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    rel: DVec3,
+    tol: f64,
+    dirs: &mut Ring,
+) -> bool {
+    const NONE: u32 = u32::MAX;
+    let mesh = p.mesh();
+    let mut front = 0u64;
+    for (f, (nf, &d)) in mesh.normals().iter().zip(mesh.offsets()).enumerate() {
+        front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
+    }
+    if front == 0 {
+        return false;
+    }
+    // Contour edges oriented by their front face (the silhouette on their left), chained by
+    // vertex index: every vertex used has one outgoing edge, and the walk from the first edge's
+    // tail uses all of them (as `chain_by_index` decides it).
+    let mut next = [NONE; INLINE_VERTICES];
+    let (mut count, mut start) = (0usize, NONE);
+    for e in p.edges() {
+        let (f0, f1) = ((front >> e.f0) & 1, (front >> e.f1) & 1);
+        if f0 != f1 {
+            let (a, b) = if f0 == 1 { (e.b, e.a) } else { (e.a, e.b) };
+            if next[a as usize] != NONE {
+                return false;
+            }
+            next[a as usize] = b;
+            if count == 0 {
+                start = a;
+            }
+            count += 1;
+        }
+    }
+    if count < 3 {
+        return false;
+    }
+    // Scaled by the inverse distance to the polyhedron's center, as in `convex_silhouette_dirs`.
+    let dist = rel.length();
+    if !(dist > 0.0) {
+        return false;
+    }
+    let inv = 1.0 / dist;
+    let verts = p.vertices();
+    dirs.clear();
+    dirs.reserve(count);
+    let first = frame.to_local(verts[start as usize]) * inv;
+    dirs.push(first);
+    let (mut prev, mut prev_id, mut at) = (first, start, next[start as usize]);
+    for k in 1..count {
+        if at == NONE || at == start {
+            return false;
+        }
+        let cur = frame.to_local(verts[at as usize]) * inv;
+        if !spaced(prev, cur, verts, frame, prev_id, at) {
+            return false;
+        }
+        dirs.push(cur);
+        (prev, prev_id) = (cur, at);
+        at = next[at as usize];
+        if k + 1 == count && at != start {
+            return false;
+        }
+    }
+    spaced(prev, first, verts, frame, prev_id, start)
+}
+
+/// Whether consecutive directions `a` and `b` (of vertices `ia` and `ib`) are further apart than
+/// `MATCH_TOLERANCE` and not antipodal within `ANTIPODAL_TOLERANCE`, as unit vectors: clearly so
+/// where the sine of the angle between them exceeds twice the larger tolerance and the angle is
+/// acute (no root, no division); otherwise decided on the unit vectors `convex_silhouette` uses.
+#[inline(always)]
+fn spaced(a: DVec3, b: DVec3, verts: &[DVec3], frame: &ShadingFrame, ia: u32, ib: u32) -> bool {
+    const TOL2: f64 = 4.0 * MATCH_TOLERANCE * MATCH_TOLERANCE;
+    let clear = a.dot(b) > 0.0
+        && a.cross(b).length_squared() > TOL2 * a.length_squared() * b.length_squared();
+    clear || spaced_ids(verts, frame, ia, ib)
+}
+
+/// The spacing test of [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) on
+/// the unit vectors of vertices `ia` and `ib`.
+#[cold]
+fn spaced_ids(verts: &[DVec3], frame: &ShadingFrame, ia: u32, ib: u32) -> bool {
+    let unit = |i: u32| frame.to_local(verts[i as usize]).try_normalize();
+    let (Some(a), Some(b)) = (unit(ia), unit(ib)) else {
+        return false;
+    };
+    (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
 }
 
 /// The spacing test of [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) on
@@ -1216,12 +1330,14 @@ fn chain_contour(
 /// edge (the silhouette is their intersection), and its vertices into `out.kv`; `false` where
 /// [`convex_silhouette_dirs`] declines or the silhouette turns right somewhere.
 fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -> bool {
-    if !convex_silhouette_dirs(p, frame, out) {
+    if !convex_silhouette_dirs(p, frame, out, true) {
         return false;
     }
-    let n = out.dirs.len();
-    out.planes.clear();
-    out.kv.clear();
+    let Pieces { kv, planes, .. } = out;
+    let kv: &[DVec3] = kv;
+    let n = kv.len();
+    planes.clear();
+    planes.reserve(n);
     // The intersection of the half-spaces is the silhouette only where it is convex: at a
     // reflex vertex (a face seen within the facing tolerance of edge-on is left out of the
     // silhouette, which then turns back by the angle that face's sliver would have filled) the
@@ -1229,16 +1345,21 @@ fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -
     // reflex angle times the silhouette's size squared. Every turn must be to the left or
     // straight within its rounding bound (a face exactly edge-on lines up its corners): a
     // reflex angle of a few ulps hides a wedge of a few ulps.
-    let mut prev = out.dirs[n - 1];
+    // Each edge's difference serves both turns at its ends, and its plane.
+    let mut cur = kv[0];
+    let mut d_in = cur - kv[n - 1];
     for k in 0..n {
-        let (cur, next) = (out.dirs[k], out.dirs[if k + 1 == n { 0 } else { k + 1 }]);
-        let turn = left_turn(prev, cur, next);
-        if !(turn > 0.0 || turn > -MARGIN * norm1(cur - prev) * norm1(next - cur) * norm1(cur)) {
+        let next = kv[if k + 1 == n { 0 } else { k + 1 }];
+        let d_out = next - cur;
+        // `left_turn(prev, cur, next)`, the same operations.
+        let turn = d_in.cross(d_out).dot(cur);
+        if !(turn > 0.0 || turn > -MARGIN * norm1(d_in) * norm1(d_out) * norm1(cur)) {
             return false;
         }
-        out.planes.push(unit1(edge_plane(cur, next)));
-        out.kv.push(cur);
-        prev = cur;
+        // `edge_plane(cur, next)`, bit for bit: `cur - next` is `-d_out` exactly, and negating a
+        // cross product's factor negates its products exactly.
+        planes.push(unit1((cur + next).cross(d_out)));
+        (cur, d_in) = (next, d_out);
     }
     true
 }
