@@ -2,15 +2,17 @@
 //! with them: Green's theorem along the exact curves for the Lambert lobe, and a fine
 //! Sutherland-Hodgman polygonization (extrapolated) for the GGX lobe.
 //!
-//! The error report (error against `eps` and against the number of edges, next to the error
-//! estimate) is printed by
-//! `cargo test --release --test bezier_accuracy -- --ignored --nocapture report`.
+//! Every adaptive result is checked against its proven error bound (`CurvedIntegral::
+//! error_bound`): `|value - reference| <= bound + the reference's own error + rounding`.
+//!
+//! The error report (error against `eps` and against the number of edges, next to the bound) is
+//! printed by `cargo test --release --test bezier_accuracy -- --ignored --nocapture report`.
 
 mod support;
 
 use arealight::glam::{DVec2, DVec3};
 use arealight::ltc::{
-    CurveSegment, Subdivision, curved_clamped_cosine_integral, ggx_curved_integral,
+    CurveSegment, Subdivision, curved_clamped_cosine_integral, ggx_curved_integral, specular_eps,
 };
 use support::bezier::{
     Lobe, Plane, Seg2, blob, facing_origin, green_lambert, letter_d, polygon_reference,
@@ -36,7 +38,7 @@ fn wall(d: f64) -> Plane {
 }
 
 /// The cases of issue 19: crossings of the horizon with 1, 2 and 3 roots in one cubic, a
-/// tangency, holes, tilted planes, a point close to the plane.
+/// tangency, holes, tilted planes, handles on end points, a cusp, a point close to the plane.
 fn cases() -> Vec<Case> {
     let mut out = Vec::new();
     // One root per crossing cubic: a blob centred a little above the horizon.
@@ -95,6 +97,32 @@ fn cases() -> Vec<Case> {
             &letter_d(),
         ),
     });
+    // Handles on the end points: the first cubic leaves its start with zero speed, the second
+    // arrives with zero speed, and the third has both handles on its start (a straight
+    // segment traversed like t^3). The parametrization is far from uniform within intervals.
+    let handles = vec![
+        Seg2::Cubic([p(-1.0, -0.4), p(-1.0, -0.4), p(0.5, -0.6), p(1.0, 0.5)]),
+        Seg2::Cubic([p(1.0, 0.5), p(1.2, 1.4), p(0.0, 1.6), p(0.0, 1.6)]),
+        Seg2::Cubic([p(0.0, 1.6), p(0.0, 1.6), p(0.0, 1.6), p(-1.0, -0.4)]),
+    ];
+    out.push(Case {
+        name: "handles on end points",
+        segs: facing_origin(&wall(1.1), &[handles]),
+    });
+    // A cusp: the control polygon of (0, 0), (1, 1), (0, 1), (1, 0), whose speed vanishes at
+    // t = 1/2, mapped so that the cubic crosses the horizon on both sides of its cusp.
+    let cusp = [
+        Seg2::Cubic([p(-1.0, -0.3), p(1.0, 1.3), p(-1.0, 1.3), p(1.0, -0.3)]),
+        Seg2::Line(p(1.0, -0.3), p(1.0, -0.8)),
+        Seg2::Line(p(1.0, -0.8), p(-1.0, -0.8)),
+        Seg2::Line(p(-1.0, -0.8), p(-1.0, -0.3)),
+    ];
+    // Written clockwise (over the cusp first): turned around.
+    let cusp: Vec<Seg2> = cusp.iter().rev().map(Seg2::reversed).collect();
+    out.push(Case {
+        name: "cusp across the horizon",
+        segs: facing_origin(&wall(0.9), &[cusp]),
+    });
     // Close to the plane: the light fills almost half the sphere.
     out.push(Case {
         name: "point 0.05 from a tilted plane",
@@ -112,6 +140,17 @@ const GGX: [(f64, f64); 4] = [(0.9, 0.3), (0.5, 0.1), (0.1, 0.05), (0.02, 0.2)];
 
 fn lambert_ref(c: &Case) -> f64 {
     green_lambert(&c.segs, 16, 24).clamp(0.0, 1.0)
+}
+
+/// What [`lambert_ref`] may be off by: Gauss-Legendre quadrature of a smooth integrand with
+/// 16 x 24 nodes per segment is exact to rounding; `references_agree_with_each_other` checks
+/// it against the independent polygonization.
+const GREEN_ERROR: f64 = 1e-13;
+
+/// Rounding of an edge sum of `edges` terms (each accurate to a few ulps of at most `pi`),
+/// over `2 pi`: what the proven bound leaves out.
+fn rounding(edges: usize) -> f64 {
+    8.0 * f64::EPSILON * (edges as f64 + 16.0)
 }
 
 #[test]
@@ -139,15 +178,13 @@ fn lambert_converges_to_the_exact_region() {
             c.name
         );
         let mut last = f64::INFINITY;
-        for eps in [1e-3, 1e-5, 1e-7, 1e-9, 1e-11] {
+        for eps in [1e-2, 1e-3, 1e-5, 1e-7, 1e-9, 1e-11] {
             let r = curved_clamped_cosine_integral(&c.segs, Subdivision::Adaptive { eps }).unwrap();
             let err = (r.value - exact).abs();
-            let est = r.error_estimate.unwrap();
-            // The estimate is the leading term of the error: within a factor of a few of the
-            // truth, never far below it (rounding aside).
+            let bound = r.error_bound.unwrap();
             assert!(
-                err <= 3.0 * est + 1e-13,
-                "{} eps {eps}: error {err:e} above 3x estimate {est:e}",
+                err <= bound + GREEN_ERROR + rounding(r.edges),
+                "{} eps {eps}: error {err:e} above the bound {bound:e}",
                 c.name
             );
             last = err;
@@ -158,20 +195,43 @@ fn lambert_converges_to_the_exact_region() {
     }
 }
 
+/// The bound is not uselessly loose: on a curve where no sliver cancels another (a convex
+/// blob above the horizon: every chord cuts off light) it is within a small factor of the
+/// error (about 4/3 from the hulls, times the cosine's variation over them), and it falls
+/// with `eps` as the error does.
+#[test]
+fn bound_is_close_to_the_error_where_nothing_cancels() {
+    let segs = facing_origin(&wall(1.5), &[blob(p(0.0, 1.2), &[1.0], 8, 0.0)]);
+    let exact = lambert_ref(&Case {
+        name: "disk",
+        segs: segs.clone(),
+    });
+    for eps in [1e-3, 1e-5, 1e-7, 1e-9] {
+        let r = curved_clamped_cosine_integral(&segs, Subdivision::Adaptive { eps }).unwrap();
+        // Every chord lies inside the convex region: the polygon has less light.
+        let err = exact - r.value;
+        let bound = r.error_bound.unwrap();
+        assert!(
+            err > 0.0 && err <= bound && bound <= 2.0 * err,
+            "eps {eps}: error {err:e}, bound {bound:e}"
+        );
+    }
+}
+
 #[test]
 fn ggx_converges_to_the_fine_polygonization() {
     for c in cases() {
         for (cos_v, alpha) in GGX {
             let (exact, spread) = polygon_reference(&c.segs, 50_000, Lobe::Ggx(cos_v, alpha, 1.0));
-            for eps in [1e-4, 1e-6, 1e-8, 1e-10] {
+            for eps in [specular_eps(alpha), 1e-4, 1e-6, 1e-8, 1e-10] {
                 let r =
                     ggx_curved_integral(&c.segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps })
                         .unwrap();
                 let err = (r.value - exact).abs();
-                let est = r.error_estimate.unwrap();
+                let bound = r.error_bound.unwrap();
                 assert!(
-                    err <= 3.0 * est + 1e-11 + spread,
-                    "{} cos {cos_v} alpha {alpha} eps {eps}: {} vs {exact}: error {err:e} above 3x estimate {est:e}",
+                    err <= bound + spread + rounding(r.edges),
+                    "{} cos {cos_v} alpha {alpha} eps {eps}: {} vs {exact}: error {err:e} above the bound {bound:e}",
                     c.name,
                     r.value
                 );
@@ -183,7 +243,7 @@ fn ggx_converges_to_the_fine_polygonization() {
 #[test]
 #[ignore = "prints the error report; run with --ignored --nocapture"]
 fn report() {
-    println!("Lambert: |error| and estimate against eps (edges in brackets)");
+    println!("Lambert: |error| / bound against eps (edges in brackets)");
     for c in cases() {
         let exact = lambert_ref(&c);
         print!("{:<34} I = {exact:.6}", c.name);
@@ -192,7 +252,7 @@ fn report() {
             print!(
                 " | {eps:.0e}: {:.1e}/{:.1e} [{}]",
                 (r.value - exact).abs(),
-                r.error_estimate.unwrap(),
+                r.error_bound.unwrap(),
                 r.edges
             );
         }
@@ -204,7 +264,7 @@ fn report() {
         }
         println!();
     }
-    println!("GGX (f0 = 1): |error| and estimate against eps (edges in brackets)");
+    println!("GGX (f0 = 1): |error| / bound against eps (edges in brackets)");
     for c in cases() {
         for (cos_v, alpha) in GGX {
             let (exact, spread) = polygon_reference(&c.segs, 50_000, Lobe::Ggx(cos_v, alpha, 1.0));
@@ -219,7 +279,7 @@ fn report() {
                 print!(
                     " | {eps:.0e}: {:.1e}/{:.1e} [{}]",
                     (r.value - exact).abs(),
-                    r.error_estimate.unwrap(),
+                    r.error_bound.unwrap(),
                     r.edges
                 );
             }
@@ -323,6 +383,16 @@ fn points_on_or_next_to_the_plane_give_finite_values() {
     }
 }
 
+/// The segments translated by `d`.
+fn moved_by(segs: &[CurveSegment], d: DVec3) -> Vec<CurveSegment> {
+    segs.iter()
+        .map(|s| match *s {
+            CurveSegment::Cubic(p) => CurveSegment::Cubic(p.map(|v| v + d)),
+            CurveSegment::Line(p) => CurveSegment::Line(p.map(|v| v + d)),
+        })
+        .collect()
+}
+
 /// Minimized findings of the `ltc_curved` fuzz target, each against the polygonization.
 #[test]
 fn fuzz_findings() {
@@ -350,9 +420,10 @@ fn fuzz_findings() {
         let r =
             ggx_curved_integral(&segs, cos_v, alpha, 1.0, Subdivision::Adaptive { eps }).unwrap();
         assert!(
-            (r.value - exact).abs() <= 3.0 * r.error_estimate.unwrap() + spread + 1e-15,
-            "eps {eps}: {} vs {exact}",
-            r.value
+            (r.value - exact).abs() <= r.error_bound.unwrap() + spread + rounding(r.edges),
+            "eps {eps}: {} vs {exact} (bound {:e})",
+            r.value,
+            r.error_bound.unwrap()
         );
     }
     // 3. The light's plane 6e-6 from the point, a near-mirror lobe at a grazing view, cubics
@@ -392,11 +463,147 @@ fn fuzz_findings() {
     for eps in [1e-6, 1e-10, 1e-13] {
         let r = ggx_curved_integral(&segs, cos_v, 0.0, 1.0, Subdivision::Adaptive { eps }).unwrap();
         assert!(
-            (r.value - exact).abs() <= 3.0 * r.error_estimate.unwrap() + spread + 1e-13,
-            "eps {eps}: {} vs {exact}",
-            r.value
+            (r.value - exact).abs() <= r.error_bound.unwrap() + spread + rounding(r.edges),
+            "eps {eps}: {} vs {exact} (bound {:e})",
+            r.value,
+            r.error_bound.unwrap()
         );
     }
+    // 4. A loop facing away from the point (integral 0), its plane 7e-5 from the point and 256
+    //    across: its 7-chord flattening crosses itself, so the uniform baseline integrates a
+    //    polygon with a lobe facing the point (the fuzz target's clip invariant, which assumed
+    //    the curves' simplicity for that polygon, failed by 6.6e-9). The curved integrals stay
+    //    within their bounds of the exact 0.
+    let at = placed(DVec3::new(-1.0, -1.0, -1.0), -7e-5);
+    let at = |x: f64, y: f64| at(x * 1024.0, y * 1024.0); // scale 4 over the default 2^-8
+    type Handles = ((f64, f64), [f64; 4]);
+    let pts: [Handles; 3] = [
+        ((63.0, -1.0), [-3.0, -1.0, -36.0, -1.0]),
+        ((-1.0, -1.0), [-1.0, -1.0, -1.0, 21.0]),
+        ((0.0, 0.0), [0.0, 64.0, -70.0, -70.0]),
+    ];
+    let segs: Vec<CurveSegment> = (0..3)
+        .map(|i| {
+            let ((x, y), h) = pts[i];
+            let ((x1, y1), _) = pts[(i + 1) % 3];
+            CurveSegment::Cubic([
+                at(x, y),
+                at(x + h[0] / 2.0, y + h[1] / 2.0),
+                at(x + h[2] / 2.0, y + h[3] / 2.0),
+                at(x1, y1),
+            ])
+        })
+        .collect();
+    let (cos_v, alpha) = (47802.0 / 65535.0, (47802.0f64 / 65535.0).powi(2));
+    let (lambert, lspread) = polygon_reference(&segs, 4000, Lobe::Lambert);
+    let (ggx, gspread) = polygon_reference(&segs, 4000, Lobe::Ggx(cos_v, alpha, 1.0));
+    let coarse = ggx_curved_integral(&segs, cos_v, alpha, 1.0, Subdivision::Uniform { n: 7 });
+    assert!(
+        lambert == 0.0 && ggx == 0.0 && coarse.as_ref().is_ok_and(|c| c.value > 1e-3),
+        "the finding: {lambert} {ggx} {coarse:?}"
+    );
+    for eps in [1e-4, 1e-10] {
+        let sub = Subdivision::Adaptive { eps };
+        let d = curved_clamped_cosine_integral(&segs, sub).unwrap();
+        let g = ggx_curved_integral(&segs, cos_v, alpha, 1.0, sub).unwrap();
+        assert!(
+            (d.value - lambert).abs() <= d.error_bound.unwrap() + lspread + rounding(d.edges),
+            "eps {eps}: lambert {} vs {lambert}",
+            d.value
+        );
+        assert!(
+            (g.value - ggx).abs() <= g.error_bound.unwrap() + gspread + rounding(g.edges),
+            "eps {eps}: ggx {} vs {ggx}",
+            g.value
+        );
+    }
+    // 5. A near-mirror lobe at the most grazing view (cos 1/65535, alpha 0), the light in a
+    //    plane 0.087 from the point that holds the mirror direction's horizon point, 800
+    //    across: the response (0.84) moves by up to 3e-9 when the light moves by 1e-14, so
+    //    the rounding of points and crossings (at that level for coordinates of a few hundred)
+    //    shows as 1.3e-9 between the curved integral and the polygonization, whatever `eps`
+    //    (the bound on the subdivision is 1.5e-13). The fuzz target's rounding allowance did
+    //    not cover it; it now adds what nudging the light by a few ulps changes, as here.
+    let at = placed(DVec3::new(-3.0, 0.0, 0.0), 0.087);
+    let at = |x: f64, y: f64| at(x * 2048.0, y * 2048.0); // scale 8 over the default 2^-8
+    let pts: [Handles; 3] = [
+        ((-1.0, -2.0), [63.0, 0.0, 0.0, -1.0]),
+        ((27.0, 27.0), [27.0; 4]),
+        ((-1.0, -1.0), [-1.0, -1.0, 2.0, -125.0]),
+    ];
+    let segs: Vec<CurveSegment> = (0..3)
+        .map(|i| {
+            let ((x, y), h) = pts[i];
+            let ((x1, y1), _) = pts[(i + 1) % 3];
+            CurveSegment::Cubic([
+                at(x, y),
+                at(x + h[0] / 2.0, y + h[1] / 2.0),
+                at(x + h[2] / 2.0, y + h[3] / 2.0),
+                at(x1, y1),
+            ])
+        })
+        .collect();
+    let (cos_v, alpha) = (1.0 / 65535.0, 0.0);
+    let (ggx, gspread) = polygon_reference(&segs, 4000, Lobe::Ggx(cos_v, alpha, 1.0));
+    let sub = Subdivision::Adaptive { eps: 1e-10 };
+    let g = ggx_curved_integral(&segs, cos_v, alpha, 1.0, sub).unwrap();
+    let cond = [-1e-14, 1e-14]
+        .map(|dz| {
+            let m = ggx_curved_integral(&moved_by(&segs, DVec3::Z * dz), cos_v, alpha, 1.0, sub)
+                .unwrap();
+            (m.value - g.value).abs()
+        })
+        .into_iter()
+        .fold(0.0f64, f64::max);
+    let err = (g.value - ggx).abs();
+    let bound = g.error_bound.unwrap();
+    assert!(
+        cond > 1e-10 && err <= bound + gspread + rounding(g.edges) + 4.0 * cond,
+        "the finding: error {err:e}, bound {bound:e}, conditioning {cond:e}"
+    );
+    // 6. The same grazing near-mirror view of a light 200 across whose plane passes 9.7e-6
+    //    from the point: the response clipped at the shading horizon came out 1.7e-9 above
+    //    the one without that clip (with bounds of 2e-17), which a simple region cannot give
+    //    in exact arithmetic; both move by 3e-8 when the light moves by 16 ulps of its
+    //    coordinates (up, down and along the plane's normal), and their difference changes
+    //    sign. The fuzz target now allows for that conditioning in its clip invariant too.
+    let at = placed(DVec3::new(97.0, 1.0, 2.0), 9.7e-6);
+    let at = |x: f64, y: f64| at(x * 8192.0, y * 8192.0); // scale 32 over the default 2^-8
+    let lat = [at(-1.0, -1.0), at(7.0, 7.0), at(-1.0, 0.0)];
+    let segs = vec![
+        CurveSegment::Line([lat[0], lat[1]]),
+        CurveSegment::Cubic([lat[1], at(6.5, 6.5), at(6.5, 6.5), lat[2]]),
+        CurveSegment::Line([lat[2], lat[0]]),
+    ];
+    let l = arealight::ltc::lookup(cos_v, alpha).unwrap();
+    let scale = l.specular_scale(1.0);
+    let far = segs
+        .iter()
+        .flat_map(|s| s.control_points())
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+    let nudge = 16.0 * f64::EPSILON * far;
+    let clipped_and_not = |segs: &[CurveSegment]| {
+        let g = ggx_curved_integral(segs, cos_v, alpha, 1.0, sub).unwrap();
+        let u = arealight::ltc::curved_ltc_integral(segs, l.m_inv, sub).unwrap();
+        (
+            g.value,
+            scale * u.value,
+            g.error_bound.unwrap() + scale * u.error_bound.unwrap(),
+        )
+    };
+    let (g, u, bounds) = clipped_and_not(&segs);
+    let (mut cond, mut low, mut high) = (0.0f64, f64::INFINITY, f64::NEG_INFINITY);
+    let normal = DVec3::new(97.0, 1.0, 2.0).normalize();
+    for d in [DVec3::Z, -DVec3::Z, normal, -normal] {
+        let (gm, um, _) = clipped_and_not(&moved_by(&segs, d * nudge));
+        cond = cond.max((gm - g).abs()).max((um - u).abs());
+        low = low.min(gm - um);
+        high = high.max(gm - um);
+    }
+    assert!(
+        g - u > 1e-9 && low < 0.0 && high > 0.0 && g <= u + bounds + 4.0 * cond,
+        "the finding: clipped {g}, unclipped {u}, bounds {bounds:e}, conditioning {cond:e}"
+    );
     // 2. A bow-tie of lines (a loop crossing itself) whose lobes' areas cancel: the plane's
     //    normal must come from the points, not the vanishing total area (it returned 0 for
     //    0.0033).
