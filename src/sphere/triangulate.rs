@@ -152,10 +152,10 @@ fn fan_from_first(ring: &[DVec3]) -> Option<Vec<SphericalTriangle>> {
         // The area decides before the triangle is built: a positive triangle with its vertices
         // nearly on a great circle is either a sliver or nearly a hemisphere, and the latter
         // must not pass for the former below.
-        let (w, err) = signed_solid_angle_with_error(apex, b, c);
+        let (area, err) = signed_solid_angle_with_error(apex, b, c);
         if orient(apex, b, c) != 1
             || !(err <= MAX_AREA_ERROR)
-            || !(w <= 2.0 * PI - HEMISPHERE_MARGIN)
+            || !(area <= 2.0 * PI - HEMISPHERE_MARGIN)
         {
             return None;
         }
@@ -165,7 +165,7 @@ fn fan_from_first(ring: &[DVec3]) -> Option<Vec<SphericalTriangle>> {
                 out.push(t);
             }
             // Certified positive, area within its own rounding.
-            Err(GeomError::Degenerate(_)) if w <= err => {}
+            Err(GeomError::Degenerate(_)) if area <= err => {}
             Err(_) => return None,
         }
     }
