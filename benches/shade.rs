@@ -1,12 +1,24 @@
 //! Shading-point benchmarks: one shading point in a penumbra with 1 light and 0, 1, 3 occluders,
 //! the silhouette path against the per-triangle path for a subdivided-icosahedron light, and the
-//! face-by-face path of occluders that interpenetrate a light. Fixed inputs; results in
-//! BENCHMARKS.md (section `shade`).
+//! face-by-face path of occluders that interpenetrate a light, and issue 15's quad-light scene
+//! (a shaded point against the bare integrals it needs). Fixed inputs; results in BENCHMARKS.md
+//! (sections `shade` and `shade: cost of a point`).
+//!
+//! Besides criterion (`cargo bench -p arealight-benches --bench shade`), the binary has a plain
+//! mode for instruction counts: `SHADE_POINT_CASE=<case> [SHADE_POINT_REPS=n]` shades issue 15's
+//! eight points `n` times (default 1) with no criterion (cases: see `count_case`), so that
+//! `valgrind --tool=callgrind` counts exactly that; run it with `n = 0` too and divide the
+//! difference by `8 n` for the instructions per shading point (scene construction cancels).
 
 use arealight::glam::DVec3;
 use arealight::internals::{DemoConfig, demo_scene};
-use arealight::shade::{Body, ConvexPolyhedron, Light, Material, Method, Scene, TriangleMesh};
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use arealight::ltc::{clamped_cosine_integral_clip_free, lookup, ltc_integral};
+use arealight::shade::{
+    Body, ConvexPolyhedron, Light, Material, Method, Scene, ShadeContext, TriangleMesh,
+};
+use arealight::solid::ShadingFrame;
+use arealight::sphere::SphericalPolygon;
+use criterion::{BenchmarkId, Criterion, criterion_group};
 use std::hint::black_box;
 
 fn occluders(c: &mut Criterion) {
@@ -116,10 +128,197 @@ fn interpenetrating(c: &mut Criterion) {
     group.finish();
 }
 
+/// Issue 15's scene: a 1 x 1 quad light at height 2 facing down, a 0.5 cube at height 1, and
+/// for the three-occluder case a flat box and an icosahedron (12 vertices) beside it; ground
+/// points in the penumbra of all of them.
+pub fn issue15_scene(occluders: usize) -> Scene {
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5).unwrap();
+    let all: [Body; 3] = [
+        ConvexPolyhedron::cuboid(DVec3::new(0.0, 0.0, 1.0), DVec3::splat(0.25))
+            .unwrap()
+            .into(),
+        ConvexPolyhedron::cuboid(DVec3::new(0.35, -0.3, 1.35), DVec3::new(0.15, 0.1, 0.05))
+            .unwrap()
+            .into(),
+        ConvexPolyhedron::icosphere(DVec3::new(0.1, 0.35, 1.5), 0.12, 0)
+            .unwrap()
+            .into(),
+    ];
+    Scene::new(
+        vec![Light::new(quad, DVec3::ONE).unwrap()],
+        all[..occluders].to_vec(),
+    )
+    .unwrap()
+}
+
+/// The ground points of issue 15's benchmarks, with a view each: eight points of a row through
+/// the penumbra of the three occluders.
+pub fn issue15_points() -> Vec<(DVec3, DVec3)> {
+    (0..8)
+        .map(|k| {
+            let t = k as f64 / 7.0;
+            (
+                DVec3::new(0.25 + 0.35 * t, 0.05 + 0.1 * t, 0.0),
+                DVec3::new(0.3 - 0.5 * t, -0.2, 1.0),
+            )
+        })
+        .collect()
+}
+
+fn quad_light_points(c: &mut Criterion) {
+    let points = issue15_points();
+    let diffuse = Material::diffuse(DVec3::splat(0.8)).unwrap();
+    let glossy = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    let scenes: Vec<Scene> = (0..4).filter(|&k| k != 2).map(issue15_scene).collect();
+    // Every point is in the penumbra of the cube and of the three occluders together.
+    for &(x, v) in &points {
+        let lit = scenes[0].shade(x, DVec3::Z, v, &diffuse).unwrap();
+        for s in &scenes[1..] {
+            let part = s.shade(x, DVec3::Z, v, &diffuse).unwrap();
+            assert!(
+                part.x > 0.05 * lit.x && part.x < 0.95 * lit.x,
+                "{x}: not a penumbra ({part} of {lit})"
+            );
+        }
+    }
+    // The integrals alone: the light's quad seen from each point, prebuilt in its frame.
+    let quads: Vec<(SphericalPolygon, f64)> = points
+        .iter()
+        .map(|&(x, v)| {
+            let f = ShadingFrame::new(x, DVec3::Z, v).unwrap();
+            let m = scenes[0].lights()[0].shape().mesh();
+            let c = [0, 1, 2, 3].map(|k| f.to_local(m.vertices()[k]));
+            // The quad's outline as a region: the light faces the point, so its corners run
+            // clockwise seen from outside the sphere of directions; reversed.
+            let ring = SphericalPolygon::new(vec![c.iter().rev().copied().collect()]).unwrap();
+            assert!(ring.solid_angle() < 1.0);
+            (ring, f.view().z)
+        })
+        .collect();
+    let mut group = c.benchmark_group("shade/quad light, 8 penumbra points");
+    group.bench_function("integrals only, diffuse", |b| {
+        b.iter(|| {
+            let mut s = 0.0;
+            for (q, _) in &quads {
+                s += clamped_cosine_integral_clip_free(black_box(q));
+            }
+            s
+        })
+    });
+    group.bench_function("integrals only, glossy", |b| {
+        b.iter(|| {
+            let mut s = 0.0;
+            for (q, cos_v) in &quads {
+                let l = lookup(black_box(*cos_v), glossy.alpha()).unwrap();
+                s += clamped_cosine_integral_clip_free(black_box(q))
+                    + l.norm * ltc_integral(q, l.m_inv).unwrap();
+            }
+            s
+        })
+    });
+    for (scene, k) in scenes.iter().zip([0, 1, 3]) {
+        for (name, m) in [("diffuse", &diffuse), ("glossy", &glossy)] {
+            group.bench_function(format!("shade, {k} occluders, {name}"), |b| {
+                b.iter(|| {
+                    let mut s = DVec3::ZERO;
+                    for &(x, v) in &points {
+                        s += scene.shade(black_box(x), DVec3::Z, v, m).unwrap();
+                    }
+                    s
+                })
+            });
+            // The same through a context kept across calls, as a renderer's thread keeps one.
+            let mut ctx = ShadeContext::new();
+            group.bench_function(format!("shade_in, {k} occluders, {name}"), |b| {
+                b.iter(|| {
+                    let mut s = DVec3::ZERO;
+                    for &(x, v) in &points {
+                        s += scene
+                            .shade_in(&mut ctx, black_box(x), DVec3::Z, v, m)
+                            .unwrap();
+                    }
+                    s
+                })
+            });
+        }
+    }
+    group.finish();
+}
+
+/// The plain mode for instruction counts (see the module documentation): `case` is
+/// `integrals-diffuse`, `integrals-glossy`, or `shade-K-M` / `shade_in-K-M` with `K` in 0, 1, 3
+/// occluders and `M` in `diffuse`, `glossy`; the eight points of issue 15 are shaded `reps`
+/// times. Returns the sum of the values, which the caller prints so that nothing is optimized
+/// out.
+fn count_case(case: &str, reps: usize) -> f64 {
+    let points = issue15_points();
+    let diffuse = Material::diffuse(DVec3::splat(0.8)).unwrap();
+    let glossy = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    let parts: Vec<&str> = case.split('-').collect();
+    let mut sum = 0.0;
+    match parts.as_slice() {
+        ["integrals", lobe] => {
+            let scene = issue15_scene(0);
+            let m = scene.lights()[0].shape().mesh();
+            let quads: Vec<(SphericalPolygon, f64)> = points
+                .iter()
+                .map(|&(x, v)| {
+                    let f = ShadingFrame::new(x, DVec3::Z, v).unwrap();
+                    let c = [0, 1, 2, 3].map(|k| f.to_local(m.vertices()[k]));
+                    let ring =
+                        SphericalPolygon::new(vec![c.iter().rev().copied().collect()]).unwrap();
+                    (ring, f.view().z)
+                })
+                .collect();
+            let glossy_lobe = *lobe == "glossy";
+            for _ in 0..reps {
+                for (q, cos_v) in &quads {
+                    sum += clamped_cosine_integral_clip_free(black_box(q));
+                    if glossy_lobe {
+                        let l = lookup(black_box(*cos_v), glossy.alpha()).unwrap();
+                        sum += l.norm * ltc_integral(q, l.m_inv).unwrap();
+                    }
+                }
+            }
+        }
+        [entry, k, lobe] => {
+            let scene = issue15_scene(k.parse().expect("occluder count"));
+            let m = if *lobe == "glossy" { &glossy } else { &diffuse };
+            let mut ctx = ShadeContext::new();
+            for _ in 0..reps {
+                for &(x, v) in &points {
+                    let rgb = if *entry == "shade_in" {
+                        scene.shade_in(&mut ctx, black_box(x), DVec3::Z, v, m)
+                    } else {
+                        scene.shade(black_box(x), DVec3::Z, v, m)
+                    };
+                    sum += rgb.unwrap().x;
+                }
+            }
+        }
+        _ => panic!("unknown SHADE_POINT_CASE {case}"),
+    }
+    sum
+}
+
 criterion_group!(
     benches,
+    quad_light_points,
     occluders,
     silhouette_vs_per_triangle,
     interpenetrating
 );
-criterion_main!(benches);
+
+fn main() {
+    if let Ok(case) = std::env::var("SHADE_POINT_CASE") {
+        let reps: usize = std::env::var("SHADE_POINT_REPS")
+            .ok()
+            .and_then(|r| r.parse().ok())
+            .unwrap_or(1);
+        println!("{case} x {reps}: {}", count_case(&case, reps));
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

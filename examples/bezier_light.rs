@@ -22,8 +22,11 @@ use arealight::shade::{
     BezierSegment, BezierShape, Body, ConvexPolyhedron, DEFAULT_DIFFUSE_SUBDIVISION, Light,
     Material, MonteCarlo, ReferenceBrdf, Scene,
 };
-use std::path::PathBuf;
 use std::time::Instant;
+
+#[path = "common/mod.rs"]
+mod common;
+use common::{image, trace};
 
 /// A 2D outline segment: a line to a point, or a cubic with two handles to a point.
 enum Seg {
@@ -136,24 +139,6 @@ enum Hit {
     Surface(DVec3, DVec3, DVec3, Material),
 }
 
-fn ray_triangle(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
-    let (e1, e2) = (b - a, c - a);
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-300 {
-        return None;
-    }
-    let s = o - a;
-    let u = s.dot(p) / det;
-    let q = s.cross(e1);
-    let v = d.dot(q) / det;
-    if !(0.0..=1.0).contains(&u) || v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(q) / det;
-    (t > 1e-9).then_some(t)
-}
-
 fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
     let (mut best, mut hit) = (f64::INFINITY, Hit::Nothing);
     if d.z < 0.0 {
@@ -185,7 +170,7 @@ fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
     for (k, occ) in w.scene.occluders().iter().enumerate() {
         let mesh = occ.mesh();
         for i in 0..mesh.triangle_count() {
-            if let Some(t) = ray_triangle(o, d, mesh.triangle(i))
+            if let Some(t) = trace::ray_triangle(o, d, mesh.triangle(i)).map(|h| h.0)
                 && t < best
             {
                 best = t;
@@ -197,16 +182,6 @@ fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
         }
     }
     hit
-}
-
-fn srgb(x: f64) -> u8 {
-    let t = 1.0 - (-2.0 * x.max(0.0)).exp();
-    let s = if t <= 0.003_130_8 {
-        12.92 * t
-    } else {
-        1.055 * t.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8
 }
 
 /// Per pixel: analytic, coarse flattening, unshadowed curved integrals, reference and its
@@ -342,24 +317,10 @@ fn main() {
             out_img[y * 3 * width + 2 * width + x] = (a - r).abs() * 10.0;
         }
     }
-    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/target/arealight-out"));
-    std::fs::create_dir_all(&dir).expect("output directory");
-    let path = dir.join("bezier_light.png");
-    let file = std::fs::File::create(&path).expect("output file");
-    let mut enc = png::Encoder::new(
-        std::io::BufWriter::new(file),
-        3 * width as u32,
-        height as u32,
-    );
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    let bytes: Vec<u8> = out_img
-        .iter()
-        .flat_map(|p| [srgb(p.x), srgb(p.y), srgb(p.z)])
-        .collect();
-    enc.write_header()
-        .and_then(|mut wr| wr.write_image_data(&bytes))
-        .expect("PNG");
+    let path = image::out_dir()
+        .expect("output directory")
+        .join("bezier_light.png");
+    image::write_png(&path, 3 * width, height, &image::to_bytes(&out_img, 2.0)).expect("PNG");
     let shaded = n / 3;
     println!(
         "{width} x {height}, {shaded} shaded pixels, {threads} threads, {wall:.1} s wall; \

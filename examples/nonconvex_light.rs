@@ -19,8 +19,11 @@ use arealight::internals::{thesis_polyhedra, torus};
 use arealight::shade::{
     ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene, TriangleMesh,
 };
-use std::path::PathBuf;
 use std::time::Instant;
+
+#[path = "common/mod.rs"]
+mod common;
+use common::{image, trace};
 
 /// `mesh` scaled by `s`, rotated by `rot` and moved to `at`.
 fn moved(mesh: &TriangleMesh, s: f64, rot: DMat3, at: DVec3) -> TriangleMesh {
@@ -93,24 +96,6 @@ enum Hit {
     Surface(DVec3, DVec3, DVec3, Material),
 }
 
-fn ray_triangle(o: DVec3, d: DVec3, [a, b, c]: [DVec3; 3]) -> Option<f64> {
-    let (e1, e2) = (b - a, c - a);
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-300 {
-        return None;
-    }
-    let s = o - a;
-    let u = s.dot(p) / det;
-    let q = s.cross(e1);
-    let v = d.dot(q) / det;
-    if !(0.0..=1.0).contains(&u) || v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(q) / det;
-    (t > 1e-9).then_some(t)
-}
-
 fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
     let (mut best, mut hit) = (f64::INFINITY, Hit::Nothing);
     if d.z < 0.0 {
@@ -124,7 +109,7 @@ fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
     for light in w.scene.lights() {
         let mesh = light.shape().mesh();
         for i in 0..mesh.triangle_count() {
-            if let Some(t) = ray_triangle(o, d, mesh.triangle(i))
+            if let Some(t) = trace::ray_triangle(o, d, mesh.triangle(i)).map(|h| h.0)
                 && t < best
             {
                 best = t;
@@ -136,7 +121,7 @@ fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
     for (k, occ) in w.scene.occluders().iter().enumerate() {
         let mesh = occ.mesh();
         for i in 0..mesh.triangle_count() {
-            if let Some(t) = ray_triangle(o, d, mesh.triangle(i))
+            if let Some(t) = trace::ray_triangle(o, d, mesh.triangle(i)).map(|h| h.0)
                 && t < best
             {
                 best = t;
@@ -148,16 +133,6 @@ fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {
         }
     }
     hit
-}
-
-fn srgb(x: f64) -> u8 {
-    let t = 1.0 - (-3.0 * x.max(0.0)).exp();
-    let s = if t <= 0.003_130_8 {
-        12.92 * t
-    } else {
-        1.055 * t.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8
 }
 
 fn main() {
@@ -233,20 +208,10 @@ fn main() {
             }
         }
     }
-    let out = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/target/arealight-out"));
-    std::fs::create_dir_all(&out).expect("output directory");
-    let path = out.join("nonconvex_light.png");
-    let file = std::fs::File::create(&path).expect("output file");
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width as u32, height as u32);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    let bytes: Vec<u8> = img
-        .iter()
-        .flat_map(|p| [srgb(p.x), srgb(p.y), srgb(p.z)])
-        .collect();
-    enc.write_header()
-        .and_then(|mut wr| wr.write_image_data(&bytes))
-        .expect("PNG");
+    let path = image::out_dir()
+        .expect("output directory")
+        .join("nonconvex_light.png");
+    image::write_png(&path, width, height, &image::to_bytes(&img, 3.0)).expect("PNG");
     println!(
         "{width} x {height} in {:.2} s ({threads} threads); {} pixels gave up (Monte Carlo); \
          largest difference to the union of front triangles on the check grid {worst:.1e}",

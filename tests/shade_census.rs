@@ -4,23 +4,34 @@
 //! near-mirror roughness, points on occluder surfaces), each point shaded with both methods.
 //!
 //! Asserted per point: a valid query gives a finite, non-negative value or
-//! `GeomError::Undecidable`, never another error; per light, `0 <= shadowed <= unshadowed`
-//! (relative 1e-9); the two methods agree within `1e-9` of the light's unshadowed value. Over the
+//! `GeomError::Undecidable`, never another error; per light, `0 <= shadowed <= unshadowed <=`
+//! radiance times the material's directional albedo from the GGX table (relative 1e-9); the two
+//! methods agree within `1e-9` of the light's unshadowed value. Over the
 //! census, give-ups stay below 0.1% of the queries. A subsample is checked against the Monte
 //! Carlo reference (`ReferenceBrdf::Ltc`, the Lambertian lobe: the reference samples lights by
 //! solid angle, which cannot resolve near-mirror lobes) at 4.5 standard errors, with a second stage of 16 times
 //! the samples for a point that fails the first (see tests/shade_exact.rs for the bound's
 //! reasoning; about 300 checks here, so a false alarm has probability near 2e-3).
 //!
-//! `CENSUS_CASES=N` multiplies the number of scenes (default 1: 60 scenes x 40 points).
+//! A second census (`census_of_points_near_cut_light_faces`) lives where a light face's plane
+//! cuts a small occluder: points inside or just outside it, points `1e-6..1e-2` from a light
+//! face, big faces seen from close; its Monte Carlo checks sample the lights' front faces.
+//! Both print their give-up rate per family (light kind / point kind).
+//!
+//! `CENSUS_CASES=N` multiplies the number of scenes (default 1: 60 scenes x 40 points, and 40
+//! scenes x 24 points). `CENSUS_VERBOSE=1` prints every give-up with its arguments,
+//! `CENSUS_DUMP=case` a scene's geometry, `CENSUS_ONLY=case:point` runs that point alone, e.g.
+//! `CENSUS_CASES=5 CENSUS_VERBOSE=1 cargo test --release --test shade_census -- --nocapture`.
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::shade::{
-    Body, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene, TriangleMesh,
+    Body, ConvexPolyhedron, Estimate, Light, LightSampling, Material, Method, MonteCarlo,
+    ReferenceBrdf, Scene, ShadingFrame, TriangleMesh,
 };
+use std::collections::BTreeMap;
 use support::Rng;
-use support::shade::point_on_mesh;
+use support::shade::{point_on_mesh, view_above};
 
 mod support;
 
@@ -165,7 +176,44 @@ struct Tally {
     gave_up_per_triangle: usize,
     mc_checks: usize,
     mc_retested: usize,
+    /// Per family (a label of the light and point kinds): queries and give-ups.
+    families: BTreeMap<String, (usize, usize)>,
     failures: Vec<String>,
+}
+
+impl Tally {
+    /// Prints the totals and the give-up rate per family, then asserts no failures and fewer
+    /// give-ups than 0.1% of the queries.
+    fn report(&self, what: &str) {
+        eprintln!(
+            "{what}: {} queries, {} give-ups ({:.3}%; {} of them PerTriangle), {} Monte Carlo checks ({} re-estimated), {} failures",
+            self.queries,
+            self.gave_up,
+            100.0 * self.gave_up as f64 / self.queries as f64,
+            self.gave_up_per_triangle,
+            self.mc_checks,
+            self.mc_retested,
+            self.failures.len()
+        );
+        for (family, (q, g)) in &self.families {
+            eprintln!(
+                "  {family:<48} {q:>6} queries {g:>4} give-ups ({:.3}%)",
+                100.0 * *g as f64 / *q as f64
+            );
+        }
+        assert!(
+            self.failures.is_empty(),
+            "{} failures:\n{}",
+            self.failures.len(),
+            self.failures.join("\n")
+        );
+        assert!(
+            self.gave_up * 1000 < self.queries,
+            "{} give-ups in {} queries",
+            self.gave_up,
+            self.queries
+        );
+    }
 }
 
 fn cases() -> u64 {
@@ -175,12 +223,153 @@ fn cases() -> u64 {
         .unwrap_or(1)
 }
 
+/// Whether `CENSUS_ONLY=case:point` names another point than this one (to rerun one point, with
+/// `CENSUS_VERBOSE` for its arguments and `CENSUS_DUMP=case` for its scene).
+fn skipped(case: u64, i: usize) -> bool {
+    std::env::var("CENSUS_ONLY").is_ok_and(|only| only != format!("{case}:{i}"))
+}
+
+/// Prints the scene's geometry when `CENSUS_DUMP` names this case.
+fn dump(case: u64, scene: &Scene) {
+    if std::env::var("CENSUS_DUMP").is_ok_and(|d| d == case.to_string()) {
+        for l in scene.lights() {
+            let m = l.shape().mesh();
+            eprintln!("DUMP light {:?} {:?}", m.vertices(), m.triangles());
+        }
+        for o in scene.occluders() {
+            let m = o.mesh();
+            eprintln!("DUMP occ {:?} {:?}", m.vertices(), m.triangles());
+        }
+    }
+}
+
+/// How a point is compared with the Monte Carlo reference, if at all.
+#[derive(Clone, Copy)]
+struct McCheck {
+    sampling: LightSampling,
+    samples: u32,
+    seed: u64,
+}
+
+/// What light 0 of `base` can send at most: its radiance times the directional albedo of the
+/// material, the diffuse albedo plus the GGX table's albedo with Schlick's Fresnel at the
+/// point's view angle (the whole upper hemisphere covered by the light).
+fn albedo_bound(base: &Scene, (x, n, v): (DVec3, DVec3, DVec3), m: &Material) -> DVec3 {
+    let cos_v = ShadingFrame::new(x, n, v).unwrap().view().z;
+    let spec = if m.has_specular() {
+        let look = arealight::ltc::lookup(cos_v, m.alpha()).unwrap();
+        m.f0()
+            .map(|f0| look.albedo * (f0 + (1.0 - f0) * look.fresnel))
+    } else {
+        DVec3::ZERO
+    };
+    base.lights()[0].radiance() * (m.albedo() + spec)
+}
+
+/// Shades one point of `base` (one light) with both methods and records what the census
+/// asserts: a finite value with `0 <= shadowed <= unshadowed` or a give-up, the two methods
+/// within `1e-9` of the unshadowed value, and, with `mc`, the Lambertian lobe against the
+/// Monte Carlo reference at 4.5 standard errors (again with 16 times the samples before a
+/// failure is recorded).
+#[allow(clippy::too_many_arguments)]
+fn check_point(
+    t: &mut Tally,
+    family: &str,
+    base: &Scene,
+    (case, i): (u64, usize),
+    (x, n, v): (DVec3, DVec3, DVec3),
+    m: &Material,
+    mc: Option<McCheck>,
+) {
+    let mut values = Vec::new();
+    for method in [Method::Silhouette, Method::PerTriangle] {
+        let scene = base.clone().with_method(method);
+        t.queries += 1;
+        let fam = t.families.entry(family.to_string()).or_default();
+        fam.0 += 1;
+        match scene.shade_per_light(x, n, v, m) {
+            Ok(parts) => {
+                let p = parts[0];
+                let (s, u) = (p.shadowed(), p.unshadowed());
+                let ok = s.is_finite()
+                    && u.is_finite()
+                    && s.min_element() >= 0.0
+                    && (s - u * (1.0 + 1e-9)).max_element() <= 1e-15
+                    && (u - albedo_bound(base, (x, n, v), m) * (1.0 + 1e-9)).max_element()
+                        <= 1e-15;
+                if !ok {
+                    t.failures.push(format!(
+                        "case {case} point {i} ({family}) {method:?}: shadowed {s} unshadowed {u} at x {x:?} n {n:?} v {v:?}"
+                    ));
+                }
+                values.push((s, u));
+            }
+            Err(e) if e.is_undecidable() => {
+                t.gave_up += 1;
+                fam.1 += 1;
+                t.gave_up_per_triangle += usize::from(method == Method::PerTriangle);
+                if std::env::var("CENSUS_VERBOSE").is_ok() {
+                    eprintln!(
+                        "gave up: case {case} point {i} ({family}) {method:?}: {e}\n  x {x:?} n {n:?} v {v:?}"
+                    );
+                }
+            }
+            Err(e) => t.failures.push(format!(
+                "case {case} point {i} ({family}) {method:?}: error {e:?} at x {x:?} n {n:?} v {v:?}"
+            )),
+        }
+    }
+    if let [(a, u), (b, _)] = values[..]
+        && (a - b).abs().max_element() > 1e-9 * u.max_element() + 1e-15
+    {
+        t.failures.push(format!(
+            "case {case} point {i} ({family}): Silhouette {a} vs PerTriangle {b} (unshadowed {u}) at x {x:?} n {n:?} v {v:?}"
+        ));
+    }
+    // The Lambertian lobe alone: it integrates over the same visible region as the GGX lobe,
+    // and the reference's light sampling (by solid angle) has bounded variance for it, while it
+    // cannot find a glossy lobe of roughness 0.05 or less (its estimate and standard error both
+    // miss the peak; an estimate at roughness 0.05 read 0.220 +- 0.0035, then 0.232 +- 0.005,
+    // against 0.255).
+    let lambert = Material::diffuse(m.albedo()).unwrap();
+    let Some(mc) = mc else { return };
+    if values.is_empty() {
+        return;
+    }
+    let Ok(a) = base.shade(x, n, v, &lambert) else {
+        return;
+    };
+    let est = |samples: u32, seed: u64| {
+        MonteCarlo::new(samples, ReferenceBrdf::Ltc)
+            .with_sampling(mc.sampling)
+            .estimate(base, x, n, v, &lambert, seed)
+            .unwrap()
+    };
+    let agrees = |e: &Estimate, c: usize| {
+        (a[c] - e.mean[c]).abs() <= 4.5 * e.std_error[c] + 1e-6 * (1.0 + a[c])
+    };
+    t.mc_checks += 1;
+    let e = est(mc.samples, mc.seed);
+    if !(0..3).all(|c| agrees(&e, c)) {
+        t.mc_retested += 1;
+        let e2 = est(16 * mc.samples, !mc.seed);
+        for c in (0..3).filter(|&c| !agrees(&e2, c)) {
+            t.failures.push(format!(
+                "case {case} point {i} ({family}) ch {c}: analytic {} mc {} +- {}, then {} +- {} at x {x:?} n {n:?} v {v:?}",
+                a[c], e.mean[c], e.std_error[c], e2.mean[c], e2.std_error[c]
+            ));
+        }
+    }
+}
+
+/// Names of the light kinds of [`random_light`] and of the point kinds of [`point`].
+const LIGHT_KINDS: [&str; 4] = ["quad", "box", "icosphere", "two sheets"];
+const POINT_KINDS: [&str; 3] = ["horizon at a vertex", "on an occluder", "ground"];
+
 #[test]
 fn census_of_the_shade_families() {
     let mut rng = Rng::new(2424);
     let mut t = Tally::default();
-    let mc = MonteCarlo::new(4096, ReferenceBrdf::Ltc);
-    let mc16 = MonteCarlo::new(16 * 4096, ReferenceBrdf::Ltc);
     for case in 0..60 * cases() {
         let c = DVec3::new(
             rng.range(-0.5, 0.5),
@@ -194,127 +383,216 @@ fn census_of_the_shade_families() {
             occ,
         )
         .unwrap();
-        if std::env::var("CENSUS_DUMP").is_ok_and(|d| d == case.to_string()) {
-            eprintln!(
-                "DUMP light {:?}",
-                base.lights()[0].shape().mesh().vertices()
-            );
-            eprintln!(
-                "DUMP tris {:?}",
-                base.lights()[0].shape().mesh().triangles()
-            );
-            for o in base.occluders() {
-                eprintln!(
-                    "DUMP occ {:?} {:?}",
-                    o.mesh().vertices(),
-                    o.mesh().triangles()
-                );
-            }
-        }
+        dump(case, &base);
         let roughness = [0.0, 0.01, 0.05, 0.4][(case % 4) as usize];
         let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), roughness).unwrap();
-        let lambert = Material::diffuse(m.albedo()).unwrap();
         for i in 0..40 {
             let (x, n, v) = point(&mut rng, &base, i);
-            // A point on one box inside another (the generator overlaps them) receives nothing by
-            // the crate's rule, since a convex occluder is an opaque solid; the reference casts
-            // rays against surfaces only and sees out through a box face lying in the light's
-            // plane. Not a point anyone shades.
-            if inside_a_convex_occluder(&base, x) {
+            if skipped(case, i) {
                 continue;
             }
-            let mut values = Vec::new();
-            for method in [Method::Silhouette, Method::PerTriangle] {
-                let scene = base.clone().with_method(method);
-                t.queries += 1;
-                match scene.shade_per_light(x, n, v, &m) {
-                    Ok(parts) => {
-                        let p = parts[0];
-                        let (s, u) = (p.shadowed(), p.unshadowed());
-                        let ok = s.is_finite()
-                            && u.is_finite()
-                            && s.min_element() >= 0.0
-                            && (s - u * (1.0 + 1e-9)).max_element() <= 1e-15;
-                        if !ok {
-                            t.failures.push(format!(
-                                "case {case} point {i} {method:?}: shadowed {s} unshadowed {u} at x {x} n {n} v {v}"
-                            ));
-                        }
-                        values.push((s, u));
-                    }
-                    Err(e) if e.is_undecidable() => {
-                        t.gave_up += 1;
-                        t.gave_up_per_triangle += usize::from(method == Method::PerTriangle);
-                        if std::env::var("CENSUS_VERBOSE").is_ok() {
-                            eprintln!(
-                                "gave up: case {case} point {i} kind {} {method:?}: {e}",
-                                i % 3
-                            );
-                        }
-                    }
-                    Err(e) => t.failures.push(format!(
-                        "case {case} point {i} {method:?}: error {e:?} at x {x} n {n} v {v}"
-                    )),
-                }
-            }
-            if let [(a, u), (b, _)] = values[..]
-                && (a - b).abs().max_element() > 1e-9 * u.max_element() + 1e-15
-            {
-                t.failures.push(format!(
-                    "case {case} point {i}: Silhouette {a} vs PerTriangle {b} (unshadowed {u}) at x {x} n {n} v {v}"
-                ));
-            }
-            // Monte Carlo on every eighth point that has a value, on the Lambertian lobe alone:
-            // it integrates over the same visible region as the GGX lobe, and the reference's
-            // light sampling (by solid angle) has bounded variance for it, while it cannot find
-            // a glossy lobe of roughness 0.05 or less (its estimate and standard error both
-            // miss the peak; an estimate at roughness 0.05 read 0.220 +- 0.0035, then
-            // 0.232 +- 0.005, against 0.255).
-            if i % 8 == 0
-                && !values.is_empty()
-                && let Ok(a) = base.shade(x, n, v, &lambert)
-            {
-                let seed = case * 1000 + i as u64;
-                let e = mc.estimate(&base, x, n, v, &lambert, seed).unwrap();
-                let agrees = |e: &arealight::shade::Estimate, c: usize| {
-                    (a[c] - e.mean[c]).abs() <= 4.5 * e.std_error[c] + 1e-6 * (1.0 + a[c])
-                };
-                t.mc_checks += 1;
-                if !(0..3).all(|c| agrees(&e, c)) {
-                    t.mc_retested += 1;
-                    let e2 = mc16.estimate(&base, x, n, v, &lambert, !seed).unwrap();
-                    for c in (0..3).filter(|&c| !agrees(&e2, c)) {
-                        t.failures.push(format!(
-                            "case {case} point {i} ch {c}: analytic {} mc {} +- {}, then {} +- {} at x {x} n {n} v {v}",
-                            a[c], e.mean[c], e.std_error[c], e2.mean[c], e2.std_error[c]
-                        ));
-                    }
-                }
-            }
+            // A point on one box inside another (the generator overlaps them): every ray leaves
+            // through the outer box, unless it meets the light in the plane of a face of it
+            // first. Each such point is checked against the reference.
+            let inside = inside_a_convex_occluder(&base, x);
+            let family = format!(
+                "{} / {}",
+                LIGHT_KINDS[(case % 4) as usize],
+                POINT_KINDS[i % 3]
+            );
+            // Monte Carlo on every eighth point, sampling the light's unoccluded region.
+            let mc = (i % 8 == 0 || inside).then_some(McCheck {
+                sampling: LightSampling::Silhouette,
+                samples: 4096,
+                seed: case * 1000 + i as u64,
+            });
+            check_point(&mut t, &family, &base, (case, i), (x, n, v), &m, mc);
         }
     }
-    eprintln!(
-        "census: {} queries, {} give-ups ({:.3}%; {} of them PerTriangle), {} Monte Carlo checks ({} re-estimated), {} failures",
-        t.queries,
-        t.gave_up,
-        100.0 * t.gave_up as f64 / t.queries as f64,
-        t.gave_up_per_triangle,
-        t.mc_checks,
-        t.mc_retested,
-        t.failures.len()
-    );
-    assert!(
-        t.failures.is_empty(),
-        "{} failures:\n{}",
-        t.failures.len(),
-        t.failures.join("\n")
-    );
-    assert!(
-        t.gave_up * 1000 < t.queries,
-        "{} give-ups in {} queries",
-        t.gave_up,
-        t.queries
-    );
+    t.report("census");
+}
+
+/// A light of the near-face family about `c`: a big quad (2 to 8 across) facing down, two
+/// sheets 0.05..0.3 apart facing each other (an open mesh light, always taken face by face), a
+/// box or an icosphere.
+fn near_face_light(rng: &mut Rng, c: DVec3, kind: u64) -> Body {
+    match kind % 4 {
+        0 => {
+            let s = rng.range(1.0, 4.0);
+            TriangleMesh::quad(c, DVec3::Y * s, DVec3::X * s)
+                .unwrap()
+                .into()
+        }
+        1 => {
+            let h = rng.range(0.5, 2.0);
+            let gap = rng.range(0.05, 0.3);
+            let below = c + DVec3::new(rng.range(-0.2, 0.2), rng.range(-0.2, 0.2), -gap);
+            TriangleMesh::quad(c, DVec3::Y * h, DVec3::X * h)
+                .unwrap()
+                .merged(&TriangleMesh::quad(below, DVec3::X * h, DVec3::Y * h).unwrap())
+                .unwrap()
+                .into()
+        }
+        2 => ConvexPolyhedron::cuboid(
+            c,
+            DVec3::new(
+                rng.range(0.3, 0.8),
+                rng.range(0.3, 0.8),
+                rng.range(0.2, 0.5),
+            ),
+        )
+        .unwrap()
+        .into(),
+        _ => ConvexPolyhedron::icosphere(c, rng.range(0.3, 0.8), 1)
+            .unwrap()
+            .into(),
+    }
+}
+
+/// A uniform point of triangle `f` of `mesh`.
+fn point_on_triangle(rng: &mut Rng, mesh: &TriangleMesh, f: usize) -> DVec3 {
+    let [a, b, c] = mesh.triangle(f);
+    let (mut u, mut v) = (rng.f64(), rng.f64());
+    if u + v > 1.0 {
+        (u, v) = (1.0 - u, 1.0 - v);
+    }
+    a + u * (b - a) + v * (c - a)
+}
+
+/// A small convex occluder (radius `1e-1.7..1e-0.7`, an icosphere or a box) whose centre lies
+/// within 0.8 of its radius of the plane of light triangle `f`, over the triangle: the face's
+/// plane cuts it.
+fn cut_occluder(rng: &mut Rng, light: &TriangleMesh, f: usize) -> Body {
+    let r = 10f64.powf(rng.range(-1.7, -0.7));
+    let centre =
+        point_on_triangle(rng, light, f) + light.triangle_normal(f) * r * rng.range(-0.8, 0.8);
+    if rng.f64() < 0.5 {
+        ConvexPolyhedron::icosphere(centre, r, 1).unwrap().into()
+    } else {
+        let h = DVec3::new(
+            r * rng.range(0.5, 1.0),
+            r * rng.range(0.5, 1.0),
+            r * rng.range(0.5, 1.0),
+        );
+        ConvexPolyhedron::cuboid(centre, h).unwrap().into()
+    }
+}
+
+/// Names of the point kinds of [`near_face_point`].
+const NEAR_FACE_POINTS: [&str; 3] = [
+    "near an occluder face",
+    "near the face over the occluder",
+    "near the face anywhere",
+];
+
+/// A shading point of the near-face family, in front of light triangle `f`:
+/// - kind 0: on a face of the occluder that is not wholly behind `f`'s plane, moved off that
+///   face by `1e-13..1e-3` of the occluder's radius, inwards or outwards (inside or just outside
+///   the occluder, close to the part of it that the face's plane cuts);
+/// - kind 1: `1e-6..1e-2` in front of `f`'s plane, over the occluder's footprint (inside it
+///   where its cut disc is);
+/// - kind 2: `1e-6..1e-2` in front of a point of `f` (a big face seen from close covers nearly
+///   a hemisphere).
+///
+/// Normals: uniform half of the time, else parallel to `f`'s plane or facing it. `None` when the
+/// draw lies behind `f`'s plane.
+fn near_face_point(
+    rng: &mut Rng,
+    light: &TriangleMesh,
+    f: usize,
+    occ: &TriangleMesh,
+    kind: usize,
+) -> Option<(DVec3, DVec3, DVec3)> {
+    let (a, nf) = (light.triangle(f)[0], light.triangle_normal(f));
+    let r = occ.bounding_sphere().radius;
+    let near = 10f64.powf(rng.range(-6.0, -2.0));
+    let x = match kind {
+        0 => {
+            let t = rng.below(occ.triangle_count());
+            let sign = if rng.f64() < 0.5 { -1.0 } else { 1.0 };
+            point_on_triangle(rng, occ, t)
+                + occ.triangle_normal(t) * sign * r * 10f64.powf(rng.range(-13.0, -3.0))
+        }
+        1 => {
+            let c = occ.bounding_sphere().center;
+            let (u, w) = nf.any_orthonormal_pair();
+            let on_plane = c - nf * nf.dot(c - a);
+            on_plane + (u * rng.range(-1.0, 1.0) + w * rng.range(-1.0, 1.0)) * r + nf * near
+        }
+        _ => point_on_triangle(rng, light, f) + nf * near,
+    };
+    if nf.dot(x - a) <= 0.0 {
+        return None;
+    }
+    let n = match rng.below(4) {
+        0 | 1 => rng.dir(),
+        2 => {
+            let (u, w) = nf.any_orthonormal_pair();
+            let phi = rng.range(0.0, std::f64::consts::TAU);
+            u * phi.cos() + w * phi.sin()
+        }
+        _ => -nf,
+    };
+    let v = if rng.f64() < 0.5 {
+        view_above(rng, n, 0.0)
+    } else {
+        let c = rng.range(1e-4, 0.05);
+        let (t, _) = n.any_orthonormal_pair();
+        n * c + t * (1.0 - c * c).sqrt()
+    };
+    Some((x, n, v))
+}
+
+/// The family of the `sheet_light_seen_from_inside_a_small_icosphere_it_cuts` regression
+/// (tests/shade_regressions.rs): small convex occluders that a light face's plane cuts, shading
+/// points inside or just outside them, points `1e-6..1e-2` from a light face, big faces seen
+/// from close. Asserted as in [`census_of_the_shade_families`], with the Monte Carlo reference
+/// on every fourth point sampling the light's front faces (independent of the light regions
+/// under test).
+#[test]
+fn census_of_points_near_cut_light_faces() {
+    let mut rng = Rng::new(2525);
+    let mut t = Tally::default();
+    for case in 0..40 * cases() {
+        let c = DVec3::new(
+            rng.range(-0.5, 0.5),
+            rng.range(-0.5, 0.5),
+            rng.range(1.5, 2.5),
+        );
+        let body = near_face_light(&mut rng, c, case);
+        let lm = body.mesh().clone();
+        let f = rng.below(lm.triangle_count());
+        let occ = cut_occluder(&mut rng, &lm, f);
+        let om = occ.mesh().clone();
+        let base = Scene::new(
+            vec![Light::new(body, DVec3::new(1.0, 0.8, 0.6)).unwrap()],
+            vec![occ],
+        )
+        .unwrap();
+        dump(case, &base);
+        let roughness = [0.0, 0.01, 0.05, 0.4][(case % 4) as usize];
+        let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), roughness).unwrap();
+        for i in 0..24 {
+            let Some((x, n, v)) = near_face_point(&mut rng, &lm, f, &om, i % 3) else {
+                continue;
+            };
+            if skipped(case, i) {
+                continue;
+            }
+            let family = format!(
+                "{} / {}",
+                ["big quad", "two sheets", "box", "icosphere"][(case % 4) as usize],
+                NEAR_FACE_POINTS[i % 3]
+            );
+            let mc = (i % 4 == 0).then_some(McCheck {
+                sampling: LightSampling::Faces,
+                samples: 4096,
+                seed: case * 1000 + i as u64,
+            });
+            check_point(&mut t, &family, &base, (case, i), (x, n, v), &m, mc);
+        }
+    }
+    t.report("near-face census");
 }
 
 /// Invalid arguments stay input faults in these scenes too.

@@ -1,5 +1,6 @@
-//! Issue 24's shade-level reproducers (6 to 9): scenes a new user builds whose shading was a
-//! silently wrong value or an error on valid input. Each is checked against the Monte Carlo
+//! Issue 24's shade-level reproducers (6 to 9) and minimized census findings
+//! (tests/shade_census.rs): scenes whose shading was a silently wrong value, an error on valid
+//! input, or a give-up. Each is checked against the Monte Carlo
 //! reference (`ReferenceBrdf::Ltc`, the BRDF the analytic path models, so that only visibility
 //! differs) at 4.5 standard errors plus a relative 1e-6 for its rounding, or against an exact
 //! identity (a light shaded twice, a light in a scene of its own).
@@ -320,4 +321,150 @@ fn reproducer_8_far_point_with_an_occluder_gets_a_tiny_value() {
             free.x
         );
     }
+}
+
+/// Two sheets of a census light (tests/shade_census.rs, light kind 3): triangles `[0, 1, 2]`,
+/// `[0, 2, 3]` of the lower sheet facing down and the same of the upper one.
+fn two_sheets(v8: [DVec3; 8]) -> TriangleMesh {
+    TriangleMesh::new(
+        v8.to_vec(),
+        vec![[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]],
+    )
+    .unwrap()
+}
+
+/// `scene` shaded with both methods: equal within 1e-9 of the value, and the Monte Carlo
+/// reference agrees (see [`assert_matches_mc`]).
+fn assert_methods_and_mc(what: &str, scene: Scene, x: DVec3, n: DVec3, view: DVec3) {
+    let m = diffuse();
+    let a = scene.shade(x, n, view, &m).unwrap();
+    let per = scene.clone().with_method(Method::PerTriangle);
+    let b = per
+        .shade(x, n, view, &m)
+        .unwrap_or_else(|e| panic!("{what}: {e:?}"));
+    assert!(
+        (a - b).abs().max_element() <= 1e-9 * a.max_element(),
+        "{what}: {a} vs {b}"
+    );
+    assert_matches_mc(what, &scene, x, n, view, &m);
+}
+
+/// A sliver occluder (its third vertex 1e-12 of its length off the line of the other two) that
+/// the lower sheet's plane cuts through both long edges, 1.7e-12 apart: the cut quadrilateral,
+/// projected, folds back within rounding, and the query gave up (census case 255 at
+/// `CENSUS_CASES=5`). Its solid angle, bounded on its fan, is below what the sphere layer
+/// resolves: it covers nothing.
+#[test]
+fn sliver_cut_by_a_light_plane_through_both_long_edges() {
+    let sheets = two_sheets([
+        v(
+            -0.27629705746767286,
+            -0.7620828334948009,
+            2.3385006980673775,
+        ),
+        v(
+            -0.27629705746767286,
+            0.32030539462759067,
+            2.3385006980673775,
+        ),
+        v(0.8060911706547187, 0.32030539462759067, 2.3385006980673775),
+        v(0.8060911706547187, -0.7620828334948009, 2.3385006980673775),
+        v(-0.5486539210709264, -0.7620828334948009, 2.6524794094459905),
+        v(-0.5486539210709264, 0.32030539462759067, 2.6524794094459905),
+        v(0.5337343070514652, 0.32030539462759067, 2.6524794094459905),
+        v(0.5337343070514652, -0.7620828334948009, 2.6524794094459905),
+    ]);
+    let sliver = TriangleMesh::new(
+        vec![
+            v(0.4025046460461048, -0.4010611479721148, 2.452577496704594),
+            v(0.6627000786457589, -0.19278217630566977, 2.154057911598133),
+            v(0.5556375748898016, -0.27848263600792933, 2.2768896380492567),
+        ],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
+    let scene = Scene::new(
+        vec![Light::new(sheets, DVec3::new(1.0, 0.8, 0.6)).unwrap()],
+        vec![sliver.into()],
+    )
+    .unwrap();
+    assert_methods_and_mc(
+        "census 255:2",
+        scene,
+        v(0.7576565195956513, 0.10300093211591088, 0.0),
+        v(0.0, 0.0, 1.0),
+        v(0.99975602411972, 0.0, 0.02208828278363511),
+    );
+}
+
+/// A sliver occluder 2.2 rad long and 8e-13 rad wide seen from a point on a box face: its
+/// projection folds back at a corner (a wedge below 1e-12 rad) though its solid angle is
+/// 9.9e-13 sr, above the 1e-12 sr that was certified to cover nothing, and the query gave up
+/// (census case 215 at `CENSUS_CASES=5`). A triangle with such a corner lies in a lune of
+/// 2e-12 sr.
+#[test]
+fn long_sliver_seen_with_a_corner_below_the_fold_test() {
+    let sheets = two_sheets([
+        v(
+            -0.37284029592149937,
+            -0.7173967268137957,
+            1.8038782273453542,
+        ),
+        v(
+            -0.37284029592149937,
+            0.24398464508734996,
+            1.8038782273453542,
+        ),
+        v(0.5885410759796463, 0.24398464508734996, 1.8038782273453542),
+        v(0.5885410759796463, -0.7173967268137957, 1.8038782273453542),
+        v(
+            -0.18948193952119247,
+            -0.7173967268137957,
+            2.2781337759792897,
+        ),
+        v(
+            -0.18948193952119247,
+            0.24398464508734996,
+            2.2781337759792897,
+        ),
+        v(0.7718994323799533, 0.24398464508734996, 2.2781337759792897),
+        v(0.7718994323799533, -0.7173967268137957, 2.2781337759792897),
+    ]);
+    let sliver = TriangleMesh::new(
+        vec![
+            v(
+                -0.014902834998565997,
+                -0.04677988127660854,
+                0.7969957209175123,
+            ),
+            v(
+                -0.12908020193304331,
+                -0.04540665089422305,
+                1.386296251114674,
+            ),
+            v(
+                -0.06741935399516182,
+                -0.04614825627505141,
+                1.0680477982308811,
+            ),
+        ],
+        vec![[0, 1, 2]],
+    )
+    .unwrap();
+    let scene = Scene::new(
+        vec![Light::new(sheets, DVec3::new(1.0, 0.8, 0.6)).unwrap()],
+        vec![sliver.into()],
+    )
+    .unwrap();
+    assert_methods_and_mc(
+        "census 215:13",
+        scene,
+        v(
+            0.06913413265098811,
+            0.019832009320439076,
+            1.0930474670953358,
+        ),
+        v(0.0, -1.0, 0.0),
+        v(0.999515634572607, -0.031120672308271778, 0.0),
+    );
 }

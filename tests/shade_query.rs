@@ -160,3 +160,45 @@ fn per_light_query_reports_the_same_errors_as_shade() {
         })
     );
 }
+
+/// Found by the `shade` fuzz target: a point on the surface of a small icosphere light, beside a
+/// long quad light. A light's shadowed and unshadowed values can come from different paths (the
+/// visibility fast path and the spherical one), which agree to rounding; `shade_per_light`
+/// clamped the shadowed value to the unshadowed one, so its shares no longer added up to `shade`
+/// (2.1e-11 relative here). The shares are now exactly what `shade` computes per light.
+#[test]
+fn shares_add_up_to_shade_where_the_paths_differ_by_rounding() {
+    let g = |x: f64, y: f64, z: f64| DVec3::new(x, y, z) / 8.0;
+    let rgb = DVec3::new(1.0, 2.0, 0.5);
+    let ico = ConvexPolyhedron::icosphere(g(-79.0, 0.0, -65.0), 1.0 / 16.0, 1).unwrap();
+    let quad = TriangleMesh::quad(g(0.0, -1.0, -1.0), g(0.0, 0.0, -1.0), g(-1.0, -1.0, 64.0));
+    let scene = Scene::new(
+        vec![
+            Light::new(ico, rgb).unwrap(),
+            Light::new(quad.unwrap(), rgb).unwrap(),
+        ],
+        vec![],
+    )
+    .unwrap();
+    let m = Material::new(
+        DVec3::splat(142.0 / 255.0),
+        DVec3::splat(14.0 / 255.0),
+        142.0 / 255.0,
+    )
+    .unwrap();
+    let x = DVec3::new(-9.821834324477997, 0.0, -8.092141805492554);
+    let (n, v) = (DVec3::new(-0.0, -0.0, -1.0), DVec3::Z);
+    let total = scene.shade(x, n, v, &m).unwrap();
+    let sum: DVec3 = scene
+        .shade_per_light(x, n, v, &m)
+        .unwrap()
+        .iter()
+        .map(|p| p.shadowed())
+        .sum();
+    for c in 0..3 {
+        assert!(
+            (sum[c] - total[c]).abs() <= 1e-12 * total[c].abs(),
+            "shares {sum} vs shade {total}"
+        );
+    }
+}

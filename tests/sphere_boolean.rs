@@ -553,3 +553,214 @@ fn regression_union_with_vertex_copies_ulps_apart() {
     .unwrap();
     check_identities(&a, &b).unwrap();
 }
+
+#[test]
+fn regression_rings_sharing_an_edge_through_vertex_copies_1e12_apart() {
+    // A light face minus the cut side triangles of a box touching its plane (tests/shade_census.rs,
+    // case 208 at CENSUS_CASES=5): the running difference `a` holds two outer rings (1 and 2)
+    // that share an edge whose two vertex copies lie 1e-12 apart, each an intersection point
+    // computed in another projection. Valid on the sphere, but projected the two edges cross,
+    // which the planar validation rejects in every projection and octant; welding them makes
+    // the rings overlap along the edge. The projected rings are read under the positive fill
+    // rule instead.
+    let v = DVec3::new;
+    let a = SphericalPolygon::new(vec![
+        vec![
+            v(
+                -0.33715148465616496,
+                -0.002970467742793994,
+                0.9414457247847763,
+            ),
+            v(
+                -0.33653860527021756,
+                -0.060341687974531315,
+                0.9397343496197003,
+            ),
+            v(
+                -0.3502376764013839,
+                -0.06279794429339862,
+                0.9345533629608759,
+            ),
+            v(-0.4340368808005864, -0.0604000474259736, 0.8988680772926791),
+            v(
+                -0.41613686146560425,
+                -0.2900589964427813,
+                0.8617980570366605,
+            ),
+            v(-0.2776901932547135, -0.1386184140818011, 0.9506172162587874),
+            v(
+                -0.27877890635351554,
+                -0.10728211204887807,
+                0.9543442092906886,
+            ),
+            v(
+                -0.2559629764347708,
+                -0.09850188838684043,
+                0.9616549967004171,
+            ),
+            v(
+                -0.24018802621516536,
+                -0.09891352929963569,
+                0.9656737677830713,
+            ),
+            v(
+                -0.006554012536182908,
+                0.13833259503210815,
+                0.9903641441769578,
+            ),
+            v(-0.4314312935178255, 0.12479884959194724, 0.8934720399173454),
+            v(-0.43418492385837754, 0.0544827530004199, 0.8991746668582195),
+            v(-0.3503668157425352, 0.05664729668821203, 0.934897950689996),
+            v(-0.3366531713953598, 0.05443007506474083, 0.9400542586031368),
+        ],
+        vec![
+            v(
+                -0.27877890635351554,
+                -0.10728211204887807,
+                0.9543442092906886,
+            ),
+            v(
+                -0.2611572429162339,
+                -0.12105280572484718,
+                0.9576758912589026,
+            ),
+            v(
+                -0.24794593197272838,
+                -0.10708642670405115,
+                0.9628371160450416,
+            ),
+            v(
+                -0.24788224023479263,
+                -0.10653917895127205,
+                0.962914221685696,
+            ),
+        ],
+        vec![
+            v(
+                -0.24788224023375427,
+                -0.10653917895124534,
+                0.9629142216859661,
+            ),
+            v(-0.247945931971412, -0.10708642670266276, 0.9628371160455351),
+            v(
+                -0.24741570366269083,
+                -0.10652717121782244,
+                0.9630355296526834,
+            ),
+        ],
+    ])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(
+            -0.10484602205110993,
+            -0.11109515621675774,
+            0.9882637188145845,
+        ),
+        v(
+            -0.2787789063535155,
+            -0.10728211204887808,
+            0.9543442092906887,
+        ),
+        v(
+            -0.10246725140247803,
+            -0.23801291674799122,
+            0.9658417643957706,
+        ),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    assert_difference_matches_mc(&a, &b, 208);
+}
+
+/// The difference checked against stratified Monte Carlo containment in the operands.
+fn assert_difference_matches_mc(a: &SphericalPolygon, b: &SphericalPolygon, seed: u64) {
+    let d = a.boolean(b, BoolOp::Difference).unwrap();
+    let mut rng = Rng::new(seed);
+    let mc = mc_solid_angle(&mut rng, 256, 512, |p| a.contains(p) && !b.contains(p));
+    let cells = crossed_cells(boundary_edges(a).chain(boundary_edges(b)), 256, 512);
+    assert_mc_agrees(d.solid_angle(), mc, cells, "a - b");
+}
+
+#[test]
+fn regression_octant_pieces_with_a_notch_narrower_than_the_silhouette_tolerance() {
+    // A light face's part seen from a box face (tests/shade_census.rs, case 189 at
+    // CENSUS_CASES=5) after a sliver occluder cut a notch into it, 1.3e-11 wide at its mouth and
+    // 1e-10 at its end, minus a quad crossing the horizon. No cap narrower than a hemisphere
+    // holds both, so the octant split solves the pieces; joining their rings at the silhouette
+    // tolerance (1e-9) closed the notch into an edge walked twice. The pieces are joined within
+    // 1e-13 when that fails.
+    let v = DVec3::new;
+    let a = SphericalPolygon::new(vec![vec![
+        v(-0.16511769471157847, 0.9862738701259067, 0.0),
+        v(0.05936841668733583, 0.2609116823376376, 0.9635354093751732),
+        v(0.2184734868821402, 0.12365065690423623, 0.9679771952771977),
+        v(0.21847348690723353, 0.12365065682204285, 0.9679771952820336),
+        v(0.05936841669941417, 0.26091168227572753, 0.9635354093911933),
+        v(0.19104542268463542, -0.7045131375627413, 0.6834931495433961),
+        v(0.26172150129994853, -0.9651434379185827, 0.0),
+        v(
+            0.9769035015781964,
+            0.21368095049456048,
+            9.319347839783076e-17,
+        ),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(0.2988219341635244, -0.9543088869243387, 0.0),
+        v(0.26880116855758873, -0.8584354581875471, 0.4368460780508519),
+        v(
+            -0.6870506422455467,
+            -0.6838826383015593,
+            0.24549124631986524,
+        ),
+        v(0.049252213552150925, -0.9987863732852053, 0.0),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    assert_difference_matches_mc(&a, &b, 189);
+}
+
+#[test]
+fn regression_octant_piece_with_a_crossing_1e11_from_a_pinch() {
+    // A big quad light's face seen 1e-9 from an occluder face (tests/shade_census.rs, near-face
+    // census case 164 at CENSUS_CASES=10): `a` is pinched at a vertex that the edge of `b`, the
+    // cut occluder triangle seen from so close that it covers nearly a hemisphere, passes
+    // within 1.2e-11 of. The octant piece holds a ring from the pinch to the crossing point
+    // next to it, which the silhouette tolerance merged into one vertex.
+    let v = DVec3::new;
+    let a = SphericalPolygon::new(vec![vec![
+        v(0.888974126652018, 0.0, 0.4579574239416606),
+        v(0.8925914460878522, 0.0498363334732667, 0.4481036155140217),
+        v(0.7936741031717446, 0.08700878979265583, 0.6020887712400425),
+        v(0.8349152249708099, 0.07310679137567719, 0.5455015711862755),
+        v(0.8925914460878522, 0.0498363334732667, 0.4481036155140217),
+        v(
+            0.4152000007164927,
+            0.9097301574670505,
+            8.492637520837422e-17,
+        ),
+        v(0.0, 1.0, 1.2819751242557095e-16),
+        v(-1.0, 0.0, 0.0),
+        v(-0.4637480047911058, -0.8859671484046509, 0.0),
+        v(
+            9.800142082344398e-18,
+            -0.9665130959233881,
+            0.25661729366624486,
+        ),
+        v(
+            0.8451641394057182,
+            -0.22002628780037123,
+            0.48712011879964456,
+        ),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(0.9987810827737618, -0.04935938303172268, 0.0),
+        v(0.7936741031717447, 0.08700878979265578, 0.6020887712400423),
+        v(-0.9987810828547851, 0.04935938139222259, 0.0),
+        v(-0.04935938221197274, -0.9987810828142734, 0.0),
+    ]])
+    .unwrap();
+    check_identities(&a, &b).unwrap();
+    assert_difference_matches_mc(&a, &b, 164);
+}

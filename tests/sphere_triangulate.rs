@@ -546,3 +546,57 @@ fn regression_antipodal_diagonal_of_a_hemisphere_sized_ring() {
     );
     assert!(r.area_error <= 1e-12, "{}", r.area_error);
 }
+
+/// Found by the `sphere_triangulate` fuzz target: a quadrilateral larger than a hemisphere
+/// (7.75 sr) whose triangles summed to 1.47 sr.
+#[test]
+fn regression_fuzz_quadrilateral_larger_than_a_hemisphere() {
+    let v = [
+        [
+            -0.5773502691896258,
+            -0.5773502691896258,
+            -0.5773502691896258,
+        ],
+        [
+            -0.43973837326775983,
+            0.8717620382325765,
+            0.21601183248240832,
+        ],
+        [
+            0.8928696638805241,
+            0.007631364648551489,
+            0.45025051426453777,
+        ],
+        [-0.7071067811865475, -0.7071067811865475, 0.0],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    run("fuzz quadrilateral larger than a hemisphere", &p);
+}
+
+/// Found by the `sphere_triangulate` fuzz target: a triangle with two vertices 6e-4 from
+/// antipodal. Its own area (from the shorter of `b -+ a`) is within 2e-14 of the exact value of
+/// the rounded vertices; the checker's plain Van Oosterom-Strackee reference is off by 5e-13, as
+/// the arc between such vertices is known only to `eps / |a + b|`, which the check now allows.
+#[test]
+fn regression_fuzz_triangle_with_nearly_antipodal_vertices() {
+    let v = [
+        [0.9996876464081226, 0.0, -0.024992191160203066],
+        [
+            -0.008337097456224104,
+            -0.12505646184336155,
+            -0.9921145972906684,
+        ],
+        [-0.99970269064305, 0.0, 0.024382992454708537],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    let r = run("fuzz triangle with nearly antipodal vertices", &p);
+    // The exact solid angle of the rounded vertices (50-digit arithmetic): 0.2507261794505107.
+    let sum: f64 = p
+        .triangulate()
+        .unwrap()
+        .iter()
+        .map(|t| t.solid_angle())
+        .sum();
+    assert!((sum - 0.2507261794505107).abs() <= 1e-13, "{sum}");
+    assert_eq!(r.extra_vertices, 0);
+}

@@ -10,14 +10,18 @@
 //!   documented give-up), never another error;
 //! - the radiance is never above the unoccluded value: each light's share (`shade_per_light`) is
 //!   at most its unshadowed value, which equals the light shaded in a scene of its own, and the
-//!   shares add up to `Scene::shade`.
+//!   shares add up to `Scene::shade`;
+//! - no light sends more than its radiance times the material's directional albedo (the
+//!   diffuse albedo plus the GGX table's, with Schlick's Fresnel).
 //!
 //! Run: `RUSTC_BOOTSTRAP=1 cargo fuzz run shade -- -max_total_time=600` (from the crate root).
 #![no_main]
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
-use arealight::shade::{Body, ConvexPolyhedron, Light, Material, Method, Scene, TriangleMesh};
+use arealight::shade::{
+    Body, ConvexPolyhedron, Light, Material, Method, Scene, ShadingFrame, TriangleMesh,
+};
 use libfuzzer_sys::arbitrary::{self, Arbitrary};
 use libfuzzer_sys::fuzz_target;
 
@@ -186,6 +190,22 @@ fn expected_fault(x: DVec3, n: DVec3, v: DVec3) -> Option<GeomError> {
     None
 }
 
+/// The material's directional albedo at the point's view angle: the diffuse albedo plus the
+/// GGX table's albedo with Schlick's Fresnel. No light can send more than its radiance times it.
+fn albedo(x: DVec3, n: DVec3, v: DVec3, m: &Material) -> DVec3 {
+    let Ok(frame) = ShadingFrame::new(x, n, v) else {
+        return DVec3::INFINITY;
+    };
+    let spec = match arealight::ltc::lookup(frame.view().z, m.alpha()) {
+        Ok(look) if m.has_specular() => m
+            .f0()
+            .map(|f0| look.albedo * (f0 + (1.0 - f0) * look.fresnel)),
+        Ok(_) => DVec3::ZERO,
+        Err(_) => DVec3::INFINITY,
+    };
+    m.albedo() + spec
+}
+
 /// `a <= b` up to the rounding of two evaluations of one region by different decompositions
 /// (the silhouette against face by face, with endpoints merged within
 /// `sphere::MATCH_TOLERANCE` = 1e-9 rad along the way): relative `1e-7`. The failures this
@@ -304,7 +324,13 @@ fuzz_target!(|case: Case| {
             return;
         };
         let un = part.unshadowed();
+        let most = light.radiance() * albedo(x, n, v, &material);
         for c in 0..3 {
+            assert!(
+                close_or_below(un[c], most[c]),
+                "light {i}: unshadowed {un} above radiance times albedo {most}\n{}",
+                describe()
+            );
             assert!(
                 (un[c] - alone[c]).abs() <= 1e-12 * alone[c].abs() + 1e-300,
                 "light {i}: unshadowed {un} vs alone {alone}\n{}",

@@ -469,6 +469,112 @@ pub(crate) fn clamped_cosine_integral_upper(poly: &SphericalPolygon) -> f64 {
     upper_sum(poly, Exact)
 }
 
+/// [`clamped_cosine_integral_upper`] of a region given as a chain of rings of directions of any
+/// positive length (not normalized: Baum's edge terms are invariant under positive scaling of
+/// each endpoint) in the closed upper hemisphere: the sum of the rings' edge terms, whatever the
+/// rings' orientation or overlap, is the integral weighted by the chain's winding number, which
+/// for the shading fast path's regions (`crate::visibility::Pieces`) is the region's indicator.
+/// The diffuse integral of that path, the same sum as the polygon's up to rounding.
+pub(crate) fn upper_rings_integral<'a>(rings: impl Iterator<Item = &'a [DVec3]>) -> f64 {
+    let mut sum = 0.0;
+    for ring in rings {
+        let Some(&last) = ring.last() else {
+            continue;
+        };
+        let mut prev = Ray::new(last);
+        for &v in ring {
+            let cur = Ray::new(v);
+            sum += edge_term(prev, cur);
+            prev = cur;
+        }
+    }
+    integral_of_sum(sum)
+}
+
+/// [`ltc_integral`] of a region given as a chain of rings (as for [`upper_rings_integral`]) in
+/// the closed upper hemisphere (clipped at the shading horizon, as the LTC tables assume): the
+/// specular integral of the shading fast path.
+///
+/// The clip-free kernel ([`transformed_clip_free`], the same code as for a polygon: the quad and
+/// single-ring kernels for one ring, the general loop for several) decides most regions; where it
+/// hands over (an image within rounding of the cosine's horizon, as the images of a piece's
+/// vertices on the shading horizon under a map that keeps the horizon), each ring's images are
+/// clipped at the horizon by Sutherland–Hodgman in homogeneous coordinates and Baum's sum is
+/// taken over the result: one plane, so the clipped chain's winding number is the ring's times
+/// the half-space's indicator for any ring (the parts outside are closed into loops outside by
+/// the same bridges along the horizon). `None` only for a map that is singular, not finite or
+/// reverses orientation, which the LTC tables never give.
+pub(crate) fn ltc_rings_integral<'a, I>(rings: I, m_inv: glam::DMat3) -> Option<f64>
+where
+    I: Iterator<Item = &'a [DVec3]> + Clone,
+{
+    let mut one = rings.clone();
+    let v = match (one.next(), one.next()) {
+        (Some(ring), None) => transformed_clip_free(ring, &m_inv, Exact),
+        _ => transformed_clip_free(&RingChain(rings.clone()), &m_inv, Exact),
+    };
+    v.or_else(|| clipped_rings_integral(rings, m_inv))
+}
+
+/// Several rings integrated as one region by the clip-free path ([`ring_sum`]).
+struct RingChain<I>(I);
+
+impl<'a, I: Iterator<Item = &'a [DVec3]> + Clone> ClipFreeInput for RingChain<I> {
+    #[inline(always)]
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+        ring_sum(self.0.clone(), map, edge)
+    }
+}
+
+/// The exact path of [`ltc_rings_integral`], out of line.
+#[cold]
+#[inline(never)]
+fn clipped_rings_integral<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+    m_inv: glam::DMat3,
+) -> Option<f64> {
+    let m = crate::math::unit_scaled(m_inv)?;
+    if !(m.determinant() > 0.0) {
+        return None;
+    }
+    let mut sum = 0.0;
+    let mut up: smallvec::SmallVec<[DVec3; 32]> = smallvec::SmallVec::new();
+    for ring in rings {
+        let Some(&last) = ring.last() else {
+            continue;
+        };
+        up.clear();
+        let mut prev = m * last;
+        for &v in ring {
+            let cur = m * v;
+            if prev.z >= 0.0 {
+                up.push(prev);
+            }
+            if (prev.z > 0.0 && cur.z < 0.0) || (prev.z < 0.0 && cur.z > 0.0) {
+                // A positive combination of the two with `z` exactly zero (the products
+                // commute).
+                let (a, b) = if prev.z > 0.0 {
+                    (prev, cur)
+                } else {
+                    (cur, prev)
+                };
+                let x = a * -b.z + b * a.z;
+                up.push(DVec3::new(x.x, x.y, 0.0));
+            }
+            prev = cur;
+        }
+        if let Some(&last) = up.last() {
+            let mut prev = Ray::new(last);
+            for &v in &up {
+                let cur = Ray::new(v);
+                sum += edge_term(prev, cur);
+                prev = cur;
+            }
+        }
+    }
+    Some(integral_of_sum(sum))
+}
+
 /// `(1 / pi)` times the integral of `max(0, z)` over the polygon: the irradiance from a uniform
 /// unit-radiance light filling the polygon onto a surface with normal `+z`, relative to a light
 /// filling the whole hemisphere. In `[0, 1]`.
@@ -532,9 +638,45 @@ fn clip_free_sum(
     edge: impl EdgeTerm,
 ) -> Option<f64> {
     match poly.single_ring() {
-        Some(ring) if ring.len() == 4 => quad_sum(ring, map, edge),
-        Some(ring) => single_ring_sum(ring, map, edge),
+        Some(ring) => ring_clip_free_sum(ring, map, edge),
         None => ring_sum(poly.rings(), map, edge),
+    }
+}
+
+/// [`clip_free_sum`] of one ring: quads through [`quad_sum`], other rings through
+/// [`single_ring_sum`].
+#[inline(always)]
+fn ring_clip_free_sum(
+    ring: &[DVec3],
+    map: impl Fn(DVec3) -> DVec3,
+    edge: impl EdgeTerm,
+) -> Option<f64> {
+    if ring.len() == 4 {
+        quad_sum(ring, map, edge)
+    } else {
+        single_ring_sum(ring, map, edge)
+    }
+}
+
+/// What the clip-free path integrates: the rings of a [`SphericalPolygon`], or one bare ring of
+/// directions of any positive length (the pieces of the shading fast path, which are never
+/// built as polygons). Generic, so that each caller's code is the kernel inlined for its input.
+trait ClipFreeInput {
+    /// The clip-free sum of the images of the vertices under `map` ([`clip_free_sum`]).
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64>;
+}
+
+impl ClipFreeInput for SphericalPolygon {
+    #[inline(always)]
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+        clip_free_sum(self, map, edge)
+    }
+}
+
+impl ClipFreeInput for [DVec3] {
+    #[inline(always)]
+    fn clip_free(&self, map: impl Fn(DVec3) -> DVec3, edge: impl EdgeTerm) -> Option<f64> {
+        ring_clip_free_sum(self, map, edge)
     }
 }
 
@@ -985,8 +1127,8 @@ fn integral_of_sum(sum: f64) -> f64 {
 /// The matrix is read entry by entry: a caller's freshly stored matrix read back with wide loads
 /// at other offsets stalls store-to-load forwarding, which cost more than the rest of a quad.
 #[inline(always)]
-fn transformed_clip_free(
-    poly: &SphericalPolygon,
+fn transformed_clip_free<P: ClipFreeInput + ?Sized>(
+    poly: &P,
     m: &glam::DMat3,
     edge: impl EdgeTerm,
 ) -> Option<f64> {
@@ -1004,7 +1146,7 @@ fn transformed_clip_free(
             return general_clip_free(poly, m, edge);
         }
         let map = |v: DVec3| DVec3::new(m00 * v.x + m02 * v.z, m11 * v.y, m20 * v.x + m22 * v.z);
-        clip_free_sum(poly, map, edge)
+        poly.clip_free(map, edge)
     } else {
         general_clip_free(poly, m, edge)
     }
@@ -1022,7 +1164,11 @@ const CLIP_FREE_RANGE: f64 = 1_073_741_824.0; // 2^30
 /// [`transformed_clip_free`] for a matrix of any form, out of line so that the common form's
 /// path reads no more of the matrix than it uses.
 #[inline(never)]
-fn general_clip_free(poly: &SphericalPolygon, m: &glam::DMat3, edge: impl EdgeTerm) -> Option<f64> {
+fn general_clip_free<P: ClipFreeInput + ?Sized>(
+    poly: &P,
+    m: &glam::DMat3,
+    edge: impl EdgeTerm,
+) -> Option<f64> {
     // Every quantity of the sum is invariant under positive scaling of the map, so it is scaled
     // to entries of at most 1; then a determinant of at least `1 / CLIP_FREE_RANGE` bounds the
     // images' lengths away from zero too. Worse conditioned maps go to the exact path, which
@@ -1031,7 +1177,7 @@ fn general_clip_free(poly: &SphericalPolygon, m: &glam::DMat3, edge: impl EdgeTe
     if !(m.determinant() >= 1.0 / CLIP_FREE_RANGE) {
         return None;
     }
-    clip_free_sum(poly, |v| m * v, edge)
+    poly.clip_free(|v| m * v, edge)
 }
 
 #[cfg(test)]

@@ -59,10 +59,12 @@ pub use distribution::Ltc;
 pub use ggx::{
     GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight,
 };
-pub(crate) use integrate::clamped_cosine_integral_upper;
 pub use integrate::{
     EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral, clamped_cosine_integral_clip_free,
     clamped_cosine_integral_rational, edge_factor_rational, ggx_polygon_integral, ltc_integral,
     ltc_integral_rational,
+};
+pub(crate) use integrate::{
+    clamped_cosine_integral_upper, ltc_rings_integral, upper_rings_integral,
 };
 pub use table::{LtcLookup, LtcTable, lookup};

@@ -92,7 +92,7 @@
 pub(crate) mod boolean;
 mod contour;
 mod fill;
-mod predicates;
+pub(crate) mod predicates;
 mod shape;
 mod triangulate;
 

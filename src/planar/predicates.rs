@@ -125,6 +125,25 @@ pub(crate) fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
     on_segment(a, b, c) || on_segment(a, b, d) || on_segment(c, d, a) || on_segment(c, d, b)
 }
 
+/// The candidates lying exactly inside the segment `a-b` (collinear by [`orient`], strictly
+/// between the ends by [`strictly_between`]), without repeats, in order from `a`: the vertices a
+/// segment must be split at so that two contours touching along it share them.
+pub(crate) fn vertices_inside_segment(
+    candidates: impl IntoIterator<Item = DVec2>,
+    a: DVec2,
+    b: DVec2,
+) -> smallvec::SmallVec<[DVec2; 2]> {
+    let d = b - a;
+    let mut hits: smallvec::SmallVec<[(f64, DVec2); 2]> = smallvec::SmallVec::new();
+    for p in candidates {
+        if orient(a, b, p) == 0.0 && strictly_between(a, b, p) && !hits.iter().any(|h| h.1 == p) {
+            hits.push(((p - a).dot(d), p));
+        }
+    }
+    hits.sort_by(|x, y| x.0.total_cmp(&y.0));
+    hits.into_iter().map(|h| h.1).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

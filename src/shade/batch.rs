@@ -4,15 +4,18 @@
 //! A renderer's G-buffer is a set of parallel arrays (positions, normals, view vectors,
 //! materials), often in `f32`; these take them as slices and return one result per point, so
 //! that a point that fails (see [`Scene::shade`]'s errors) can fall back alone. Points are
-//! independent and each is shaded by exactly the code of [`Scene::shade`], so the results do
-//! not depend on the order, the batch or the number of threads: `par_shade_batch` returns bit
-//! for bit what `shade_batch` returns, and both what `shade` returns point by point.
+//! independent and each is shaded by exactly the code of [`Scene::shade`] (through
+//! [`Scene::shade_in`], with one [`super::ShadeContext`] per thread: scratch storage, no
+//! results), so the results do not depend on the order, the batch or the number of threads:
+//! `par_shade_batch` returns bit for bit what `shade_batch` returns, and both what `shade`
+//! returns point by point.
 
 use alloc::vec::Vec;
 
 use glam::DVec3;
 
 use super::material::Material;
+use super::query::ShadeContext;
 use super::scene::Scene;
 use crate::{GeomError, IntoDVec3};
 
@@ -106,8 +109,13 @@ impl Scene {
         V: IntoDVec3 + Copy,
     {
         check_lengths(points.len(), normals.len(), views.len(), materials.len())?;
+        // One context for the batch: `shade`'s value without its scratch set-up per point.
+        let mut ctx = ShadeContext::new();
         Ok((0..points.len())
-            .map(|i| self.shade(points[i], normals[i], views[i], material_of(materials, i)))
+            .map(|i| {
+                let m = material_of(materials, i);
+                self.shade_in(&mut ctx, points[i], normals[i], views[i], m)
+            })
             .collect())
     }
 
@@ -138,7 +146,10 @@ impl Scene {
         Ok((0..points.len())
             .into_par_iter()
             .with_min_len(PAR_MIN_RUN)
-            .map(|i| self.shade(points[i], normals[i], views[i], material_of(materials, i)))
+            .map_init(ShadeContext::new, |ctx, i| {
+                let m = material_of(materials, i);
+                self.shade_in(ctx, points[i], normals[i], views[i], m)
+            })
             .collect())
     }
 }

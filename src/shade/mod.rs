@@ -3,7 +3,10 @@
 //!
 //! - [`Scene`]: lights ([`Light`]) and occluders, and [`Scene::shade`], the analytic radiance at
 //!   a shading point. Which part of each light the point sees comes from the visibility layer
-//!   ([`crate::visibility::ClipVisibility`], the exact rule of [`Scene::visible_region`]).
+//!   ([`crate::visibility::ClipVisibility`], the exact rule of [`Scene::visible_region`]; for
+//!   convex and planar lights with separated blockers its fast path,
+//!   [`crate::visibility::ClipVisibility::visible_pieces`]). [`Scene::shade_in`] reuses a
+//!   [`ShadeContext`] (scratch storage, one per thread).
 //! - [`Scene::shade_per_light`]: every light's share, split into diffuse and specular lobes,
 //!   with its unshadowed value ([`LightShading`]), for denoising and ratio estimators.
 //! - [`Material`]: Lambert + GGX with Schlick's Fresnel.
@@ -85,7 +88,7 @@ pub use batch::BatchResult;
 pub use batch::PAR_MIN_RUN;
 pub use curved::{CurvedShading, DEFAULT_DIFFUSE_SUBDIVISION};
 pub use material::Material;
-pub use query::LightShading;
+pub use query::{LightShading, ShadeContext};
 pub use ratio::{LightRatio, RatioEstimator};
 pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf};
 pub use scene::{Light, Scene};

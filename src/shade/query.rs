@@ -6,6 +6,12 @@
 //! integrates the visible region (seed 000 Alg. 1 lines 13-16): Baum's formula for the diffuse
 //! lobe and, after the LTC transform `M^-1` for the view angle and roughness, the same formula
 //! for the GGX lobe (HDHN16 eq. 2 / seed 000 eq. 2).
+//!
+//! The region comes from the visibility layer's fast path ([`ClipVisibility::visible_pieces`]:
+//! pieces cut by half-spaces, never built as spherical polygons, integrated as they are) where it
+//! applies, and from the spherical path ([`ClipVisibility::visible_region`]) elsewhere; the two
+//! agree to rounding (`tests/shade_speed.rs`). A [`ShadeContext`] holds the fast path's scratch
+//! storage: [`Scene::shade_in`] reuses the caller's, [`Scene::shade`] makes one on the stack.
 
 use alloc::vec::Vec;
 
@@ -13,10 +19,14 @@ use glam::{DMat3, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::ltc::{clamped_cosine_integral_upper, lookup, ltc_integral};
+use crate::ltc::{
+    clamped_cosine_integral_upper, lookup, ltc_integral, ltc_rings_integral, upper_rings_integral,
+};
 use crate::solid::ShadingFrame;
 use crate::sphere::SphericalPolygon;
-use crate::visibility::Visibility;
+#[cfg(doc)]
+use crate::visibility::ClipVisibility;
+use crate::visibility::{Pieces, Visibility};
 use crate::{GeomError, IntoDVec3};
 
 /// What a failed LTC lookup or integral reports: the frame's view and the material were
@@ -90,6 +100,86 @@ pub(super) fn specular_setup(
     Ok(Some((look.m_inv, scale)))
 }
 
+/// Scratch storage and counters of shading queries ([`Scene::shade_in`]): the visibility fast
+/// path's [`Pieces`], kept so that their buffers are reused from one query to the next.
+///
+/// Inline storage covers lights and blockers of up to 16 vertices, so neither a context kept by
+/// the caller nor the one [`Scene::shade`] makes on the stack allocates for them; larger inputs
+/// spill to the heap once per context. A context holds no results: any context serves any
+/// scene. One per thread (it is `Send`, and the scene is shared).
+///
+/// # Examples
+///
+/// ```
+/// use arealight::glam::DVec3;
+/// use arealight::shade::{Light, Material, Scene, ShadeContext, TriangleMesh};
+/// let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5)?;
+/// let scene = Scene::new(vec![Light::new(quad, DVec3::ONE)?], vec![])?;
+/// let white = Material::diffuse(DVec3::ONE)?;
+/// let mut ctx = ShadeContext::new();
+/// for k in 0..4 {
+///     let x = DVec3::new(0.1 * k as f64, 0.0, 0.0);
+///     let rgb = scene.shade_in(&mut ctx, x, DVec3::Z, DVec3::Z, &white)?;
+///     assert_eq!(rgb, scene.shade(x, DVec3::Z, DVec3::Z, &white)?);
+/// }
+/// // A quad light seen from the front: every query took the fast path.
+/// assert_eq!((ctx.fast_lights(), ctx.spherical_lights()), (4, 0));
+/// # Ok::<(), arealight::GeomError>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct ShadeContext {
+    pieces: Pieces,
+    fast: u64,
+    spherical: u64,
+}
+
+impl Default for ShadeContext {
+    #[inline(always)]
+    fn default() -> Self {
+        ShadeContext::new()
+    }
+}
+
+impl ShadeContext {
+    /// A fresh context (no heap allocation).
+    #[must_use]
+    #[inline(always)]
+    pub fn new() -> Self {
+        ShadeContext {
+            pieces: Pieces::new(),
+            fast: 0,
+            spherical: 0,
+        }
+    }
+
+    /// How many (point, light) regions the queries through this context took from the fast path
+    /// ([`ClipVisibility::visible_pieces`]).
+    #[must_use]
+    pub fn fast_lights(&self) -> u64 {
+        self.fast
+    }
+
+    /// How many (point, light) regions took the spherical path
+    /// ([`ClipVisibility::visible_region`]), where the fast path does not apply.
+    #[must_use]
+    pub fn spherical_lights(&self) -> u64 {
+        self.spherical
+    }
+}
+
+/// The diffuse and LTC integrals of the fast path's pieces, as [`integrals`] of the same region
+/// (up to rounding); `None` only for an LTC map the ring integral declines (never one of the
+/// tables').
+#[inline(always)]
+fn piece_integrals(pieces: &Pieces, spec: &SpecularSetup) -> Option<(f64, f64)> {
+    let diffuse = upper_rings_integral(pieces.rings());
+    let specular = match spec {
+        Some((m_inv, _)) => ltc_rings_integral(pieces.rings(), *m_inv)?,
+        None => 0.0,
+    };
+    Some((diffuse, specular))
+}
+
 /// The diffuse (clamped cosine over pi) and LTC integrals over region pieces already clipped to
 /// the upper hemisphere; the second is zero without a specular lobe.
 pub(super) fn integrals(
@@ -104,6 +194,36 @@ pub(super) fn integrals(
         }
     }
     Ok((diffuse, specular))
+}
+
+/// The diffuse and LTC integrals of light `i`'s visible region (`blocked`) or of its region
+/// with every other object removed, as `vis` gives it: from the backend's fast path
+/// ([`Visibility::visible_pieces`]) where it has one that applies, else from its spherical
+/// polygons ([`Visibility::visible_region`], [`Visibility::unoccluded_region`]). Counted in
+/// `ctx`.
+#[inline(always)]
+pub(super) fn region_integrals<V: Visibility + ?Sized>(
+    vis: &V,
+    i: usize,
+    frame: &ShadingFrame,
+    spec: &SpecularSetup,
+    blocked: bool,
+    ctx: &mut ShadeContext,
+) -> Result<(f64, f64), GeomError> {
+    if vis.visible_pieces(i, frame, blocked, &mut ctx.pieces)?
+        && let Some(v) = piece_integrals(&ctx.pieces, spec)
+    {
+        ctx.fast += 1;
+        return Ok(v);
+    }
+    ctx.spherical += 1;
+    // The spherical path's pieces are already clipped to the upper hemisphere.
+    let region = if blocked {
+        vis.visible_region(i, frame)?
+    } else {
+        vis.unoccluded_region(i, frame)?
+    };
+    integrals(&region, *spec)
 }
 
 impl Scene {
@@ -132,8 +252,39 @@ impl Scene {
     ///   reference, or a point moved by a tiny amount).
     ///
     /// No other error is returned: the scene and the material were validated when built.
+    ///
+    /// # Points on surfaces
+    ///
+    /// A point on an occluder's surface (or within the facing predicate's tolerance of one of its
+    /// face planes, [`crate::solid::FACE_TOLERANCE`]) gets a finite value: a convex occluder
+    /// covers the half-space behind the faces it lies on (a hemisphere seen from a point on a
+    /// face, a lune from an edge), so such a point sees the light only through the other side
+    /// of those face planes; a mesh occluder's triangles seen edge-on cover nothing. A point on
+    /// a planar light's plane sees none of that light (it is seen edge-on); a point inside a
+    /// closed light that bounds a solid, or on a convex light's surface, receives nothing from
+    /// it.
+    ///
+    /// Each call makes a [`ShadeContext`] on the stack; [`Scene::shade_in`] reuses one.
     pub fn shade(
         &self,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
+        material: &Material,
+    ) -> Result<DVec3, GeomError> {
+        self.shade_in(&mut ShadeContext::new(), point, normal, view, material)
+    }
+
+    /// [`Scene::shade`] in the caller's [`ShadeContext`]: the same value, bit for bit, without
+    /// setting up scratch storage per call, and with the context's counters of which path each
+    /// light took. Keep one context per thread.
+    ///
+    /// # Errors
+    ///
+    /// As [`Scene::shade`].
+    pub fn shade_in(
+        &self,
+        ctx: &mut ShadeContext,
         point: impl IntoDVec3,
         normal: impl IntoDVec3,
         view: impl IntoDVec3,
@@ -143,7 +294,7 @@ impl Scene {
         let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
         for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, spec)?;
+            total += self.shade_light_in(i, &frame, material, &spec, ctx)?;
         }
         Ok(total)
     }
@@ -194,9 +345,10 @@ impl Scene {
         }
         let frame = ShadingFrame::new(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
+        let mut ctx = ShadeContext::new();
         let mut total = DVec3::ZERO;
         for (i, light) in self.lights().iter().enumerate() {
-            let (diffuse, specular) = integrals(&vis.visible_region(i, &frame)?, spec)?;
+            let (diffuse, specular) = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
             let mut out = material.albedo() * diffuse;
             if let Some((_, scale)) = spec {
                 out += scale * specular;
@@ -222,7 +374,7 @@ impl Scene {
         self.light(light)?;
         let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        self.shade_light_in(light, &frame, material, spec)
+        self.shade_light_in(light, &frame, material, &spec, &mut ShadeContext::new())
     }
 
     /// Every light's share of [`Scene::shade`] at `point` (same arguments), split into the
@@ -265,11 +417,16 @@ impl Scene {
     ) -> Result<Vec<LightShading>, GeomError> {
         let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
+        let mut ctx = ShadeContext::new();
         let mut out = Vec::with_capacity(self.lights().len());
         for (i, light) in self.lights().iter().enumerate() {
             let vis = self.light_visibility(i, &frame);
-            let shadowed = integrals(&vis.visible_region(i, &frame)?, spec)?;
-            let unshadowed = integrals(&vis.unoccluded_region(i, &frame)?, spec)?;
+            let unshadowed = region_integrals(vis, i, &frame, &spec, false, &mut ctx)?;
+            // Exactly what `shade` computes for the light, so that the shares add up to it. The
+            // unshadowed region may come from the other path (the fast path declines only where
+            // a blocker needs the spherical one); the two agree to rounding, so the shadowed
+            // value can exceed the unshadowed one by rounding.
+            let shadowed = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
             let rgb = light.radiance();
             let lobes = |(d, s): (f64, f64)| {
                 let specular = spec.map_or(DVec3::ZERO, |(_, scale)| scale * s * rgb);
@@ -292,15 +449,15 @@ impl Scene {
         i: usize,
         frame: &ShadingFrame,
         material: &Material,
-        spec: SpecularSetup,
+        spec: &SpecularSetup,
+        ctx: &mut ShadeContext,
     ) -> Result<DVec3, GeomError> {
         let light = &self.lights()[i];
-        // The visible pieces are already clipped to the upper hemisphere.
         let vis = self.light_visibility(i, frame);
-        let (diffuse, specular) = integrals(&vis.visible_region(i, frame)?, spec)?;
+        let (diffuse, specular) = region_integrals(vis, i, frame, spec, true, ctx)?;
         let mut out = material.albedo() * diffuse;
         if let Some((_, scale)) = spec {
-            out += scale * specular;
+            out += *scale * specular;
         }
         Ok(out * light.radiance())
     }

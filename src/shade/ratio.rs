@@ -46,7 +46,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 
 use super::material::Material;
-use super::query::{integrals, specular_setup};
+use super::query::{ShadeContext, region_integrals, specular_setup};
 use super::reference::{
     Estimate, LightDomain, LightSampling, Outcome, Pcg32, PointSampler, ReferenceBrdf,
 };
@@ -186,13 +186,14 @@ impl RatioEstimator {
         let n = self.samples_per_light.max(1);
         let mut domain = LightDomain::default();
         let mut out = Vec::with_capacity(scene.lights().len());
+        let mut ctx = ShadeContext::new();
         for (li, light) in scene.lights().iter().enumerate() {
             // Two-sided lights seen from behind live in the turned-around backend.
-            let pieces = scene
-                .light_visibility(li, frame)
-                .unoccluded_region(li, frame)?;
-            // The analytic factor, as `Scene::shade_per_light` forms it.
-            let (d, s) = integrals(&pieces, spec)?;
+            let vis = scene.light_visibility(li, frame);
+            let pieces = vis.unoccluded_region(li, frame)?;
+            // The analytic factor, as `Scene::shade_per_light` forms it (from the same path,
+            // so that the two agree bit for bit).
+            let (d, s) = region_integrals(vis, li, frame, &spec, false, &mut ctx)?;
             let rgb = light.radiance();
             let mut unshadowed = material.albedo() * d * rgb;
             if let Some((_, scale)) = spec {

@@ -71,10 +71,14 @@ impl ShadingFrame {
         let n = direction(normal, "surface normal")?;
         let v = direction(view, "view direction")?;
         // Tangent: the view's component in the surface plane; any tangent for a view along n.
-        let t = (v - n * v.dot(n))
-            .try_normalize()
-            .filter(|t| (v - n * v.dot(n)).length() > 1e-12 && t.is_finite())
-            .unwrap_or_else(|| n.any_orthonormal_vector());
+        // (`p * (1 / |p|)` is `try_normalize`'s result, which above 1e-12 always exists.)
+        let p = v - n * v.dot(n);
+        let len = p.length();
+        let t = if len > 1e-12 {
+            p * len.recip()
+        } else {
+            n.any_orthonormal_vector()
+        };
         let b = n.cross(t);
         let rot = DMat3::from_cols(t, b, n).transpose();
         let local_v = rot * v;

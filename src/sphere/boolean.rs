@@ -9,11 +9,12 @@ use smallvec::SmallVec;
 
 use super::clip::HORIZON_TOLERANCE;
 use super::gnomonic::{Gnomonic, enclosing_cap};
-use super::order::order_directed_edges;
+use super::order::{order_directed_edges, order_directed_edges_within};
 use super::polygon::{SphericalPolygon, Verts, close_ring, regularized};
 use super::predicates::tangent_frame;
 use crate::GeomError;
-use crate::planar::{BoolOp, Shape, boolean};
+use crate::planar::predicates::vertices_inside_segment;
+use crate::planar::{BoolOp, FillRule, Shape, boolean};
 
 /// Smallest cosine of the enclosing cap's radius for the single-projection path: projected
 /// coordinates stay below `1 / MIN_CAP_COS` (here 1e3), well inside the range where the planar
@@ -218,11 +219,13 @@ fn separated(a: &SphericalPolygon, b: &SphericalPolygon, op: BoolOp) -> Option<S
     Some(SphericalPolygon::from_parts(verts, ends))
 }
 
-/// One operand in the plane: a bounded shape, and whether the region is its complement (the
-/// region contains the far side of the projection hemisphere).
+/// One operand in the plane: a bounded shape, whether the region is its complement (the
+/// region contains the far side of the projection hemisphere), and whether the shape had to be
+/// rebuilt from its rings under a fill rule (see [`to_plane`]).
 struct Planar {
     shape: Shape,
     complemented: bool,
+    rebuilt: bool,
 }
 
 fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
@@ -235,20 +238,38 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
     } else {
         p.clone()
     };
-    let mut contours: Vec<Vec<DVec2>> = Vec::with_capacity(q.ring_count());
-    for ring in q.rings() {
-        let mut c = Vec::with_capacity(ring.len());
-        for &v in ring {
-            c.push(g.project(v).ok_or(GeomError::Undecidable(
-                "a vertex left the projection hemisphere",
-            ))?);
+    let project = || -> Result<Vec<Vec<DVec2>>, GeomError> {
+        let mut contours: Vec<Vec<DVec2>> = Vec::with_capacity(q.ring_count());
+        for ring in q.rings() {
+            let mut c = Vec::with_capacity(ring.len());
+            for &v in ring {
+                c.push(g.project(v).ok_or(GeomError::Undecidable(
+                    "a vertex left the projection hemisphere",
+                ))?);
+            }
+            split_pinches(c, &mut contours);
         }
-        split_pinches(c, &mut contours);
+        Ok(contours)
+    };
+    match Shape::new(project()?) {
+        Ok(shape) => Ok(Planar {
+            shape,
+            complemented,
+            rebuilt: false,
+        }),
+        // The polygon is valid on the sphere, so its projected rings bound the region by
+        // winding number (outer rings counter-clockwise, holes clockwise, none crossing) up to
+        // the rounding of the projection. What the planar validation rejects is that rounding
+        // where rings nearly meet: results of earlier operations can carry two rings whose
+        // shared edge has vertex copies `1e-12` apart (each copy an intersection point computed
+        // in another projection), which cross in the plane. The ring soup under the positive
+        // fill rule is the same region with those contacts welded (the planar resolution).
+        Err(_) => Ok(Planar {
+            shape: Shape::with_fill_rule(project()?, FillRule::Positive)?,
+            complemented,
+            rebuilt: true,
+        }),
     }
-    Ok(Planar {
-        shape: Shape::new(contours)?,
-        complemented,
-    })
 }
 
 /// Vertices of the two operands closer than this chord are made the same vertex before an
@@ -457,6 +478,7 @@ fn projected(
     let a = snapped.0.as_ref().unwrap_or(a);
     let b = snapped.1.as_ref().unwrap_or(b);
     let (pa, pb) = (to_plane(a, &g)?, to_plane(b, &g)?);
+    let clean = clean && !pa.rebuilt && !pb.rebuilt;
     let (ca, cb) = (pa.complemented, pb.complemented);
     let (sa, sb) = (&pa.shape, &pb.shape);
     // Rewrite the operation on possibly complemented operands as one on bounded shapes, with
@@ -560,31 +582,9 @@ fn rings_apart(p: &SphericalPolygon, d: f64) -> bool {
 }
 
 /// Vertices of any contour lying exactly inside the segment `a-b` (not at its ends), in order
-/// from `a`. Exact: collinearity by `orient2d`, betweenness along the segment.
+/// from `a`.
 fn touching_vertices(contours: &[&[DVec2]], a: DVec2, b: DVec2) -> SmallVec<[DVec2; 2]> {
-    let mut hits: SmallVec<[(f64, DVec2); 2]> = SmallVec::new();
-    let d = b - a;
-    for c in contours {
-        for &p in c.iter() {
-            if p == a || p == b {
-                continue;
-            }
-            let o = robust::orient2d(
-                robust::Coord { x: a.x, y: a.y },
-                robust::Coord { x: b.x, y: b.y },
-                robust::Coord { x: p.x, y: p.y },
-            );
-            if o != 0.0 {
-                continue;
-            }
-            let t = (p - a).dot(d) / d.length_squared();
-            if t > 0.0 && t < 1.0 && !hits.iter().any(|h| h.1 == p) {
-                hits.push((t, p));
-            }
-        }
-    }
-    hits.sort_by(|x, y| x.0.total_cmp(&y.0));
-    hits.into_iter().map(|h| h.1).collect()
+    vertices_inside_segment(contours.iter().flat_map(|c| c.iter().copied()), a, b)
 }
 
 /// The operation on operands no narrow cap holds: solved per octant and merged.
@@ -627,8 +627,26 @@ fn split(
         // Every piece boundary lay on a cut and cancelled: the pieces tile the whole sphere.
         return Ok(SphericalPolygon::full());
     }
-    order_directed_edges(&edges)
+    match order_directed_edges(&edges) {
+        Ok(r) if r.validate().is_ok() => Ok(r),
+        // The pieces' rings join at copies of one vertex a few ulps apart (the octants'
+        // projections round differently), which the silhouette tolerance of
+        // `order_directed_edges` (1e-9) joins; but it also merges distinct vertices of a piece
+        // closer than that (a notch left by a sliver occluder, a crossing 1e-11 from a vertex),
+        // collapsing a valid piece into an edge walked twice. Joined only within
+        // [`SPLIT_MATCH`], such features survive.
+        first => match order_directed_edges_within(&edges, SPLIT_MATCH) {
+            Ok(r) if r.validate().is_ok() => Ok(r),
+            _ => first,
+        },
+    }
 }
+
+/// Chord length within which [`split`] joins piece endpoints when the silhouette tolerance
+/// fails: far above the rounding of a unit vector through an octant's projection and back (a
+/// few `1e-16`), far below the weld tolerance of the pieces' operations ([`WELD_TOLERANCE`]),
+/// so that vertices the pieces keep apart stay apart.
+const SPLIT_MATCH: f64 = 1e-13;
 
 /// Removes the parts of edges lying on the three cut circles that two adjacent octants' pieces
 /// both have (with opposite directions), keeping the net boundary.

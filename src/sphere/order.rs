@@ -55,7 +55,7 @@ pub const MATCH_TOLERANCE: f64 = 1e-9;
 /// # Ok::<(), arealight::GeomError>(())
 /// ```
 pub fn order_edges(edges: &[(DVec3, DVec3)]) -> Result<SphericalPolygon, GeomError> {
-    let mut rings = chain(edges, false)?;
+    let mut rings = chain(edges, false, MATCH_TOLERANCE)?;
     // Orient each loop around its smaller side.
     for ring in rings.iter_mut() {
         if ring_left_area(ring) > 2.0 * PI {
@@ -94,11 +94,26 @@ pub fn order_edges(edges: &[(DVec3, DVec3)]) -> Result<SphericalPolygon, GeomErr
 /// an [`GeomError::OpenChain`], and [`GeomError::InconsistentOrientation`] reports loops whose
 /// directions contradict each other.
 pub fn order_directed_edges(edges: &[(DVec3, DVec3)]) -> Result<SphericalPolygon, GeomError> {
-    SphericalPolygon::new(chain(edges, true)?)
+    order_directed_edges_within(edges, MATCH_TOLERANCE)
 }
 
-/// Merges endpoints and walks the loops. With `directed`, loops follow the edges' directions.
-fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, GeomError> {
+/// [`order_directed_edges`] with endpoints merged within `tolerance` (chord length) instead of
+/// [`MATCH_TOLERANCE`]: for edges whose shared endpoints are copies a few ulps apart, where
+/// features between `tolerance` and [`MATCH_TOLERANCE`] must survive.
+pub(crate) fn order_directed_edges_within(
+    edges: &[(DVec3, DVec3)],
+    tolerance: f64,
+) -> Result<SphericalPolygon, GeomError> {
+    SphericalPolygon::new(chain(edges, true, tolerance)?)
+}
+
+/// Merges endpoints closer than `tolerance` and walks the loops. With `directed`, loops follow
+/// the edges' directions.
+fn chain(
+    edges: &[(DVec3, DVec3)],
+    directed: bool,
+    tolerance: f64,
+) -> Result<Vec<Vec<DVec3>>, GeomError> {
     let n = edges.len();
     let mut pts: Vec<DVec3> = Vec::with_capacity(2 * n);
     for (e, &(a, b)) in edges.iter().enumerate() {
@@ -109,7 +124,7 @@ fn chain(edges: &[(DVec3, DVec3)], directed: bool) -> Result<Vec<Vec<DVec3>>, Ge
             pts.push(normalize_any(p).ok_or(GeomError::ZeroVector { ring: e, vertex: k })?);
         }
     }
-    let cluster = merge_endpoints(&pts);
+    let cluster = merge_endpoints(&pts, tolerance);
     let nclusters = cluster.iter().copied().max().map_or(0, |m| m + 1);
 
     // Representative of each merged vertex: the normalized mean of its members, so the result does
@@ -228,10 +243,10 @@ fn pick_clockwise(from: DVec3, at: DVec3, cands: &[usize], far: impl Fn(usize) -
     best.1
 }
 
-/// Union–find of endpoints closer than [`MATCH_TOLERANCE`]: sort by x and compare only within the
+/// Union–find of endpoints closer than `tolerance`: sort by x and compare only within the
 /// tolerance window, so the cost is near linear for well-separated vertices. Returns dense
 /// cluster ids in first-appearance order.
-fn merge_endpoints(pts: &[DVec3]) -> Vec<usize> {
+fn merge_endpoints(pts: &[DVec3], tolerance: f64) -> Vec<usize> {
     let m = pts.len();
     let mut parent: Vec<usize> = (0..m).collect();
     fn find(parent: &mut [usize], mut i: usize) -> usize {
@@ -245,10 +260,10 @@ fn merge_endpoints(pts: &[DVec3]) -> Vec<usize> {
     order.sort_by(|&i, &j| pts[i].x.total_cmp(&pts[j].x));
     for (k, &i) in order.iter().enumerate() {
         for &j in &order[k + 1..] {
-            if pts[j].x - pts[i].x > MATCH_TOLERANCE {
+            if pts[j].x - pts[i].x > tolerance {
                 break;
             }
-            if (pts[i] - pts[j]).length() <= MATCH_TOLERANCE {
+            if (pts[i] - pts[j]).length() <= tolerance {
                 let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
                 parent[ri.max(rj)] = ri.min(rj);
             }

@@ -149,19 +149,23 @@ fn fan_from_first(ring: &[DVec3]) -> Option<Vec<SphericalTriangle>> {
     let mut sum = 0.0;
     for w in ring[1..].windows(2) {
         let (b, c) = (w[0], w[1]);
-        if orient(apex, b, c) != 1 || !well_conditioned(apex, b, c) {
+        // The area decides before the triangle is built: a positive triangle with its vertices
+        // nearly on a great circle is either a sliver or nearly a hemisphere, and the latter
+        // must not pass for the former below.
+        let (area, err) = signed_solid_angle_with_error(apex, b, c);
+        if orient(apex, b, c) != 1
+            || !(err <= MAX_AREA_ERROR)
+            || !(area <= 2.0 * PI - HEMISPHERE_MARGIN)
+        {
             return None;
         }
         match SphericalTriangle::from_unit(apex, b, c) {
             Ok(t) => {
-                if !(t.solid_angle() <= 2.0 * PI - HEMISPHERE_MARGIN) {
-                    return None;
-                }
                 sum += t.solid_angle();
                 out.push(t);
             }
-            // Certified positive, area below rounding.
-            Err(GeomError::Degenerate(_)) => {}
+            // Certified positive, area within its own rounding.
+            Err(GeomError::Degenerate(_)) if area <= err => {}
             Err(_) => return None,
         }
     }
@@ -735,11 +739,6 @@ fn label(
 /// about a hemisphere wide) has an area that rounding decides at will; another candidate avoids
 /// that diagonal.
 const MAX_AREA_ERROR: f64 = 1e-11;
-
-/// Whether the triangle's area is computed to within [`MAX_AREA_ERROR`].
-fn well_conditioned(a: DVec3, b: DVec3, c: DVec3) -> bool {
-    signed_solid_angle_with_error(a, b, c).1 <= MAX_AREA_ERROR
-}
 
 /// Whether `tris` tiles exactly the region of solid angle `area` bounded by the directed
 /// `edges` (see [`SphericalPolygon::triangulate`]): every triangle positively oriented (exact)

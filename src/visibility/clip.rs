@@ -66,9 +66,9 @@ pub enum Method {
 pub struct ClipVisibility<L> {
     lights: Vec<L>,
     occluders: Vec<Body>,
-    light_bounds: Vec<BoundingSphere>,
+    pub(super) light_bounds: Vec<BoundingSphere>,
     occluder_bounds: Vec<BoundingSphere>,
-    method: Method,
+    pub(super) method: Method,
     /// Per light: its mesh validated as a solid ([`ClosedMesh`]) when it is a closed,
     /// non-planar mesh light that bounds one (then its region is its non-convex silhouette).
     solids: Vec<Option<ClosedMesh>>,
@@ -77,6 +77,9 @@ pub struct ClipVisibility<L> {
     /// the two, or `None` when they overlap (the blocker interpenetrates the light, or is the
     /// light itself).
     separations: Vec<Option<Separation>>,
+    /// Per planar mesh light: its [`Outline`], for the fast path
+    /// ([`ClipVisibility::visible_pieces`]).
+    pub(super) outlines: Vec<Option<Outline>>,
     /// Per blocker slot: a bounding-volume hierarchy over the triangles of a body with at least
     /// [`BVH_MIN_TRIANGLES`] of them, for culling by shafts, and whether front faces alone
     /// cover what a closed mesh hides.
@@ -160,6 +163,13 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 _ => None,
             })
             .collect();
+        let outlines = lights
+            .iter()
+            .map(|l| match l.as_ref() {
+                Body::Mesh(m) if m.is_planar() => Outline::of(m),
+                _ => None,
+            })
+            .collect();
         ClipVisibility {
             lights,
             occluders,
@@ -168,6 +178,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             method: Method::Silhouette,
             solids,
             separations,
+            outlines,
             accels,
             touching,
         }
@@ -199,7 +210,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// The body of light `i`, or [`GeomError::OutOfRange`] past the end.
-    fn light_body(&self, i: usize) -> Result<&Body, GeomError> {
+    pub(super) fn light_body(&self, i: usize) -> Result<&Body, GeomError> {
         self.lights
             .get(i)
             .map(AsRef::as_ref)
@@ -212,7 +223,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
 
     /// Number of blocker slots per light: every occluder, then every light (the light itself
     /// among them, never returned by [`ClipVisibility::blockers_between`]).
-    fn blocker_count(&self) -> usize {
+    pub(super) fn blocker_count(&self) -> usize {
         self.occluders.len() + self.lights.len()
     }
 
@@ -225,7 +236,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// The precomputed separating plane between light `light` and blocker `b`, if any.
-    fn separation(&self, light: usize, b: Blocker) -> Option<Separation> {
+    pub(super) fn separation(&self, light: usize, b: Blocker) -> Option<Separation> {
         self.separations[light * self.blocker_count() + self.slot(b)]
     }
 
@@ -235,7 +246,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// The bounding-volume hierarchy of a blocker's triangles, if it has one.
-    fn bvh(&self, b: Blocker) -> Option<&Bvh> {
+    pub(super) fn bvh(&self, b: Blocker) -> Option<&Bvh> {
         self.accels[self.slot(b)].bvh.as_ref()
     }
 
@@ -252,12 +263,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// Whether blocker `b` has a vertex in the plane of a triangle of light `light`.
-    fn touches(&self, light: usize, b: Blocker) -> bool {
+    pub(super) fn touches(&self, light: usize, b: Blocker) -> bool {
         self.touching[light * self.blocker_count() + self.slot(b)]
     }
 
     /// The geometry and bounding sphere of a blocker.
-    fn blocker(&self, b: Blocker) -> (&Body, BoundingSphere) {
+    pub(super) fn blocker(&self, b: Blocker) -> (&Body, BoundingSphere) {
         match b {
             Blocker::Occluder(k) => (&self.occluders[k], self.occluder_bounds[k]),
             Blocker::Light(k) => (self.lights[k].as_ref(), self.light_bounds[k]),
@@ -738,6 +749,16 @@ impl<L: AsRef<Body>> Visibility for ClipVisibility<L> {
     ) -> Result<Vec<SphericalPolygon>, GeomError> {
         self.region(light, frame, false)
     }
+
+    fn visible_pieces(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        blocked: bool,
+        out: &mut super::Pieces,
+    ) -> Result<bool, GeomError> {
+        ClipVisibility::visible_pieces(self, light, frame, blocked, out)
+    }
 }
 
 /// Subtracts from `piece` (part of light face `f` of `light_mesh`, within `face_bound`) the
@@ -784,6 +805,54 @@ fn subtract_cut(
         }
     }
     Ok(piece)
+}
+
+/// The region a planar mesh light covers seen from its front, as the fast path takes it
+/// ([`ClipVisibility::visible_pieces`]): its boundary loops ([`TriangleMesh::boundary_loops`]),
+/// whose chain bounds exactly the union of its triangles, and whether they are one convex loop
+/// (every turn to the left about the mesh's normal, or straight), which stays one simple loop
+/// when the horizon cuts it.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Outline {
+    /// The loops' vertex positions, each loop reversed: counter-clockwise about the normal, so
+    /// clockwise seen from the front, which is counter-clockwise on the sphere of directions
+    /// seen from outside (the region on the left of each edge).
+    pub(super) rings: Vec<Vec<DVec3>>,
+    pub(super) convex: bool,
+}
+
+impl Outline {
+    /// The outline of planar mesh `m`; `None` for a mesh without boundary (which covers
+    /// nothing seen from either side, and which the fast path leaves alone).
+    fn of(m: &TriangleMesh) -> Option<Outline> {
+        let loops = m.boundary_loops();
+        if loops.is_empty() {
+            return None;
+        }
+        let n = m.triangle_normal(0);
+        let v = m.vertices();
+        let convex = loops.len() == 1 && {
+            let lp = &loops[0];
+            let k = lp.len();
+            let mut distinct = lp.clone();
+            distinct.sort_unstable();
+            distinct.dedup();
+            distinct.len() == k
+                && (0..k).all(|i| {
+                    let (a, b, c) = (
+                        v[lp[i] as usize],
+                        v[lp[(i + 1) % k] as usize],
+                        v[lp[(i + 2) % k] as usize],
+                    );
+                    (b - a).cross(c - b).dot(n) >= 0.0
+                })
+        };
+        let rings = loops
+            .iter()
+            .map(|lp| lp.iter().rev().map(|&i| v[i as usize]).collect())
+            .collect();
+        Some(Outline { rings, convex })
+    }
 }
 
 /// What a clip that added part of the horizon outside its polygon reports (see [`upper_part`]).
@@ -860,7 +929,7 @@ fn upper_pieces(pieces: Vec<SphericalPolygon>) -> Result<Vec<SphericalPolygon>, 
 
 /// A sphere holding a triangle (about its centroid, padded by a relative ulp margin), for the
 /// per-triangle culling.
-fn triangle_bound(tri: [DVec3; 3]) -> BoundingSphere {
+pub(super) fn triangle_bound(tri: [DVec3; 3]) -> BoundingSphere {
     let c = (tri[0] + tri[1] + tri[2]) / 3.0;
     let r = tri.iter().map(|&v| (v - c).length()).fold(0.0, f64::max) * (1.0 + 1e-12);
     BoundingSphere {

@@ -14,7 +14,7 @@ use smallvec::SmallVec;
 
 use alloc::vec::Vec;
 
-use crate::math::{acos, asin, sqrt};
+use crate::math::sqrt;
 use crate::solid::{BoundingSphere, Bvh, TriangleMesh};
 
 /// Angular margin (radians) added to every cone test, far above the rounding of the angles, so
@@ -59,11 +59,20 @@ pub fn may_occlude(x: DVec3, n: DVec3, light: BoundingSphere, occ: BoundingSpher
     if d_occ <= occ.radius || d_light <= light.radius {
         return true;
     }
-    let half_occ = asin((occ.radius / d_occ).min(1.0));
-    let half_light = asin((light.radius / d_light).min(1.0));
-    let cos_between = (to_occ.dot(to_light) / (d_occ * d_light)).clamp(-1.0, 1.0);
-    let between = acos(cos_between);
-    between <= half_occ + half_light + MARGIN
+    // The cones meet where the angle between their axes is at most the sum of their half-angles
+    // `a + b` (`sin a = r / d` for each): compared through cosines, `cos(a + b) = cos a cos b -
+    // sin a sin b`, with two roots and no inverse trigonometric function. The margin moves to the
+    // cosine side as `cos(a + b + MARGIN) >= cos(a + b) - MARGIN`, which keeps every pair the
+    // angles' test keeps (and a few more where the cones are tiny and the cosine flat), far above
+    // the rounding of either side.
+    let (sin_o, sin_l) = (
+        (occ.radius / d_occ).min(1.0),
+        (light.radius / d_light).min(1.0),
+    );
+    let cos_o = sqrt((1.0 - sin_o * sin_o).max(0.0));
+    let cos_l = sqrt((1.0 - sin_l * sin_l).max(0.0));
+    let cos_between = to_occ.dot(to_light) / (d_occ * d_light);
+    cos_between >= cos_o * cos_l - sin_o * sin_l - MARGIN
 }
 
 /// Whether a light bounded by `light` may be above the horizon of `x` (normal `n`, unit).

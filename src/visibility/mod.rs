@@ -15,12 +15,14 @@
 
 mod clip;
 pub(crate) mod cull;
+mod pieces;
 pub mod plucker;
 mod union;
 
 use alloc::vec::Vec;
 
 pub use clip::{BVH_MIN_TRIANGLES, ClipVisibility, Method};
+pub use pieces::Pieces;
 pub use plucker::{PluckerContext, PluckerVisibility, WithContext};
 
 use crate::GeomError;
@@ -71,4 +73,26 @@ pub trait Visibility {
         light: usize,
         frame: &ShadingFrame,
     ) -> Result<Vec<SphericalPolygon>, GeomError>;
+
+    /// The backend's fast path, where it has one: the region of
+    /// [`Visibility::visible_region`] (`blocked`) or of [`Visibility::unoccluded_region`]
+    /// (without) as [`Pieces`] in `out`, whose integrals are those of the polygons up to
+    /// rounding. `Ok(true)` when `out` holds the region, `Ok(false)` when the caller must ask
+    /// for the polygons. The default has no fast path; [`ClipVisibility`] answers with
+    /// [`ClipVisibility::visible_pieces`].
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::OutOfRange`] for a light index past the end (the default, which declines
+    /// every query, leaves that to [`Visibility::visible_region`]).
+    fn visible_pieces(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        blocked: bool,
+        out: &mut Pieces,
+    ) -> Result<bool, GeomError> {
+        let _ = (light, frame, blocked, out);
+        Ok(false)
+    }
 }

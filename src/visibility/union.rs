@@ -56,6 +56,7 @@ use smallvec::SmallVec;
 
 use super::cull::Shaft;
 use crate::GeomError;
+use crate::planar::predicates::vertices_inside_segment;
 use crate::planar::{BoolOp, FillRule, Shape, boolean};
 use crate::solid::facing::{FACE_TOLERANCE, Side};
 use crate::solid::silhouette::convex_silhouette;
@@ -805,30 +806,15 @@ fn push_distinct(verts: &mut SmallVec<[DVec3; 12]>, start: usize, d: DVec3) {
 }
 
 /// Vertices (all contours' vertices, sorted by `x`) lying exactly inside the segment `a-b` (not
-/// at its ends), in order from `a`: the vertices in the segment's `x` range, a `y` range
-/// filter, then exact collinearity and betweenness.
+/// at its ends), in order from `a`: the vertices in the segment's `x` range, then a `y` range
+/// filter, before the exact test.
 fn touching(by_x: &[DVec2], a: DVec2, b: DVec2) -> SmallVec<[DVec2; 2]> {
     let (lo, hi) = (a.min(b), a.max(b));
-    let d = b - a;
-    let mut hits: SmallVec<[(f64, DVec2); 2]> = SmallVec::new();
     let first = by_x.partition_point(|p| p.x < lo.x);
-    for &p in by_x[first..].iter().take_while(|p| p.x <= hi.x) {
-        if p.y < lo.y || p.y > hi.y || p == a || p == b {
-            continue;
-        }
-        let o = robust::orient2d(
-            robust::Coord { x: a.x, y: a.y },
-            robust::Coord { x: b.x, y: b.y },
-            robust::Coord { x: p.x, y: p.y },
-        );
-        if o != 0.0 {
-            continue;
-        }
-        let t = (p - a).dot(d) / d.length_squared();
-        if t > 0.0 && t < 1.0 && !hits.iter().any(|h| h.1 == p) {
-            hits.push((t, p));
-        }
-    }
-    hits.sort_by(|x, y| x.0.total_cmp(&y.0));
-    hits.into_iter().map(|h| h.1).collect()
+    let near = by_x[first..]
+        .iter()
+        .take_while(|p| p.x <= hi.x)
+        .filter(|p| p.y >= lo.y && p.y <= hi.y)
+        .copied();
+    vertices_inside_segment(near, a, b)
 }

@@ -151,7 +151,9 @@ pub(crate) fn chain_by_index(edges: &[(u32, u32)], nverts: usize) -> Option<Smal
     if edges.len() < 3 {
         return None;
     }
-    let mut next = alloc::vec![NONE; nverts];
+    // Inline for polyhedra of up to 64 vertices, so that silhouettes of small ones allocate
+    // nothing here.
+    let mut next: SmallVec<[u32; 64]> = smallvec::smallvec![NONE; nverts];
     for &(a, b) in edges {
         if next[a as usize] != NONE {
             return None;

@@ -10,6 +10,7 @@ mod triangle;
 mod triangulated;
 
 pub use bsp::{DEFAULT_REGION_RADII, SilhouetteBsp};
+pub(crate) use convex::chain_by_index;
 pub use convex::convex_silhouette;
 pub use nonconvex::nonconvex_silhouette;
 #[allow(unused_imports)]

@@ -96,15 +96,16 @@ fn covered_region(local: &[DVec3], side: Side) -> Result<Option<SphericalPolygon
             | GeomError::CoincidentVertices { .. }
             | GeomError::TooFewVertices { .. },
         ) => Ok(None),
-        // Rounding can also make the ring of a triangle seen nearly edge-on look
-        // self-intersecting (three vertices cannot cross otherwise). Its solid angle, by Van
-        // Oosterom and Strackee's formula on edge differences, is then far below anything the
-        // layer resolves: it covers nothing. The formula is trusted only where its denominator
-        // is well away from zero (no two corners nearly opposite, which a point close to the
-        // triangle's edge line makes, and where the triangle can cover a quarter of the sphere).
+        // Rounding can also make the ring of a convex polygon seen nearly edge-on look
+        // self-intersecting (a triangle, or a sliver triangle cut by a plane through both its
+        // long edges, whose two cut points lie 1e-12 apart). Its solid angle, the sum of its
+        // fan triangles' by Van Oosterom and Strackee's formula on edge differences, is then
+        // below what the sphere layer resolves: it covers nothing. The formula is trusted only
+        // where its denominator is well away from zero (no two corners nearly opposite, which a
+        // point close to the polygon's edge line makes, and where it can cover a quarter of the
+        // sphere).
         Err(GeomError::SelfIntersecting { .. })
-            if keep.len() == 3
-                && edge_on_triangle([ordered[keep[0]], ordered[keep[1]], ordered[keep[2]]]) =>
+            if edge_on_fan(keep.iter().map(|&k| ordered[k])) =>
         {
             Ok(None)
         }
@@ -112,23 +113,44 @@ fn covered_region(local: &[DVec3], side: Side) -> Result<Option<SphericalPolygon
     }
 }
 
-/// Whether the spherical triangle of directions `ring` (any lengths) has a solid angle below
-/// `1e-12` sr, certified: Van Oosterom and Strackee's `tan(Omega / 2) = det / den` with the
-/// determinant on edge differences (absolute error below `64 eps` for unit vectors, whose
-/// differences are at most 2 long) and a denominator of at least `0.5`, where
-/// `|Omega| <= 2 |det| / den`. That is below the rounding of the integrals of any region the
-/// triangle is subtracted from.
-fn edge_on_triangle(ring: [DVec3; 3]) -> bool {
-    let (Some(a), Some(b), Some(c)) = (
-        ring[0].try_normalize(),
-        ring[1].try_normalize(),
-        ring[2].try_normalize(),
-    ) else {
+/// Solid angle (sr) below which a projected convex polygon that [`SphericalPolygon::new`]
+/// rejects is taken to cover nothing ([`edge_on_fan`]). Validation rejects a ring that folds
+/// back at a vertex (a wedge below `1e-12` rad, see `sphere::polygon::folds_back`); a triangle
+/// with such a corner lies in the lune of that wedge, `2e-12` sr at most, so twice that bound
+/// accepts every such triangle whose measure is certified. The sphere layer drops result rings
+/// at the same scale (thinner than `1e-12` times their squared perimeter).
+const EDGE_ON_SOLID_ANGLE: f64 = 4e-12;
+
+/// Whether the convex polygon of directions `ring` (any lengths; the projection of a planar
+/// convex polygon) has a solid angle below [`EDGE_ON_SOLID_ANGLE`], certified on its fan from
+/// the first corner: each fan triangle by Van Oosterom and Strackee's
+/// `tan(Omega / 2) = det / den` with the determinant on edge differences (absolute error below
+/// `64 eps` for unit vectors, whose differences are at most 2 long) and a denominator of at
+/// least `0.5`, where `|Omega| <= 2 |det| / den`, and the polygon's solid angle at most the sum
+/// of its fan triangles'.
+fn edge_on_fan(ring: impl Iterator<Item = DVec3>) -> bool {
+    let mut units: SmallVec<[DVec3; 4]> = SmallVec::new();
+    for v in ring {
+        match v.try_normalize() {
+            Some(u) => units.push(u),
+            None => return false,
+        }
+    }
+    if units.len() < 3 {
         return false;
-    };
-    let det = a.dot((b - a).cross(c - a));
-    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    den >= 0.5 && 2.0 * (det.abs() + 64.0 * f64::EPSILON) / den <= 1e-12
+    }
+    let a = units[0];
+    let mut bound = 0.0;
+    for w in units[1..].windows(2) {
+        let (b, c) = (w[0], w[1]);
+        let det = a.dot((b - a).cross(c - a));
+        let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+        if !(den >= 0.5) {
+            return false;
+        }
+        bound += 2.0 * (det.abs() + 64.0 * f64::EPSILON) / den;
+    }
+    bound <= EDGE_ON_SOLID_ANGLE
 }
 
 /// The region covered, seen from the frame's origin, by the part of blocker triangle `i` of

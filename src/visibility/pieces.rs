@@ -1,0 +1,1382 @@
+//! The fast path of [`ClipVisibility`]: the visible region of a light as rings of directions
+//! cut by half-spaces through the shading point, with no spherical polygon built, validated,
+//! projected or unprojected, and no allocation for small inputs.
+//!
+//! # Why half-spaces suffice
+//!
+//! A direction is a point of the projective plane: the gnomonic plane about any center, without
+//! the division (a point `(x, y)` of that plane is the direction `c + x e1 + y e2`, and any
+//! positive multiple of it). Great circles are its lines, and a minor arc between two directions
+//! is the chord between any positive multiples of them. So the set operations of the exact
+//! visibility rule can run on direction vectors of any positive length, in the shading frame,
+//! with each line given by the normal `n = a x b` of a great circle and each side test a sign
+//! of `n . v`: one projection (the frame's rotation) per point and light, for the light and
+//! every blocker alike, and no projection center to choose. Every integral downstream (Baum's
+//! edge sum, the clip-free LTC kernel, thesis 003 eq. 4.6/4.7) is invariant under positive
+//! scaling of each vertex, so nothing is ever normalized for it.
+//!
+//! The region is a chain of rings whose winding number is its indicator (the rings' edges with
+//! the region on their left): Baum's edge sum over all of them is the integral over the region,
+//! whatever their number, orientation or overlap. The light's own region starts it, clipped to
+//! the upper hemisphere (one half-space, `z >= 0`, whose crossing points have `z` exactly zero),
+//! so every ring lies in the closed upper hemisphere, where Baum's sum is the clamped-cosine
+//! integral.
+//!
+//! # Subtracting a blocker
+//!
+//! The region a blocker covers is convex whenever the blocker is: a convex polyhedron seen from
+//! outside covers the cone bounded by the planes through the point and its contour edges (seed
+//! 000 Alg. 2, thesis 003 section 4.2), `K = n_j H_j`, one half-space `H_j` per contour edge; a
+//! mesh triangle covers the cone of its three edges. `R - K` is computed in one of two ways:
+//!
+//! - **Boundary tracing** (Greiner and Hormann 1998, the difference), while the rings are simple
+//!   and disjoint (an outer boundary and its holes, or the light's one ring): the crossings of
+//!   the rings with `K`'s edges by parametric clipping of each ring edge against the half-spaces
+//!   (Cyrus and Beck 1978), then the rings followed outside `K` and `K`'s edges followed
+//!   backwards inside the region. The result is the region's boundary itself, the fewest edges
+//!   to integrate. Every decision it takes (a vertex's side of a plane, the order of two
+//!   crossings on one edge, which plane an edge enters `K` by) must clear its rounding bound by a
+//!   margin, and the traversal must close consistently; otherwise it does nothing and the
+//!   subtraction below runs instead, for this blocker and every later one.
+//! - **Inclusion–exclusion**, on any chain: `R - K = R - (R n K)`, each ring `L` cut by `K`'s
+//!   planes in turn (Sutherland–Hodgman against planes through the origin) and the cut appended
+//!   reversed. On a ring that is not convex a cut may leave bridges (edges along the cutting
+//!   circle run once each way), but as a chain its winding number is still the ring's times the
+//!   indicator of the half-space: the parts outside are closed by the same bridges into loops
+//!   outside it. A ring that `K` covers whole is removed instead, and one that a plane of `K`
+//!   leaves entirely outside costs one pass over its vertices. The chain cancels where blockers
+//!   overlap, to a few ulps of the light's integral, far below the spherical path's own
+//!   snapping of vertices (`crate::planar::SNAP_REL` of the projected coordinates). Each cut is
+//!   continuous in its input: a vertex on or within rounding of a cutting plane moves the
+//!   boundary by rounding, not its topology, so no near-degenerate configuration needs a
+//!   decision (and none is an [`GeomError::Undecidable`]).
+//!
+//! # Where it applies
+//!
+//! [`ClipVisibility::visible_pieces`] answers for [`Method::Silhouette`] with:
+//!
+//! - a convex light (its silhouette ring), or a planar mesh light (its boundary loops,
+//!   [`TriangleMesh::boundary_loops`], once per scene: seen from the front its region is the
+//!   region they bound, not a union of its triangles);
+//! - blockers that are separated from the light by the precomputed plane and touch none of its
+//!   triangles' planes (step 2 of [`ClipVisibility::visible_region`]: subtracted whole),
+//!   convex (their contour half-spaces) or meshes below
+//!   [`BVH_MIN_TRIANGLES`](super::BVH_MIN_TRIANGLES) triangles (each triangle's three
+//!   half-spaces, seen from either side).
+//!
+//! It declines (`Ok(false)`), leaving the region to the spherical path, for everything else: a
+//! blocker that interpenetrates the light or has a vertex in the plane of one of its triangles,
+//! a mesh blocker with a hierarchy (the one-pass union culls its triangles by shafts, see
+//! `visibility/union.rs`), a point inside a closed light or on its surface (a convex light
+//! without a front face), non-planar mesh lights, Bezier-bounded lights (flattened per point;
+//! as blockers they are their triangulated flattening, a mesh), a planar light seen
+//! edge-on by some of its triangles and not others, every silhouette that
+//! [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) would not take as one
+//! loop chained by vertex index with well separated vertices (the point inside or on a convex
+//! object, a point within rounding of an edge's line), and a blocker's silhouette that turns
+//! right somewhere (a face within the facing tolerance of edge-on left out): there the
+//! spherical path decides, or gives up, exactly as without this path.
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use super::cull::{above_horizon, may_occlude};
+use super::{ClipVisibility, Method};
+use crate::GeomError;
+use crate::solid::facing::{FACE_TOLERANCE, Side, face_side, in_front};
+use crate::solid::silhouette::chain_by_index;
+use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
+use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE};
+
+/// Directions of one ring of vertices, inline for the rings of small lights and their cuts.
+type Ring = SmallVec<[DVec3; 32]>;
+
+/// Most rings [`Pieces`] holds before the fast path declines: inclusion–exclusion can double
+/// them with each blocker that meets all of them, so this bounds the work for many mutually
+/// overlapping blockers, which the spherical path then takes.
+const MAX_RINGS: usize = 64;
+
+/// Margin of the boundary tracing's decisions, in units of the rounding error bounds they are
+/// compared with (see [`Pieces::trace_difference`]).
+const MARGIN: f64 = 64.0 * f64::EPSILON;
+
+/// Polyhedra up to this many vertices are chained without a buffer on the heap.
+const INLINE_VERTICES: usize = 64;
+
+/// A chain of rings: ring `k` is `pts[ends[k - 1]..ends[k]]` (from 0 for the first).
+#[derive(Debug, Clone)]
+struct Chain {
+    pts: SmallVec<[DVec3; 128]>,
+    ends: SmallVec<[u32; 16]>,
+}
+
+impl Chain {
+    #[inline(always)]
+    fn new() -> Self {
+        Chain {
+            pts: SmallVec::new(),
+            ends: SmallVec::new(),
+        }
+    }
+
+    fn clear(&mut self) {
+        self.pts.clear();
+        self.ends.clear();
+    }
+
+    /// Ends the ring started at `start`; one with fewer than three vertices bounds nothing and
+    /// is dropped.
+    fn close(&mut self, start: usize) {
+        if self.pts.len() - start >= 3 {
+            self.ends.push(self.pts.len() as u32);
+        } else {
+            self.pts.truncate(start);
+        }
+    }
+
+    /// Appends `ring` as a ring of the chain.
+    fn push_ring(&mut self, ring: &[DVec3]) {
+        self.pts.extend_from_slice(ring);
+        self.ends.push(self.pts.len() as u32);
+    }
+
+    /// The rings' index ranges.
+    fn ranges(&self) -> impl Iterator<Item = core::ops::Range<usize>> + '_ {
+        let mut start = 0usize;
+        self.ends.iter().map(move |&e| {
+            let r = start..e as usize;
+            start = e as usize;
+            r
+        })
+    }
+}
+
+/// The visible region of a light from a shading point, as the fast path of
+/// [`ClipVisibility::visible_pieces`] leaves it: rings of directions of any positive length (not
+/// unit vectors) in the closed upper hemisphere of the shading frame, forming a chain whose
+/// winding number is the region's indicator (the region on the left of each edge, as for a
+/// [`SphericalPolygon`](crate::sphere::SphericalPolygon), but rings may overlap and cancel):
+/// the region's boundary integrals are the sums of the rings' edge terms.
+///
+/// It is also the scratch storage of the fast path: a caller that keeps one across calls
+/// reuses its buffers. Inline room for 128 vertices in all, so small lights and blockers (up to
+/// 16 vertices each, a few blockers) allocate nothing; larger ones spill to the heap once per
+/// `Pieces` value.
+#[derive(Debug, Clone)]
+pub struct Pieces {
+    /// The region (`bufs[cur]`) and the one a subtraction builds (the other).
+    bufs: [Chain; 2],
+    cur: usize,
+    /// Whether the rings are simple and disjoint (no two touch), so that the boundary tracing
+    /// applies.
+    simple: bool,
+    /// A ring being cut by a blocker's planes, and the cut's output, used in turn.
+    rings: [Ring; 2],
+    /// The current blocker: its vertices (directions, counter-clockwise) and the normals of
+    /// its half-spaces (`planes[j]` through `kv[j]` and `kv[j + 1]`, `n . v >= 0` inside).
+    kv: Ring,
+    planes: SmallVec<[DVec3; 24]>,
+    /// Contour edges of a convex silhouette, and front-face flags of polyhedra with more than
+    /// 64 faces.
+    contour: SmallVec<[(u32, u32); 24]>,
+    front: SmallVec<[bool; 64]>,
+    /// A light ring being built.
+    dirs: Ring,
+    /// Boundary tracing: which vertices of the rings are inside `K` (bit `i` for vertex `i`),
+    /// and the crossings with their order along `K`.
+    inside_bits: u64,
+    crossings: SmallVec<[Crossing; 16]>,
+    order: SmallVec<[u16; 16]>,
+    /// Subtractions so far by boundary tracing and by inclusion–exclusion (diagnostics).
+    traced: u64,
+    cut: u64,
+}
+
+/// Where a ring of the region crosses the boundary of a blocker's region `K`.
+#[derive(Debug, Default, Clone, Copy)]
+struct Crossing {
+    /// The crossing point.
+    x: DVec3,
+    /// Position along the ring: the index (into the chain's points) of the crossed edge's first
+    /// vertex, and the parameter along the edge's chord.
+    edge: u32,
+    t: f64,
+    /// The ring's first and one-past-last vertex indices.
+    ring: (u32, u32),
+    /// The edge of `K` crossed (from `kv[j]` to `kv[j + 1]`).
+    j: u16,
+    /// Whether the ring enters `K` here (else it leaves it).
+    enter: bool,
+    /// The next crossing along the same ring, and this crossing's position in the order along
+    /// `K`'s boundary.
+    next: u16,
+    rank: u16,
+    /// Visited by the traversal.
+    done: bool,
+}
+
+impl Default for Pieces {
+    #[inline(always)]
+    fn default() -> Self {
+        Pieces::new()
+    }
+}
+
+impl Pieces {
+    /// Empty storage (no heap allocation).
+    #[must_use]
+    #[inline(always)]
+    pub fn new() -> Self {
+        // Field by field and always inlined, so that a caller's `Pieces` (or `ShadeContext`) is
+        // set up where it lives: only the vectors' lengths are written, not their inline storage
+        // (a few kilobytes) copied.
+        Pieces {
+            bufs: [Chain::new(), Chain::new()],
+            cur: 0,
+            simple: false,
+            rings: [SmallVec::new(), SmallVec::new()],
+            kv: SmallVec::new(),
+            planes: SmallVec::new(),
+            contour: SmallVec::new(),
+            front: SmallVec::new(),
+            dirs: SmallVec::new(),
+            inside_bits: 0,
+            crossings: SmallVec::new(),
+            order: SmallVec::new(),
+            traced: 0,
+            cut: 0,
+        }
+    }
+
+    /// The rings, each a slice of directions in the shading frame (not normalized).
+    pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + Clone + '_ {
+        let c = &self.bufs[self.cur];
+        let mut start = 0usize;
+        c.ends.iter().map(move |&e| {
+            let r = &c.pts[start..e as usize];
+            start = e as usize;
+            r
+        })
+    }
+
+    /// How many blocker subtractions this storage has run, over all calls: by boundary tracing
+    /// and by inclusion–exclusion (see the source of `visibility::pieces`); for tests and
+    /// benchmarks.
+    #[doc(hidden)]
+    #[must_use]
+    pub fn subtractions(&self) -> (u64, u64) {
+        (self.traced, self.cut)
+    }
+
+    /// Number of rings.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.bufs[self.cur].ends.len()
+    }
+
+    /// Whether there is no ring (nothing of the light is visible).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.bufs[self.cur].ends.is_empty()
+    }
+
+    fn clear(&mut self) {
+        self.bufs[self.cur].clear();
+        self.simple = false;
+    }
+
+    /// Makes the region a subtraction built in the other buffer the current one.
+    fn flip(&mut self) {
+        self.cur ^= 1;
+    }
+
+    /// Appends `self.dirs` clipped to the closed upper hemisphere (`z >= 0`) as a ring; whether
+    /// the horizon cut it.
+    fn push_dirs_upper(&mut self) -> bool {
+        let chain = &mut self.bufs[self.cur];
+        let dirs = &self.dirs;
+        let start = chain.pts.len();
+        let mut cut = false;
+        if dirs.iter().all(|v| v.z > 0.0) {
+            chain.pts.extend_from_slice(dirs);
+        } else if let Some(&last) = dirs.last() {
+            cut = true;
+            let mut prev = last;
+            for &cur in dirs.iter() {
+                if prev.z >= 0.0 {
+                    chain.pts.push(prev);
+                }
+                if (prev.z > 0.0 && cur.z < 0.0) || (prev.z < 0.0 && cur.z > 0.0) {
+                    // A positive combination with `z` exactly zero: the two products are the
+                    // same product (multiplication commutes), so they cancel exactly.
+                    let (a, b) = if prev.z > 0.0 {
+                        (prev, cur)
+                    } else {
+                        (cur, prev)
+                    };
+                    let x = a * -b.z + b * a.z;
+                    chain.pts.push(DVec3::new(x.x, x.y, 0.0));
+                }
+                prev = cur;
+            }
+        }
+        chain.close(start);
+        cut
+    }
+
+    /// Subtracts `K` (the intersection of the half-spaces in `self.planes`, whose vertices are
+    /// `self.kv`): by boundary tracing while the rings are simple, else (or where the tracing
+    /// declines) by inclusion–exclusion. `false` when the rings would exceed [`MAX_RINGS`].
+    fn subtract(&mut self) -> bool {
+        if self.simple {
+            if self.trace_difference() {
+                self.traced += 1;
+                return true;
+            }
+            self.simple = false;
+        }
+        self.cut += 1;
+        self.subtract_by_cuts()
+    }
+
+    /// `R - (R n K)`: for each ring `L` that `K` meets, `L n K` appended reversed, or `L`
+    /// removed where `K` covers it (see the module documentation).
+    fn subtract_by_cuts(&mut self) -> bool {
+        let Pieces {
+            bufs,
+            cur,
+            rings,
+            planes,
+            ..
+        } = self;
+        let (a, b) = bufs.split_at_mut(1);
+        let (from, to) = if *cur == 0 {
+            (&a[0], &mut b[0])
+        } else {
+            (&b[0], &mut a[0])
+        };
+        to.clear();
+        for range in from.ranges() {
+            let ring = &from.pts[range];
+            match cut_by_planes(ring, planes, rings) {
+                Cut::Outside => to.push_ring(ring),
+                // Covered whole: the ring and its cut cancel.
+                Cut::Inside => {}
+                Cut::Part(r) => {
+                    to.push_ring(ring);
+                    to.pts.extend(rings[r].iter().rev().copied());
+                    to.ends.push(to.pts.len() as u32);
+                }
+            }
+        }
+        let ok = to.ends.len() <= MAX_RINGS;
+        self.flip();
+        ok
+    }
+}
+
+/// The ring cut by every plane of `planes` (Sutherland–Hodgman), the result, if any, in
+/// `rings[r]`.
+fn cut_by_planes(ring: &[DVec3], planes: &[DVec3], rings: &mut [Ring; 2]) -> Cut {
+    // Index of the ring holding the current cut; `None` while it is still the ring itself.
+    let mut at: Option<usize> = None;
+    for &n in planes {
+        let (lo, hi) = rings.split_at_mut(1);
+        let (src, out): (&[DVec3], &mut Ring) = match at {
+            None => (ring, &mut lo[0]),
+            Some(0) => (&lo[0], &mut hi[0]),
+            Some(_) => (&hi[0], &mut lo[0]),
+        };
+        let (mut any_in, mut any_out) = (false, false);
+        for &v in src {
+            let s = n.dot(v);
+            any_in |= s > 0.0;
+            any_out |= s < 0.0;
+        }
+        if !any_out {
+            continue;
+        }
+        if !any_in {
+            return Cut::Outside;
+        }
+        cut_ring(src, n, out);
+        if out.len() < 3 {
+            return Cut::Outside;
+        }
+        at = Some(at.map_or(0, |r| 1 - r));
+    }
+    match at {
+        None => Cut::Inside,
+        Some(r) => Cut::Part(r),
+    }
+}
+
+/// What a blocker's planes leave of a ring ([`cut_by_planes`]).
+enum Cut {
+    /// Nothing inside: the blocker misses the ring (or meets it in no area).
+    Outside,
+    /// All of it inside: the blocker covers the ring.
+    Inside,
+    /// The part inside, in the ring of that index.
+    Part(usize),
+}
+
+/// The part of `ring` on the non-negative side of the plane with normal `n` through the origin,
+/// into `out` (Sutherland–Hodgman against one plane).
+fn cut_ring(ring: &[DVec3], n: DVec3, out: &mut Ring) {
+    out.clear();
+    let Some(&last) = ring.last() else {
+        return;
+    };
+    let (mut a, mut sa) = (last, n.dot(last));
+    for &b in ring {
+        let sb = n.dot(b);
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa > 0.0 && sb < 0.0) || (sa < 0.0 && sb > 0.0) {
+            out.push(chord_point(a, sa, b, sb));
+        }
+        (a, sa) = (b, sb);
+    }
+}
+
+/// The point of the chord `a-b` on the plane where the sides `sa` and `sb` (of opposite signs)
+/// vanish: a convex combination, so its length stays between theirs.
+#[inline]
+fn chord_point(a: DVec3, sa: f64, b: DVec3, sb: f64) -> DVec3 {
+    let (wa, wb) = (sb.abs(), sa.abs());
+    (a * wa + b * wb) / (wa + wb)
+}
+
+/// `|v|_1`, an upper bound of `|v|` without a root, for the rounding bounds.
+#[inline]
+fn norm1(v: DVec3) -> f64 {
+    v.x.abs() + v.y.abs() + v.z.abs()
+}
+
+/// `n` scaled to a 1-norm of 1 (a plane's normal: the half-space is the same, and the rounding
+/// bounds of the sides need no norm of it). `n` is not zero: the edges it comes from are checked
+/// to be apart.
+#[inline]
+fn unit1(n: DVec3) -> DVec3 {
+    n / norm1(n)
+}
+
+impl Pieces {
+    /// `R - K` by boundary tracing (Greiner and Hormann 1998, the difference; the crossings by
+    /// Cyrus–Beck clipping of each ring edge against `K`'s half-spaces), for simple disjoint
+    /// rings. `false`, with the region unchanged, where a decision is within its rounding bound
+    /// (times [`MARGIN`]) or the traversal does not close consistently.
+    ///
+    /// Rounding bounds: a side `n . v` (`n` from [`edge_plane`], scaled to `|n|_1 = 1` by
+    /// [`unit1`]) is off by at most a few `eps |v|`; a chord parameter `t = sa / (sa - sb)` by at most
+    /// `eps |n| (|a| + |b|) / |sa - sb|` times a small constant; both are compared with
+    /// [`MARGIN`] (64 `eps`) times the same products, with 1-norms for the lengths.
+    fn trace_difference(&mut self) -> bool {
+        let region = &self.bufs[self.cur];
+        let pts: &[DVec3] = &region.pts;
+        let planes: &[DVec3] = &self.planes;
+        if pts.len() > 64 {
+            return false;
+        }
+        // Which vertices lie inside `K` (bit `i`): outside at the first plane with a negative
+        // side. Each side that decides is checked against its rounding bound; sides are
+        // recomputed where the crossings need them, which is cheaper than storing them.
+        // Also the first plane each vertex outside `K` is outside of: an edge whose ends share
+        // it misses `K`, which the crossings' pass would find at that plane after the same
+        // checks on the same sides.
+        let mut inside = 0u64;
+        let mut first_out = [u32::MAX; 64];
+        for (i, &v) in pts.iter().enumerate() {
+            let v1 = norm1(v);
+            let mut all = true;
+            for (j, &n) in planes.iter().enumerate() {
+                let s = n.dot(v);
+                if s.abs() <= MARGIN * v1 {
+                    return false;
+                }
+                if s < 0.0 {
+                    all = false;
+                    first_out[i] = j as u32;
+                    break;
+                }
+            }
+            inside |= u64::from(all) << i;
+        }
+        self.inside_bits = inside;
+        // The crossings, ring by ring, in order along each ring.
+        self.crossings.clear();
+        let mut start = 0usize;
+        for &end in &region.ends {
+            let end = end as usize;
+            let first = self.crossings.len();
+            for a in start..end {
+                let b = if a + 1 == end { start } else { a + 1 };
+                // Both ends inside `K`, or both outside it first by the same plane (both
+                // inside is the one way to share `u32::MAX`).
+                if (inside >> a) & (inside >> b) & 1 == 1 || first_out[a] == first_out[b] {
+                    continue;
+                }
+                if !edge_crossings(
+                    pts,
+                    planes,
+                    (a, b),
+                    (start as u32, end as u32),
+                    &mut self.crossings,
+                ) {
+                    return false;
+                }
+            }
+            // Link the ring's crossings in a cycle.
+            let cs = &mut self.crossings[first..];
+            let last = cs.len();
+            for (c, x) in cs.iter_mut().enumerate() {
+                x.next = (first + if c + 1 == last { 0 } else { c + 1 }) as u16;
+            }
+            start = end;
+        }
+        if self.crossings.len() > u16::MAX as usize / 2 {
+            return false;
+        }
+        if self.crossings.is_empty() {
+            return self.difference_without_crossings();
+        }
+        if !self.order_along_k() {
+            return false;
+        }
+        self.traverse()
+    }
+
+    /// Ranks the crossings in order along `K`'s boundary (by edge, then along it); `false` where
+    /// two on one edge are within rounding of each other.
+    fn order_along_k(&mut self) -> bool {
+        let n = self.crossings.len();
+        self.order.clear();
+        for c in 0..n as u16 {
+            self.order.push(c);
+        }
+        // Insertion sort: a handful of crossings.
+        for i in 1..n {
+            let mut k = i;
+            while k > 0 {
+                let (p, q) = (self.order[k - 1] as usize, self.order[k] as usize);
+                let (cp, cq) = (&self.crossings[p], &self.crossings[q]);
+                let before = if cp.j != cq.j {
+                    cq.j < cp.j
+                } else {
+                    // Along the edge's great circle, counter-clockwise about its normal.
+                    let nj = self.planes[cp.j as usize];
+                    let d = cq.x.cross(cp.x).dot(nj);
+                    if d.abs() <= MARGIN * norm1(cp.x) * norm1(cq.x) {
+                        return false;
+                    }
+                    d > 0.0
+                };
+                if !before {
+                    break;
+                }
+                self.order.swap(k - 1, k);
+                k -= 1;
+            }
+        }
+        for (rank, &c) in self.order.iter().enumerate() {
+            self.crossings[c as usize].rank = rank as u16;
+        }
+        true
+    }
+
+    /// The Greiner–Hormann traversal of `R - K`: from each crossing where a ring leaves `K`,
+    /// along the ring to the next crossing (where it enters `K`), then backwards along `K`'s
+    /// boundary to the previous crossing in `K`'s order (where a ring leaves `K` again), until
+    /// the loop closes. Rings without crossings are kept outside `K` and dropped inside it.
+    /// `false`, with the region unchanged, where the crossings do not alternate as they must.
+    fn traverse(&mut self) -> bool {
+        let n = self.crossings.len();
+        let m = self.kv.len();
+        let Pieces {
+            bufs,
+            cur,
+            kv,
+            inside_bits,
+            crossings,
+            order,
+            ..
+        } = self;
+        let inside = *inside_bits;
+        let (a, b) = bufs.split_at_mut(1);
+        let (from, to) = if *cur == 0 {
+            (&a[0], &mut b[0])
+        } else {
+            (&b[0], &mut a[0])
+        };
+        to.clear();
+        let (fp, kv, order): (&[DVec3], &[DVec3], &[u16]) = (&from.pts, kv, order);
+        let crossings: &mut [Crossing] = crossings;
+        let mut guard = n + 1;
+        for c0 in 0..n {
+            if crossings[c0].done || crossings[c0].enter {
+                continue;
+            }
+            let start = to.pts.len();
+            let mut c = c0;
+            loop {
+                guard = match guard.checked_sub(1) {
+                    Some(g) => g,
+                    None => return false,
+                };
+                // Leaving `K` at `c`: along the ring to the next crossing.
+                let cc = crossings[c];
+                if cc.enter || cc.done {
+                    return false;
+                }
+                crossings[c].done = true;
+                to.pts.push(cc.x);
+                let e = crossings[cc.next as usize];
+                if !e.enter || e.done {
+                    return false;
+                }
+                let (r0, r1) = (cc.ring.0 as usize, cc.ring.1 as usize);
+                let len = r1 - r0;
+                let (ia, ib) = (cc.edge as usize - r0, e.edge as usize - r0);
+                let mut steps = (ib + len - ia) % len;
+                if steps == 0 && e.t <= cc.t {
+                    steps = len;
+                }
+                for k in 1..=steps {
+                    let i = ia + k;
+                    to.pts.push(fp[r0 + if i >= len { i - len } else { i }]);
+                }
+                to.pts.push(e.x);
+                crossings[cc.next as usize].done = true;
+                // Entering `K` at `e`: backwards along `K` to the previous crossing.
+                let p = order[if e.rank == 0 {
+                    n - 1
+                } else {
+                    e.rank as usize - 1
+                }] as usize;
+                let pc = crossings[p];
+                if pc.enter {
+                    return false;
+                }
+                let (je, jp) = (e.j as usize, pc.j as usize);
+                let mut steps = (je + m - jp) % m;
+                if steps == 0 && pc.rank > e.rank {
+                    steps = m;
+                }
+                for k in 0..steps {
+                    to.pts.push(kv[(je + m - k) % m]);
+                }
+                c = p;
+                if c == c0 {
+                    break;
+                }
+            }
+            to.close(start);
+        }
+        if crossings.iter().any(|c| !c.done) {
+            return false;
+        }
+        // Rings without crossings: kept outside `K`, dropped inside.
+        for range in from.ranges() {
+            let crossed = crossings.iter().any(|c| c.ring.0 as usize == range.start);
+            if !crossed && (inside >> range.start) & 1 == 0 {
+                to.push_ring(&from.pts[range]);
+            }
+        }
+        self.flip();
+        true
+    }
+
+    /// `R - K` where no ring crosses `K`'s boundary: rings inside `K` dropped, and `K` itself a
+    /// new hole where it lies inside the region (decided by the parity of the region's
+    /// crossings with the meridian arc from a vertex of `K` down through the horizon). `false`
+    /// where that parity is within rounding.
+    fn difference_without_crossings(&mut self) -> bool {
+        let k0 = self.kv[0];
+        // The region lies in the upper hemisphere.
+        let inside_region = if k0.z <= 0.0 {
+            Some(false)
+        } else {
+            contains(&self.bufs[self.cur], k0)
+        };
+        let Some(inside_region) = inside_region else {
+            return false;
+        };
+        let Pieces {
+            bufs,
+            cur,
+            kv,
+            inside_bits,
+            ..
+        } = self;
+        let inside = *inside_bits;
+        let (a, b) = bufs.split_at_mut(1);
+        let (from, to) = if *cur == 0 {
+            (&a[0], &mut b[0])
+        } else {
+            (&b[0], &mut a[0])
+        };
+        to.clear();
+        for range in from.ranges() {
+            if (inside >> range.start) & 1 == 0 {
+                to.push_ring(&from.pts[range]);
+            }
+        }
+        if inside_region {
+            // The boundary of `R - K` runs around `K` clockwise.
+            to.pts.extend(kv.iter().rev().copied());
+            to.ends.push(to.pts.len() as u32);
+        }
+        self.flip();
+        true
+    }
+}
+
+/// Adds to `out` the crossings of the ring edge `a -> b` (indices into `pts`, the ring's range
+/// `ring`) with `K`'s boundary, by Cyrus–Beck: the edge's part inside `K` is `[t_in, t_out]`,
+/// `t_in` the largest parameter at which it enters a half-space and `t_out` the smallest at which
+/// it leaves one. `false` where a side, the plane of the entry or exit, or whether the part is
+/// empty, is within rounding.
+fn edge_crossings(
+    pts: &[DVec3],
+    planes: &[DVec3],
+    (a, b): (usize, usize),
+    ring: (u32, u32),
+    out: &mut SmallVec<[Crossing; 16]>,
+) -> bool {
+    let (pa, pb) = (pts[a], pts[b]);
+    let (a1, b1) = (norm1(pa), norm1(pb));
+    // Entry and exit: parameter, error bound, plane; and the runners-up's nearest bound.
+    let (mut t_in, mut e_in, mut j_in, mut second_in) = (0.0, 0.0, usize::MAX, f64::NEG_INFINITY);
+    let (mut t_out, mut e_out, mut j_out, mut second_out) = (1.0, 0.0, usize::MAX, f64::INFINITY);
+    for (j, &n) in planes.iter().enumerate() {
+        let (sa, sb) = (n.dot(pa), n.dot(pb));
+        let bound = MARGIN;
+        if sa.abs() <= bound * a1 || sb.abs() <= bound * b1 {
+            return false;
+        }
+        if sa < 0.0 && sb < 0.0 {
+            // Outside this half-space all along: the edge misses `K`.
+            return true;
+        }
+        if (sa < 0.0) == (sb < 0.0) {
+            continue;
+        }
+        let t = sa / (sa - sb);
+        let e = bound * (a1 + b1) / (sa - sb).abs();
+        if sa < 0.0 {
+            // Entering this half-space.
+            if t - e > t_in + e_in {
+                second_in = second_in.max(t_in + e_in);
+                (t_in, e_in, j_in) = (t, e, j);
+            } else if t + e >= t_in - e_in {
+                return false;
+            } else {
+                second_in = second_in.max(t + e);
+            }
+        } else if t + e < t_out - e_out {
+            second_out = second_out.min(t_out - e_out);
+            (t_out, e_out, j_out) = (t, e, j);
+        } else if t - e <= t_out + e_out {
+            return false;
+        } else {
+            second_out = second_out.min(t - e);
+        }
+    }
+    if (j_in != usize::MAX && second_in >= t_in - e_in)
+        || (j_out != usize::MAX && second_out <= t_out + e_out)
+    {
+        return false;
+    }
+    if t_in + e_in >= t_out - e_out {
+        // Either clearly empty (the edge passes outside a corner of `K`) or within rounding of a
+        // corner.
+        return t_in - e_in > t_out + e_out;
+    }
+    let crossing = |t: f64, j: usize, enter: bool| Crossing {
+        x: pa + (pb - pa) * t,
+        edge: a as u32,
+        t,
+        ring,
+        j: j as u16,
+        enter,
+        ..Crossing::default()
+    };
+    match (j_in != usize::MAX, j_out != usize::MAX) {
+        (true, true) => out.extend([crossing(t_in, j_in, true), crossing(t_out, j_out, false)]),
+        (true, false) => out.push(crossing(t_in, j_in, true)),
+        (false, true) => out.push(crossing(t_out, j_out, false)),
+        (false, false) => {}
+    }
+    true
+}
+
+/// Whether the direction `p` (above the horizon, on no ring) lies in the region bounded by the
+/// simple disjoint rings of `region`: the parity of their crossings with the meridian arc from
+/// `p` down to the horizon and on to the nadir (the region lies in the closed upper hemisphere,
+/// so the nadir is outside it). `None` where a crossing is within rounding of the arc's plane or
+/// of `p`.
+fn contains(region: &Chain, p: DVec3) -> Option<bool> {
+    // The meridian plane's normal, `z x p`: points of the plane are further from the zenith than
+    // `p` (on `p`'s side) where `(p x q) . mer > 0`.
+    let mer = DVec3::new(-p.y, p.x, 0.0);
+    let (pm, mm) = (norm1(p), norm1(mer));
+    if mm <= MARGIN * pm {
+        return None;
+    }
+    let mut parity = false;
+    for range in region.ranges() {
+        let ring = &region.pts[range];
+        let mut a = ring[ring.len() - 1];
+        let mut sa = mer.dot(a);
+        for &b in ring {
+            let sb = mer.dot(b);
+            if sb.abs() <= MARGIN * mm * norm1(b) {
+                return None;
+            }
+            if (sa < 0.0) != (sb < 0.0) {
+                let x = chord_point(a, sa, b, sb);
+                let d = p.cross(x).dot(mer);
+                if d.abs() <= MARGIN * pm * norm1(x) * mm {
+                    return None;
+                }
+                parity ^= d > 0.0;
+            }
+            (a, sa) = (b, sb);
+        }
+    }
+    Some(parity)
+}
+
+impl<L: AsRef<Body>> ClipVisibility<L> {
+    /// The fast path of [`ClipVisibility::visible_region`] (with `blocked`) or of
+    /// [`Visibility::unoccluded_region`](super::Visibility::unoccluded_region) (without): the
+    /// region as [`Pieces`], whose integrals are those of the spherical path's region up to
+    /// rounding. `Ok(true)` when `out` holds the region; `Ok(false)` when this path does not
+    /// apply (see [`Pieces`] and the source of `visibility::pieces`) and the caller takes
+    /// [`ClipVisibility::visible_region`]. Allocates nothing for lights and blockers of up to
+    /// 16 vertices (beyond what `out` already holds).
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::OutOfRange`] for a light index past the end; nothing else (where the
+    /// spherical path could give up, this path declines instead).
+    pub fn visible_pieces(
+        &self,
+        light: usize,
+        frame: &ShadingFrame,
+        blocked: bool,
+        out: &mut Pieces,
+    ) -> Result<bool, GeomError> {
+        let body = self.light_body(light)?;
+        out.clear();
+        if self.method != Method::Silhouette {
+            return Ok(false);
+        }
+        let (x, n) = (frame.origin(), frame.normal());
+        if !above_horizon(x, n, self.light_bounds[light]) {
+            return Ok(true);
+        }
+        if !self.light_rings(light, body, frame, out) {
+            out.clear();
+            return Ok(false);
+        }
+        // No other object (the light alone in the scene): nothing to set up below.
+        if !blocked || self.blocker_count() == 1 {
+            return Ok(true);
+        }
+        for b in self.blockers_between(light, frame) {
+            if out.is_empty() {
+                break;
+            }
+            // Interpenetrating blockers, and blockers with a vertex in the plane of a light
+            // triangle (never subtracted whole: the touching part hides nothing), act face by
+            // face: the spherical path's business. Meshes large enough for a hierarchy go to
+            // the one-pass union, which culls their triangles by shafts. A Bezier-bounded
+            // light blocks others by its triangulated flattening, as on the spherical path.
+            let fits = self.separation(light, b).is_some()
+                && !self.touches(light, b)
+                && match self.blocker(b).0 {
+                    Body::Convex(p) => convex_planes(p, frame, out) && out.subtract(),
+                    other => {
+                        self.bvh(b).is_none()
+                            && self.subtract_triangles(light, other.mesh(), frame, out)
+                    }
+                };
+            if !fits {
+                out.clear();
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    /// The light's own region as the first rings of `out`, clipped to the upper hemisphere;
+    /// `false` where the fast path does not apply.
+    fn light_rings(
+        &self,
+        light: usize,
+        body: &Body,
+        frame: &ShadingFrame,
+        out: &mut Pieces,
+    ) -> bool {
+        match body {
+            Body::Convex(p) => {
+                if !convex_silhouette_dirs(p, frame, out, false) {
+                    return false;
+                }
+                // A convex ring stays one simple ring when the horizon cuts it.
+                out.push_dirs_upper();
+                out.simple = out.len() == 1;
+                true
+            }
+            Body::Mesh(m) => {
+                let Some(outline) = &self.outlines[light] else {
+                    return false;
+                };
+                // Every triangle of a planar mesh lies in one plane, but the facing predicate
+                // sees each with its own normal: the region is the outline only if it sees all
+                // of them from the front, and nothing if from none. (The facing predicate of
+                // `face_side`, with the tolerance computed once.)
+                let x = frame.origin();
+                let bound = m.bounding_sphere();
+                let rel = x - bound.center;
+                let tol = FACE_TOLERANCE * (bound.radius + rel.length());
+                let front = m
+                    .normals()
+                    .iter()
+                    .zip(m.offsets())
+                    .filter(|&(nf, &d)| in_front(nf.dot(rel) - d, tol))
+                    .count();
+                if front == 0 {
+                    return true;
+                }
+                if front != m.triangle_count() {
+                    return false;
+                }
+                // Lengths of the scene's scale would make the edge terms' products overflow or
+                // underflow far from 1: scaled by the inverse distance there.
+                let d2 = rel.length_squared();
+                let scale = if (1e-60..=1e60).contains(&d2) {
+                    1.0
+                } else {
+                    1.0 / crate::math::sqrt(d2)
+                };
+                let mut cut = false;
+                for ring in &outline.rings {
+                    // Written straight into the region; moved out to be clipped where the
+                    // horizon cuts it.
+                    let chain = &mut out.bufs[out.cur];
+                    let start = chain.pts.len();
+                    let mut above = true;
+                    for &p in ring {
+                        let v = frame.to_local(p);
+                        above &= v.z > 0.0;
+                        chain.pts.push(v);
+                    }
+                    if scale != 1.0 {
+                        chain.pts[start..].iter_mut().for_each(|v| *v *= scale);
+                    }
+                    if above {
+                        chain.close(start);
+                    } else {
+                        out.dirs.clear();
+                        out.dirs.extend_from_slice(&chain.pts[start..]);
+                        chain.pts.truncate(start);
+                        cut |= out.push_dirs_upper();
+                    }
+                }
+                // One ring, simple unless a concave one was cut into a chain with bridges.
+                out.simple = out.len() == 1 && (outline.convex || !cut);
+                true
+            }
+            // Flattened per point, as its own angular flatness from the point requires: the
+            // spherical path's business.
+            Body::Bezier(_) => false,
+        }
+    }
+
+    /// Subtracts from `out` every triangle of the mesh blocker `m` (seen from either side, each
+    /// with its three half-spaces), after the per-triangle cull of the spherical path; `false`
+    /// where a triangle's projection is turned over by rounding or the rings would exceed
+    /// [`MAX_RINGS`].
+    fn subtract_triangles(
+        &self,
+        light: usize,
+        m: &TriangleMesh,
+        frame: &ShadingFrame,
+        out: &mut Pieces,
+    ) -> bool {
+        let (x, n) = (frame.origin(), frame.normal());
+        let lb = self.light_bounds[light];
+        for t in 0..m.triangle_count() {
+            if out.is_empty() {
+                break;
+            }
+            if !may_occlude(x, n, lb, super::clip::triangle_bound(m.triangle(t))) {
+                continue;
+            }
+            let side = face_side(m, t, x);
+            if side == Side::On {
+                continue;
+            }
+            let [a, b, c] = m.triangle(t).map(|v| frame.to_local(v));
+            // Unit directions: the normals are then at most 1 long whatever the scene's scale.
+            let (Some(a), Some(b), Some(c)) =
+                (a.try_normalize(), b.try_normalize(), c.try_normalize())
+            else {
+                continue;
+            };
+            // Counter-clockwise seen from the point (a front face) is clockwise on the sphere:
+            // the region is on the left of the reversed ring.
+            let ring = if side == Side::Front {
+                [c, b, a]
+            } else {
+                [a, b, c]
+            };
+            // A triangle so nearly edge-on that rounding turns its projection over is the
+            // spherical path's to decide.
+            if !(left_turn(ring[0], ring[1], ring[2]) > 0.0) {
+                return false;
+            }
+            out.planes.clear();
+            out.planes
+                .extend((0..3).map(|k| unit1(edge_plane(ring[k], ring[(k + 1) % 3]))));
+            out.kv.clear();
+            out.kv.extend_from_slice(&ring);
+            if !out.subtract() {
+                return false;
+            }
+        }
+        true
+    }
+}
+
+/// The silhouette of the convex polyhedron `p` seen from the frame's point as directions in the
+/// frame (scaled by one positive factor), in `out.kv` if `to_kv` (a blocker's), else in
+/// `out.dirs` (counter-clockwise on the sphere: the silhouette on the left), exactly where [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the
+/// loop of the same vertices without its general ordering: front faces by the facing predicate
+/// (the same distances and tolerance), contour edges oriented by their front face, chained by
+/// vertex index into one loop whose consecutive directions are further apart than
+/// [`MATCH_TOLERANCE`] and not antipodal within [`ANTIPODAL_TOLERANCE`]. `false` elsewhere: no
+/// face in front (the point inside or on the surface, where that function returns a hemisphere,
+/// a lune or the full sphere) or a loop that needs the general ordering.
+fn convex_silhouette_dirs(
+    p: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    out: &mut Pieces,
+    to_kv: bool,
+) -> bool {
+    let mesh = p.mesh();
+    let b = mesh.bounding_sphere();
+    let rel = frame.origin() - b.center;
+    let tol = FACE_TOLERANCE * (b.radius + rel.length());
+    let normals = mesh.normals();
+    let offsets = mesh.offsets();
+    out.contour.clear();
+    if normals.len() <= 64 && p.vertices().len() <= INLINE_VERTICES {
+        let dirs = if to_kv { &mut out.kv } else { &mut out.dirs };
+        return small_silhouette_dirs(p, frame, rel, tol, dirs);
+    }
+    if normals.len() <= 64 {
+        // Front faces as bits, without a buffer.
+        let mut front = 0u64;
+        for (f, (nf, &d)) in normals.iter().zip(offsets).enumerate() {
+            front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
+        }
+        if front == 0 {
+            return false;
+        }
+        for e in p.edges() {
+            let (f0, f1) = ((front >> e.f0) & 1, (front >> e.f1) & 1);
+            if f0 != f1 {
+                out.contour
+                    .push(if f0 == 1 { (e.b, e.a) } else { (e.a, e.b) });
+            }
+        }
+    } else {
+        out.front.clear();
+        let mut any = false;
+        for (nf, &d) in normals.iter().zip(offsets) {
+            let f = in_front(nf.dot(rel) - d, tol);
+            any |= f;
+            out.front.push(f);
+        }
+        if !any {
+            return false;
+        }
+        for e in p.edges() {
+            match (out.front[e.f0 as usize], out.front[e.f1 as usize]) {
+                (true, false) => out.contour.push((e.b, e.a)),
+                (false, true) => out.contour.push((e.a, e.b)),
+                _ => {}
+            }
+        }
+    }
+    // Directions scaled by the inverse distance to the polyhedron's center (one division for
+    // all), not normalized: the planes, turns and sides below are invariant under positive
+    // scaling, and the lengths stay within a few units whatever the scene's scale.
+    let dist = rel.length();
+    if !(dist > 0.0) {
+        return false;
+    }
+    let inv = 1.0 / dist;
+    let verts = p.vertices();
+    out.dirs.clear();
+    if !chain_contour(&out.contour, verts, frame, inv, &mut out.dirs) {
+        return false;
+    }
+    let n = out.dirs.len();
+    if n < 3 {
+        return false;
+    }
+    // Consecutive directions further apart than `MATCH_TOLERANCE` and not antipodal within
+    // `ANTIPODAL_TOLERANCE`, as unit vectors: clearly so where the sine of the angle between
+    // them exceeds twice the larger tolerance and the angle is acute (no root, no division);
+    // otherwise decided on the unit vectors `convex_silhouette` uses.
+    const TOL2: f64 = 4.0 * MATCH_TOLERANCE * MATCH_TOLERANCE;
+    let mut prev = out.dirs[n - 1];
+    for k in 0..n {
+        let cur = out.dirs[k];
+        let clear = prev.dot(cur) > 0.0
+            && prev.cross(cur).length_squared()
+                > TOL2 * prev.length_squared() * cur.length_squared();
+        if !clear && !spaced_units(out, verts, frame, k) {
+            return false;
+        }
+        prev = cur;
+    }
+    if to_kv {
+        out.kv.clear();
+        out.kv.extend_from_slice(&out.dirs);
+    }
+    true
+}
+
+/// [`convex_silhouette_dirs`] for the common small polyhedron (at most 64 faces and
+/// [`INLINE_VERTICES`] vertices), the same decisions in one pass over the edges and one walk,
+/// without a list of contour edges: front faces as bits, each contour edge written straight
+/// into the successor table the chaining walks, and the spacing of consecutive directions
+/// tested during the walk (a vertex at the point has a zero direction, which no spacing test
+/// passes).
+fn small_silhouette_dirs(
+    p: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    rel: DVec3,
+    tol: f64,
+    dirs: &mut Ring,
+) -> bool {
+    const NONE: u32 = u32::MAX;
+    let mesh = p.mesh();
+    let mut front = 0u64;
+    for (f, (nf, &d)) in mesh.normals().iter().zip(mesh.offsets()).enumerate() {
+        front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
+    }
+    if front == 0 {
+        return false;
+    }
+    // Contour edges oriented by their front face (the silhouette on their left), chained by
+    // vertex index: every vertex used has one outgoing edge, and the walk from the first edge's
+    // tail uses all of them (as `chain_by_index` decides it).
+    let mut next = [NONE; INLINE_VERTICES];
+    let (mut count, mut start) = (0usize, NONE);
+    for e in p.edges() {
+        let (f0, f1) = ((front >> e.f0) & 1, (front >> e.f1) & 1);
+        if f0 != f1 {
+            let (a, b) = if f0 == 1 { (e.b, e.a) } else { (e.a, e.b) };
+            if next[a as usize] != NONE {
+                return false;
+            }
+            next[a as usize] = b;
+            if count == 0 {
+                start = a;
+            }
+            count += 1;
+        }
+    }
+    if count < 3 {
+        return false;
+    }
+    // Scaled by the inverse distance to the polyhedron's center, as in `convex_silhouette_dirs`.
+    let dist = rel.length();
+    if !(dist > 0.0) {
+        return false;
+    }
+    let inv = 1.0 / dist;
+    let verts = p.vertices();
+    dirs.clear();
+    dirs.reserve(count);
+    let first = frame.to_local(verts[start as usize]) * inv;
+    dirs.push(first);
+    let (mut prev, mut prev_id, mut at) = (first, start, next[start as usize]);
+    for k in 1..count {
+        if at == NONE || at == start {
+            return false;
+        }
+        let cur = frame.to_local(verts[at as usize]) * inv;
+        if !spaced(prev, cur, verts, frame, prev_id, at) {
+            return false;
+        }
+        dirs.push(cur);
+        (prev, prev_id) = (cur, at);
+        at = next[at as usize];
+        if k + 1 == count && at != start {
+            return false;
+        }
+    }
+    spaced(prev, first, verts, frame, prev_id, start)
+}
+
+/// Whether consecutive directions `a` and `b` (of vertices `ia` and `ib`) are further apart than
+/// `MATCH_TOLERANCE` and not antipodal within `ANTIPODAL_TOLERANCE`, as unit vectors: clearly so
+/// where the sine of the angle between them exceeds twice the larger tolerance and the angle is
+/// acute (no root, no division); otherwise decided on the unit vectors `convex_silhouette` uses.
+#[inline(always)]
+fn spaced(a: DVec3, b: DVec3, verts: &[DVec3], frame: &ShadingFrame, ia: u32, ib: u32) -> bool {
+    const TOL2: f64 = 4.0 * MATCH_TOLERANCE * MATCH_TOLERANCE;
+    let clear = a.dot(b) > 0.0
+        && a.cross(b).length_squared() > TOL2 * a.length_squared() * b.length_squared();
+    clear || spaced_ids(verts, frame, ia, ib)
+}
+
+/// The spacing test of [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) on
+/// the unit vectors of vertices `ia` and `ib`.
+#[cold]
+fn spaced_ids(verts: &[DVec3], frame: &ShadingFrame, ia: u32, ib: u32) -> bool {
+    let unit = |i: u32| frame.to_local(verts[i as usize]).try_normalize();
+    let (Some(a), Some(b)) = (unit(ia), unit(ib)) else {
+        return false;
+    };
+    (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+}
+
+/// The spacing test of [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) on
+/// the `k`-th chained vertex and its predecessor, on the unit vectors it uses.
+#[cold]
+fn spaced_units(out: &Pieces, verts: &[DVec3], frame: &ShadingFrame, k: usize) -> bool {
+    let n = out.contour.len();
+    // The chain starts at the first contour edge's tail, in the contour's own order.
+    let mut at = out.contour[0].0;
+    let mut ids = [0u32; 2];
+    let kp = if k == 0 { n - 1 } else { k - 1 };
+    for step in 0..n {
+        if step == kp {
+            ids[0] = at;
+        }
+        if step == k {
+            ids[1] = at;
+        }
+        match out.contour.iter().find(|e| e.0 == at) {
+            Some(e) => at = e.1,
+            None => return false,
+        }
+    }
+    let unit = |i: u32| frame.to_local(verts[i as usize]).try_normalize();
+    let (Some(a), Some(b)) = (unit(ids[0]), unit(ids[1])) else {
+        return false;
+    };
+    (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+}
+
+/// The contour edges chained by vertex index into one loop (as
+/// [`chain_by_index`](crate::solid::silhouette::chain_by_index) decides it: every vertex used
+/// has one outgoing edge and the walk from the first edge uses all of them), with the
+/// directions of its vertices in the frame, scaled by `scale`, pushed to `dirs` in order;
+/// `false` where it is not one such loop or a vertex is at the point.
+fn chain_contour(
+    contour: &[(u32, u32)],
+    verts: &[DVec3],
+    frame: &ShadingFrame,
+    scale: f64,
+    dirs: &mut Ring,
+) -> bool {
+    const NONE: u32 = u32::MAX;
+    if contour.len() < 3 {
+        return false;
+    }
+    let n = contour.len();
+    dirs.reserve(n);
+    if verts.len() > INLINE_VERTICES {
+        let Some(ring) = chain_by_index(contour, verts.len()) else {
+            return false;
+        };
+        for &i in &ring {
+            dirs.push(frame.to_local(verts[i as usize]) * scale);
+        }
+    } else {
+        let mut next = [NONE; INLINE_VERTICES];
+        for &(a, b) in contour {
+            if next[a as usize] != NONE {
+                return false;
+            }
+            next[a as usize] = b;
+        }
+        let start = contour[0].0;
+        let mut at = start;
+        for k in 0..n {
+            dirs.push(frame.to_local(verts[at as usize]) * scale);
+            at = next[at as usize];
+            if at == NONE || (at == start) != (k + 1 == n) {
+                return false;
+            }
+        }
+    }
+    // A vertex at the point has no direction.
+    dirs.iter().all(|v| v.length_squared() > 0.0)
+}
+
+/// The half-spaces of the convex blocker `p`'s silhouette into `out.planes`, one per contour
+/// edge (the silhouette is their intersection), and its vertices into `out.kv`; `false` where
+/// [`convex_silhouette_dirs`] declines or the silhouette turns right somewhere.
+fn convex_planes(p: &ConvexPolyhedron, frame: &ShadingFrame, out: &mut Pieces) -> bool {
+    if !convex_silhouette_dirs(p, frame, out, true) {
+        return false;
+    }
+    let Pieces { kv, planes, .. } = out;
+    let kv: &[DVec3] = kv;
+    let n = kv.len();
+    planes.clear();
+    planes.reserve(n);
+    // The intersection of the half-spaces is the silhouette only where it is convex: at a
+    // reflex vertex (a face seen within the facing tolerance of edge-on is left out of the
+    // silhouette, which then turns back by the angle that face's sliver would have filled) the
+    // planes would cut a wedge out of the silhouette along the extended edge, of about the
+    // reflex angle times the silhouette's size squared. Every turn must be to the left or
+    // straight within its rounding bound (a face exactly edge-on lines up its corners): a
+    // reflex angle of a few ulps hides a wedge of a few ulps.
+    // Each edge's difference serves both turns at its ends, and its plane.
+    let mut cur = kv[0];
+    let mut d_in = cur - kv[n - 1];
+    for k in 0..n {
+        let next = kv[if k + 1 == n { 0 } else { k + 1 }];
+        let d_out = next - cur;
+        // `left_turn(prev, cur, next)`, the same operations.
+        let turn = d_in.cross(d_out).dot(cur);
+        if !(turn > 0.0 || turn > -MARGIN * norm1(d_in) * norm1(d_out) * norm1(cur)) {
+            return false;
+        }
+        // `edge_plane(cur, next)`, bit for bit: `cur - next` is `-d_out` exactly, and negating a
+        // cross product's factor negates its products exactly.
+        planes.push(unit1((cur + next).cross(d_out)));
+        (cur, d_in) = (next, d_out);
+    }
+    true
+}
+
+/// The normal of the great circle through the unit directions `a` and `b`, pointing to the left
+/// of `a -> b`: `(a - b) x (a + b) = 2 a x b`, which keeps its relative precision when `a` and `b`
+/// are close (the difference is exact there), so that the circle passes within rounding of both
+/// however short the edge.
+#[inline]
+fn edge_plane(a: DVec3, b: DVec3) -> DVec3 {
+    (a - b).cross(a + b)
+}
+
+/// `det(a, b, c)` for unit directions, evaluated as `((b - a) x (c - b)) . b` so that it keeps
+/// its relative precision for close points: positive when `a -> b -> c` turns left (seen from
+/// outside the sphere).
+#[inline]
+fn left_turn(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    (b - a).cross(c - b).dot(b)
+}
