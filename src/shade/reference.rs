@@ -35,12 +35,12 @@ use glam::{DVec2, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::GeomError;
 use crate::ltc::{Ltc, lookup};
 use crate::math::sqrt;
 use crate::solid::{Body, BoundingSphere, ShadingFrame, Side, TriangleMesh, face_side};
 use crate::sphere::{SphericalPolygon, SphericalTriangle};
 use crate::visibility::Visibility;
+use crate::{GeomError, IntoDVec3};
 
 /// PCG32 (O'Neill 2014, `XSH RR` output): a small, fast, deterministic generator, so that the
 /// crate needs no RNG dependency and every estimate is reproducible from its seed.
@@ -616,8 +616,8 @@ impl MonteCarlo {
         self
     }
 
-    /// Estimates the radiance [`Scene::shade`] computes at `point` (same arguments), with the
-    /// random sequence given by `seed`.
+    /// Estimates the radiance [`Scene::shade`] computes at `point` (same arguments, `f32`
+    /// vectors included through [`IntoDVec3`]), with the random sequence given by `seed`.
     ///
     /// # Errors
     ///
@@ -625,12 +625,13 @@ impl MonteCarlo {
     pub fn estimate(
         &self,
         scene: &Scene,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
         seed: u64,
     ) -> Result<Estimate, GeomError> {
+        let (point, normal, view) = (point.into_dvec3(), normal.into_dvec3(), view.into_dvec3());
         let ps = PointSampler::new(scene, point, normal, view, material, self.brdf)?;
         let mut rng = Pcg32::new(seed, 0x5ade);
         let n = self.samples_per_light.max(1);
