@@ -288,7 +288,7 @@ pub(crate) fn one_pass(
                     // The point is inside the blocker: it hides everything.
                     return Ok(Some(Vec::new()));
                 }
-                polygon_rings(&sil, &chart, &mut soup);
+                polygon_rings(&sil, &chart, &mut soup)?;
             }
             _ => {
                 let role = Role::Blocker(accel.closed.as_ref());
@@ -672,7 +672,11 @@ fn clipped(dirs: &[DVec3; 3], chart: &Chart, horizon: bool) -> Option<Vec<DVec2>
 /// `-1` inside): projected as they are when every vertex lies in the zone of whole triangles and
 /// the region does not hold the chart's antipode (then the region lies in the chart's
 /// hemisphere), else after clipping it to the chart's cone by exact hemisphere clipping.
-fn polygon_rings(p: &SphericalPolygon, chart: &Chart, soup: &mut Vec<Vec<DVec2>>) {
+fn polygon_rings(
+    p: &SphericalPolygon,
+    chart: &Chart,
+    soup: &mut Vec<Vec<DVec2>>,
+) -> Result<(), GeomError> {
     let c = chart.g.center();
     let in_zone = |d: DVec3| {
         d.dot(c) >= MIN_WHOLE_COS
@@ -688,7 +692,10 @@ fn polygon_rings(p: &SphericalPolygon, chart: &Chart, soup: &mut Vec<Vec<DVec2>>
     } else {
         let mut c = p.clone();
         for n in chart.sides {
-            c = c.clip_to_hemisphere(n);
+            // The chart's sides are computed, not given: a bad one must not drop the blocker.
+            c = c
+                .try_clip_to_hemisphere(n)
+                .map_err(|e| e.give_up("a side of the union's chart is not a direction"))?;
         }
         clipped = c;
         &clipped
@@ -696,6 +703,7 @@ fn polygon_rings(p: &SphericalPolygon, chart: &Chart, soup: &mut Vec<Vec<DVec2>>
     for r in q.rings() {
         soup.push(r.iter().rev().map(|&d| chart.project(d)).collect());
     }
+    Ok(())
 }
 
 /// The directed edges of whole triangles in `work.edges` without the pairs that cancel (one
