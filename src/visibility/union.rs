@@ -58,7 +58,7 @@ use super::cull::Shaft;
 use crate::GeomError;
 use crate::planar::predicates::vertices_inside_segment;
 use crate::planar::{BoolOp, FillRule, Shape, boolean};
-use crate::solid::facing::{FACE_TOLERANCE, Side};
+use crate::solid::facing::{FacingAt, Side};
 use crate::solid::silhouette::convex_silhouette;
 use crate::solid::{Body, BoundingSphere, Bvh, ShadingFrame, TriangleMesh};
 use crate::sphere::{COINCIDENT_TOLERANCE, Gnomonic, SphericalPolygon, enclosing_cap};
@@ -544,9 +544,7 @@ fn mesh_rings(
     let x = frame.origin();
     let up = frame.normal();
     // The facing predicate (`face_side`) with its scale-relative tolerance computed once.
-    let b = mesh.bounding_sphere();
-    let rel = x - b.center;
-    let tol = FACE_TOLERANCE * (b.radius + rel.length());
+    let at = FacingAt::new(mesh, x);
     let (normals, offsets, verts) = (mesh.normals(), mesh.offsets(), mesh.vertices());
     work.edges.clear();
     let edges = &mut work.edges;
@@ -555,7 +553,7 @@ fn mesh_rings(
     let tested = bvh.is_some() || role == Role::Light;
     let mut visit = |t: usize, inside: bool| {
         // The facing first: it needs no corner, and drops the back faces of closed components.
-        let side = Side::of(normals[t].dot(rel) - offsets[t], tol);
+        let side = at.side(normals[t], offsets[t]);
         // Seen from the front a triangle's corners run clockwise in the chart (its axes are
         // right-handed seen from outside the sphere): winding -1 as given, +1 reversed.
         let keep_order = match (side, role) {
