@@ -56,6 +56,7 @@ fn set_point(l: &mut [Vec<BezierSegment>], r: usize, s: usize, k: usize, v: DVec
     match &mut l[r][s] {
         BezierSegment::Line(p) => p[k] = v,
         BezierSegment::Cubic(p) => p[k] = v,
+        _ => panic!("a segment kind these tests do not know"),
     }
 }
 

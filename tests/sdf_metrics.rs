@@ -1,8 +1,8 @@
-//! The image measures of the `sdf_shadows` example (examples/sdf_shadows/metrics.rs): MAE and
+//! The image measures of the `sdf_shadows` example (demo/src/bin/sdf_shadows/metrics.rs): MAE and
 //! RMSE against direct sums, SSIM against its closed form for constant images, against a
 //! separate single-window evaluation written out term by term, and for its basic properties.
 
-#[path = "../examples/sdf_shadows/metrics.rs"]
+#[path = "../demo/src/bin/sdf_shadows/metrics.rs"]
 mod metrics;
 mod support;
 

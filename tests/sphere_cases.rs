@@ -147,6 +147,42 @@ fn clip_full_and_empty() {
         })
     );
     assert!(up.clip_to_hemisphere(DVec3::ZERO).is_empty());
+    // Every bad normal, partly or wholly non-finite or zero: an error from the checked form, and
+    // the documented empty region from the infallible one, even for regions (the full sphere,
+    // a cap around the normal's axis) whose clip at any valid normal is not empty.
+    for bad in [
+        DVec3::ZERO,
+        -DVec3::ZERO,
+        DVec3::NAN,
+        DVec3::new(f64::NAN, 0.0, 1.0),
+        DVec3::new(0.0, f64::INFINITY, 0.0),
+        DVec3::new(1.0, 1.0, f64::NEG_INFINITY),
+    ] {
+        let want = if bad.is_finite() {
+            GeomError::ZeroLengthArgument {
+                what: "hemisphere normal",
+            }
+        } else {
+            GeomError::NonFiniteArgument {
+                what: "hemisphere normal",
+            }
+        };
+        for p in [SphericalPolygon::full(), up.clone()] {
+            assert_eq!(p.try_clip_to_hemisphere(bad), Err(want.clone()), "{bad}");
+            assert!(p.clip_to_hemisphere(bad).is_empty(), "{bad}");
+        }
+    }
+    // The smallest normals that name a direction are valid (the check is not a length test).
+    let tiny = DVec3::new(0.0, 0.0, f64::from_bits(1));
+    assert_eq!(
+        up.try_clip_to_hemisphere(tiny),
+        Ok(up.clip_to_hemisphere(DVec3::Z))
+    );
+    assert!(close(
+        up.clip_to_hemisphere(tiny).solid_angle(),
+        up.solid_angle(),
+        0.0
+    ));
 }
 
 #[test]

@@ -5,6 +5,10 @@
 
 // This file lives in the `compare` member because some of its references are i_overlay's.
 
+// The crate's shared test helpers (the one test RNG), from the package next door.
+#[path = "../../tests/support/mod.rs"]
+mod support;
+
 use arealight::glam::DVec3;
 use arealight::sphere::SphericalPolygon;
 
@@ -407,16 +411,10 @@ fn issue24_repro5_per_triangle_chain_over_a_jittered_grid() {
         v(-1.0, 1.0, 3.0),
     ]])
     .unwrap();
-    // A fixed pseudo-random jitter (SplitMix64), 1e-12 of the distance in each coordinate.
-    let mut state = 24u64;
+    // A fixed pseudo-random jitter, 1e-12 of the distance in each coordinate.
+    let mut rng = support::Rng::from_state(24);
     let mut jitter = |p: DVec3| {
-        let mut unit = || {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut unit = || rng.range(-1.0, 1.0);
         p + v(unit(), unit(), unit()) * 1e-12 * p.length()
     };
     let k = 6;

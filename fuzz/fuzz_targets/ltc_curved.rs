@@ -98,6 +98,7 @@ fn flatten(segs: &[CurveSegment], n: usize) -> Vec<DVec3> {
                     ring.push(s.point(k as f64 / n as f64));
                 }
             }
+            _ => panic!("a segment kind this target does not know"),
         }
     }
     ring
@@ -237,6 +238,7 @@ fuzz_target!(|case: Case| {
                 .map(|s| match *s {
                     CurveSegment::Line(p) => CurveSegment::Line(p.map(|v| v + shift * nudge)),
                     CurveSegment::Cubic(p) => CurveSegment::Cubic(p.map(|v| v + shift * nudge)),
+                    _ => panic!("a segment kind this target does not know"),
                 })
                 .collect()
         })

@@ -1,11 +1,17 @@
 //! Fuzz `Scene::shade`: random scenes of a few primitives (quads, boxes, icospheres, frustums,
 //! two-sheet meshes) on a coarse grid, so that touching, coplanar and interpenetrating objects
 //! are frequent, shaded at points on, near (2^-10 to 2^-60 off) and away from their surfaces,
-//! with NaN, infinities, zero and huge values anywhere in the point, normal and view.
+//! with NaN, infinities, zero, huge and tiny values anywhere: in the point, normal and view, in
+//! the primitives' parameters and raw triangles (wild geometry), in the lights' radiance and in
+//! the material's albedo, f0 and roughness.
 //!
 //! Asserted:
 //! - a non-finite, zero-length or out-of-range argument is the input fault naming it
 //!   (`NonFiniteArgument`, `ZeroLengthArgument`, `OutOfRange`), never a give-up;
+//! - a primitive with a non-finite parameter is `NonFiniteArgument` naming that parameter, a
+//!   raw mesh with a non-finite vertex `NonFinite` naming the vertex, and finite parameters never
+//!   give either; a non-finite or negative radiance and a material parameter outside `[0, 1]`
+//!   (NaN included) are `OutOfRange` naming the parameter;
 //! - a valid query gives a finite, non-negative radiance, or `GeomError::Undecidable` (a
 //!   documented give-up), never another error;
 //! - the radiance is never above the unoccluded value: each light's share (`shade_per_light`) is
@@ -48,6 +54,174 @@ enum Prim {
     Frustum(Grid, Grid, u8, u8, u8),
     /// Two quads as one open, non-planar mesh (self-occluding as a light).
     Sheets(Grid, Grid, u8),
+    /// A primitive from arbitrary values (NaN, infinities, zero, huge and tiny included).
+    Wild(Wild),
+}
+
+/// A vector of arbitrary values.
+#[derive(Debug, Clone, Copy, Arbitrary)]
+struct V(Num, Num, Num);
+
+impl V {
+    fn at(self) -> DVec3 {
+        DVec3::new(self.0.value(), self.1.value(), self.2.value())
+    }
+}
+
+#[derive(Debug, Clone, Copy, Arbitrary)]
+enum Wild {
+    Quad(V, V, V),
+    Cuboid(V, V),
+    Icosphere(V, Num),
+    Frustum(V, V, Num, Num),
+    /// One triangle through `TriangleMesh::new`.
+    Triangle(V, V, V),
+}
+
+/// The error a constructor must give for these named arguments: `NonFiniteArgument` naming the
+/// first non-finite one, if any.
+fn first_non_finite(args: &[(&'static str, DVec3)]) -> Option<GeomError> {
+    args.iter()
+        .find(|(_, v)| !v.is_finite())
+        .map(|&(what, _)| GeomError::NonFiniteArgument { what })
+}
+
+/// Checks a constructor's result against the fault its arguments must give (`None`: the
+/// arguments are finite, so whatever the constructor decides, it is not a non-finite fault).
+fn checked<T>(r: Result<T, GeomError>, fault: Option<GeomError>, what: &Wild) -> Option<T> {
+    match fault {
+        Some(f) => {
+            assert_eq!(r.err(), Some(f), "{what:?}");
+            None
+        }
+        None => match r {
+            Ok(t) => Some(t),
+            Err(e) => {
+                assert!(
+                    !matches!(
+                        e,
+                        GeomError::NonFinite { .. } | GeomError::NonFiniteArgument { .. }
+                    ),
+                    "finite arguments reported as non-finite: {e:?}\n{what:?}"
+                );
+                None
+            }
+        },
+    }
+}
+
+impl Wild {
+    fn build(self) -> Option<Body> {
+        let w = &self;
+        Some(match self {
+            Wild::Quad(c, u, v) => {
+                let (c, u, v) = (c.at(), u.at(), v.at());
+                let fault = first_non_finite(&[
+                    ("quad center", c),
+                    ("quad half-edge u", u),
+                    ("quad half-edge v", v),
+                ]);
+                checked(TriangleMesh::quad(c, u, v), fault, w)?.into()
+            }
+            Wild::Cuboid(c, h) => {
+                let (c, h) = (c.at(), h.at());
+                let fault =
+                    first_non_finite(&[("cuboid center", c), ("cuboid half extents", h)]);
+                checked(ConvexPolyhedron::cuboid(c, h), fault, w)?.into()
+            }
+            Wild::Icosphere(c, r) => {
+                let (c, r) = (c.at(), r.value());
+                let fault = first_non_finite(&[
+                    ("icosphere center", c),
+                    ("icosphere radius (positive)", DVec3::splat(r)),
+                ]);
+                checked(ConvexPolyhedron::icosphere(c, r, 1), fault, w)?.into()
+            }
+            Wild::Frustum(b, a, r0, r1) => {
+                let (b, a, r0, r1) = (b.at(), a.at(), r0.value(), r1.value());
+                let fault = first_non_finite(&[
+                    ("frustum base", b),
+                    ("frustum axis", a),
+                    ("frustum radius", DVec3::new(r0, r1, 0.0)),
+                ]);
+                checked(ConvexPolyhedron::frustum(b, a, r0, r1, 5), fault, w)?.into()
+            }
+            Wild::Triangle(a, b, c) => {
+                let pts = vec![a.at(), b.at(), c.at()];
+                // The vertices are checked in order: the first bad one is reported, non-finite
+                // or out of range.
+                let bad = pts
+                    .iter()
+                    .position(|p| !p.is_finite() || p.abs().max_element() > 1e100);
+                let result = TriangleMesh::new(pts.clone(), vec![[0, 1, 2]]);
+                match bad {
+                    Some(vertex) if !pts[vertex].is_finite() => {
+                        checked(result, Some(GeomError::NonFinite { ring: 0, vertex }), w)?
+                    }
+                    Some(_) => {
+                        assert!(
+                            matches!(result, Err(GeomError::OutOfRange { .. })),
+                            "{w:?}: {result:?}"
+                        );
+                        return None;
+                    }
+                    None => checked(result, None, w)?,
+                }
+                .into()
+            }
+        })
+    }
+}
+
+/// A light's radiance: the usual one, or arbitrary values.
+#[derive(Debug, Clone, Copy, Arbitrary)]
+enum Radiance {
+    Usual,
+    Wild(V),
+}
+
+/// The material: from bytes (always valid), or arbitrary albedo, f0 and roughness.
+#[derive(Debug, Clone, Copy, Arbitrary)]
+enum MaterialSpec {
+    Bytes(u8, u8, u8),
+    Wild(Num, Num, Num),
+}
+
+impl MaterialSpec {
+    fn build(self) -> Option<Material> {
+        match self {
+            MaterialSpec::Bytes(al, f0, r) => Some(
+                Material::new(
+                    DVec3::splat(f64::from(al) / 255.0),
+                    DVec3::splat(f64::from(f0 % 128) / 255.0),
+                    f64::from(r) / 255.0,
+                )
+                .unwrap(),
+            ),
+            MaterialSpec::Wild(al, f0, r) => {
+                let (al, f0, r) = (al.value(), f0.value(), r.value());
+                let result = Material::new(DVec3::splat(al), DVec3::splat(f0), r);
+                let unit = |x: f64| (0.0..=1.0).contains(&x);
+                let fault = [
+                    ("material albedo", al),
+                    ("material f0", f0),
+                    ("material roughness", r),
+                ]
+                .into_iter()
+                .find(|&(_, x)| !unit(x));
+                match fault {
+                    Some((what, _)) => {
+                        assert!(
+                            matches!(result, Err(GeomError::OutOfRange { what: w, .. }) if w == what),
+                            "{self:?}: {result:?}, expected OutOfRange naming {what}"
+                        );
+                        None
+                    }
+                    None => Some(result.unwrap()),
+                }
+            }
+        }
+    }
 }
 
 impl Prim {
@@ -77,6 +251,7 @@ impl Prim {
                     .ok()?
                     .into()
             }
+            Prim::Wild(w) => w.build()?,
         })
     }
 }
@@ -143,13 +318,42 @@ enum DirSpec {
 
 #[derive(Debug, Arbitrary)]
 struct Case {
-    lights: Vec<Prim>,
+    lights: Vec<(Prim, Radiance)>,
     occluders: Vec<Prim>,
     point: PointSpec,
     normal: DirSpec,
     view: DirSpec,
-    material: (u8, u8, u8),
+    material: MaterialSpec,
     per_triangle: bool,
+}
+
+/// The light of `body` with `radiance`, or `None` where `Light::new` must refuse it; asserts
+/// the refusal's variant.
+fn light(body: Body, radiance: Radiance) -> Option<Light> {
+    let rgb = match radiance {
+        Radiance::Usual => DVec3::new(1.0, 2.0, 0.5),
+        Radiance::Wild(v) => v.at(),
+    };
+    let result = Light::new(body, rgb);
+    if !rgb.to_array().iter().all(|c| c.is_finite() && *c >= 0.0) {
+        assert!(
+            matches!(
+                result,
+                Err(GeomError::OutOfRange {
+                    what: "light radiance (non-negative, finite)",
+                    ..
+                })
+            ),
+            "radiance {rgb}: {result:?}"
+        );
+        return None;
+    }
+    match result {
+        Ok(l) => Some(l),
+        // Raw triangles of a wild mesh may overlap as a planar light.
+        Err(GeomError::OverlappingLightTriangles { .. }) => None,
+        Err(e) => panic!("radiance {rgb}: {e:?}"),
+    }
 }
 
 fn dir(spec: DirSpec, surface: DVec3) -> DVec3 {
@@ -215,12 +419,13 @@ fn close_or_below(a: f64, b: f64) -> bool {
 }
 
 fuzz_target!(|case: Case| {
+    // Every part is built (and its faults checked) before any is found missing.
+    let material = case.material.build();
     let lights: Vec<Light> = case
         .lights
         .iter()
         .take(2)
-        .filter_map(|p| p.build())
-        .map(|b| Light::new(b, DVec3::new(1.0, 2.0, 0.5)).unwrap())
+        .filter_map(|&(p, r)| light(p.build()?, r))
         .collect();
     let occluders: Vec<Body> = case.occluders.iter().take(3).filter_map(|p| p.build()).collect();
     if lights.is_empty() {
@@ -253,13 +458,9 @@ fuzz_target!(|case: Case| {
         }
     };
     let (n, v) = (dir(case.normal, surface), dir(case.view, surface));
-    let (al, f0, r) = case.material;
-    let material = Material::new(
-        DVec3::splat(f64::from(al) / 255.0),
-        DVec3::splat(f64::from(f0 % 128) / 255.0),
-        f64::from(r) / 255.0,
-    )
-    .unwrap();
+    let Some(material) = material else {
+        return;
+    };
     let method = if case.per_triangle {
         Method::PerTriangle
     } else {

@@ -118,7 +118,10 @@ use crate::GeomError;
 /// One segment of a boundary loop, by its control points in the shading frame (directions are
 /// taken from the shading point, at the origin): a straight segment or a cubic Bezier curve
 /// `B(t) = (1-t)^3 p0 + 3 (1-t)^2 t p1 + 3 (1-t) t^2 p2 + t^3 p3`.
+///
+/// More segment kinds (quadratic or rational curves) may be added, hence `#[non_exhaustive]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum CurveSegment {
     /// The straight segment from the first point to the second.
     Line([DVec3; 2]),
@@ -183,8 +186,9 @@ impl CurveSegment {
     }
 }
 
-/// How the curves are turned into chords.
+/// How the curves are turned into chords. More strategies may be added (`#[non_exhaustive]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum Subdivision {
     /// Radiance-aware adaptive subdivision (seed 004 section 2.3): [`INITIAL_INTERVALS`]
     /// intervals per kept part of a curve, each split at its parameter midpoint while the signed

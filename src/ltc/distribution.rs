@@ -48,10 +48,11 @@ pub struct Ltc {
 /// Relative threshold below which a matrix counts as singular: `|det M| <= EPS * |M|_F^3`.
 const SINGULAR_EPS: f64 = 1e-14;
 
-fn check_matrix(m: DMat3) -> Result<(), GeomError> {
+/// Checks `m`, an argument named `what` (or computed from one: then `what` says so).
+fn check_matrix(m: DMat3, what: &'static str) -> Result<(), GeomError> {
     let cols = m.to_cols_array();
-    if let Some(i) = cols.iter().position(|c| !c.is_finite()) {
-        return Err(GeomError::NonFinite { ring: 0, vertex: i });
+    if cols.iter().any(|c| !c.is_finite()) {
+        return Err(GeomError::NonFiniteArgument { what });
     }
     let frob2: f64 = cols.iter().map(|c| c * c).sum();
     let scale = frob2 * sqrt(frob2);
@@ -70,12 +71,14 @@ impl Ltc {
     ///
     /// # Errors
     ///
-    /// [`GeomError::NonFinite`] if an entry is NaN or infinite (`vertex` is the column-major entry
-    /// index), [`GeomError::Degenerate`] if `m` is singular relative to its scale.
+    /// [`GeomError::NonFiniteArgument`] if an entry of `m` is NaN or infinite,
+    /// [`GeomError::Degenerate`] if `m` is singular relative to its scale.
     pub fn new(m: DMat3) -> Result<Self, GeomError> {
-        check_matrix(m)?;
+        check_matrix(m, "LTC matrix")?;
         let m_inv = m.inverse();
-        check_matrix(m_inv)?;
+        // Regular relative to its scale bounds the inverse's entries by `1e14 / |m|`, finite for
+        // every `m` whose determinant does not underflow; checked all the same.
+        check_matrix(m_inv, "LTC matrix (its inverse)")?;
         Ok(Self {
             m,
             m_inv,
@@ -90,9 +93,9 @@ impl Ltc {
     ///
     /// As for [`Ltc::new`].
     pub fn from_inverse(m_inv: DMat3) -> Result<Self, GeomError> {
-        check_matrix(m_inv)?;
+        check_matrix(m_inv, "inverse LTC matrix")?;
         let m = m_inv.inverse();
-        check_matrix(m)?;
+        check_matrix(m, "inverse LTC matrix (its inverse)")?;
         Ok(Self {
             m,
             m_inv,

@@ -189,7 +189,7 @@ fn checked_upper_part(
     what: &'static str,
 ) -> Result<(SphericalPolygon, f64), crate::GeomError> {
     const TOL: f64 = 4e-9 * PI;
-    let up = poly.clip_to_hemisphere(DVec3::Z);
+    let up = poly.clip_to_axis_hemisphere(DVec3::Z);
     let (wu, w) = (up.solid_angle(), poly.solid_angle());
     if !(wu <= w + TOL && w - wu <= 2.0 * PI + TOL) {
         return Err(crate::GeomError::Undecidable(what));
@@ -454,7 +454,7 @@ fn boundary_sum(poly: &SphericalPolygon, edge: impl EdgeTerm) -> f64 {
 
 /// The exact path: clip to the upper hemisphere, then the boundary sum.
 fn clipped_sum(poly: &SphericalPolygon, edge: impl EdgeTerm) -> f64 {
-    upper_sum(&poly.clip_to_hemisphere(DVec3::Z), edge)
+    upper_sum(&poly.clip_to_axis_hemisphere(DVec3::Z), edge)
 }
 
 /// The boundary sum of a region inside the closed upper hemisphere, where it is the integral.

@@ -185,7 +185,7 @@ impl Shape {
     /// - [`GeomError::NonFinite`] for a NaN or infinite coordinate, with its ring and vertex;
     /// - [`GeomError::CoordinateOutOfRange`] for a coordinate of magnitude above
     ///   [`MAX_COORD`](super::MAX_COORD), with its ring and vertex;
-    /// - [`GeomError::Undecidable`] or [`GeomError::Degenerate`] when `f64` cannot resolve the
+    /// - [`GeomError::Undecidable`] when `f64` cannot resolve the
     ///   arrangement consistently (splitting does not settle, or the exact winding numbers
     ///   contradict each other), as for [`boolean`](super::boolean); never for well-separated or
     ///   exactly degenerate input such as shared edges and vertices.

@@ -99,7 +99,11 @@ pub(crate) fn constrained_delaunay(
     let mut crossing = false;
     let cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
         ConstrainedDelaunayTriangulation::try_bulk_load_cdt(unique, edges, |_| crossing = true)
-            .map_err(|_| GeomError::NonFinite { ring: 0, vertex: 0 })?;
+            .map_err(|_| {
+                // Every coordinate was checked finite and scaled into spade's range above, so
+                // this is spade declining input the crate derived, not a fault of the caller's.
+                GeomError::Undecidable("the planar triangulation rejected scaled coordinates")
+            })?;
     if crossing {
         return Err(GeomError::Undecidable(
             "segments of the planar triangulation cross in rounded coordinates",

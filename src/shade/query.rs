@@ -331,9 +331,9 @@ impl Scene {
     pub fn shade_with(
         &self,
         vis: &dyn Visibility,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
         if vis.light_count() != self.lights().len() {
@@ -343,7 +343,7 @@ impl Scene {
                 limit: self.lights().len() as f64,
             });
         }
-        let frame = ShadingFrame::new(point, normal, view)?;
+        let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
         let mut ctx = ShadeContext::new();
         let mut total = DVec3::ZERO;

@@ -35,12 +35,12 @@ use glam::{DVec2, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::GeomError;
 use crate::ltc::{Ltc, lookup};
 use crate::math::sqrt;
 use crate::solid::{Body, BoundingSphere, ShadingFrame, Side, TriangleMesh, face_side};
 use crate::sphere::{SphericalPolygon, SphericalTriangle};
 use crate::visibility::Visibility;
+use crate::{GeomError, IntoDVec3};
 
 /// PCG32 (O'Neill 2014, `XSH RR` output): a small, fast, deterministic generator, so that the
 /// crate needs no RNG dependency and every estimate is reproducible from its seed.
@@ -416,13 +416,21 @@ impl<'a> PointSampler<'a> {
     }
 
     /// Whether triangle `i` of light `light`'s mesh `mesh` emits towards the shading point: it
-    /// faces the point (the point is on its centroid's front side), or the light is two-sided
-    /// ([`super::Light::two_sided`]) and the point is strictly behind it.
+    /// faces the point, or the light is two-sided ([`super::Light::two_sided`]) and the point is
+    /// behind it; a point in its plane sees it edge-on and gets nothing.
+    ///
+    /// The facing predicate ([`face_side`]) is the analytic path's on purpose. Which side of a
+    /// face a point within rounding of its plane is on is a convention of the model (like the
+    /// opacity model, which [`hits_before`] shares for the same reason), not something the
+    /// reference could check: the face covers a solid angle of the order of the tolerance
+    /// there. What the reference checks independently is the rest: which directions reach the
+    /// light (its own ray casts) and what they carry (sampling, the BRDF).
     fn emits_towards(&self, light: usize, mesh: &TriangleMesh, i: usize) -> bool {
-        let [a, b, c] = mesh.triangle(i);
-        let centroid = (a + b + c) / 3.0;
-        let facing = mesh.triangle_normal(i).dot(self.frame.origin() - centroid);
-        facing > 0.0 || (facing < 0.0 && self.scene.lights()[light].is_two_sided())
+        match face_side(mesh, i, self.frame.origin()) {
+            Side::Front => true,
+            Side::Behind => self.scene.lights()[light].is_two_sided(),
+            Side::On => false,
+        }
     }
 
     /// Fills `out` with the projections of light `light`'s front faces ([`LightSampling::Faces`]).
@@ -616,8 +624,8 @@ impl MonteCarlo {
         self
     }
 
-    /// Estimates the radiance [`Scene::shade`] computes at `point` (same arguments), with the
-    /// random sequence given by `seed`.
+    /// Estimates the radiance [`Scene::shade`] computes at `point` (same arguments, `f32`
+    /// vectors included through [`IntoDVec3`]), with the random sequence given by `seed`.
     ///
     /// # Errors
     ///
@@ -625,12 +633,13 @@ impl MonteCarlo {
     pub fn estimate(
         &self,
         scene: &Scene,
-        point: DVec3,
-        normal: DVec3,
-        view: DVec3,
+        point: impl IntoDVec3,
+        normal: impl IntoDVec3,
+        view: impl IntoDVec3,
         material: &Material,
         seed: u64,
     ) -> Result<Estimate, GeomError> {
+        let (point, normal, view) = (point.into_dvec3(), normal.into_dvec3(), view.into_dvec3());
         let ps = PointSampler::new(scene, point, normal, view, material, self.brdf)?;
         let mut rng = Pcg32::new(seed, 0x5ade);
         let n = self.samples_per_light.max(1);

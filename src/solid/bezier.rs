@@ -18,7 +18,10 @@ use crate::sphere::SphericalPolygon;
 /// One segment of a boundary loop of a [`BezierShape`], by its control points: a straight
 /// segment, or the cubic Bezier curve
 /// `B(t) = (1-t)^3 p0 + 3 (1-t)^2 t p1 + 3 (1-t) t^2 p2 + t^3 p3`, `t` in `[0, 1]`.
+///
+/// More segment kinds (quadratic or rational curves) may be added, hence `#[non_exhaustive]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum BezierSegment {
     /// The straight segment from the first point to the second.
     Line([DVec3; 2]),

@@ -7,7 +7,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use robust::orient3d;
 
-use super::facing::{FACE_TOLERANCE, Side, face_distances, face_side};
+use super::facing::{FacingAt, Side, face_distances, face_side};
 use super::mesh::{BoundingSphere, DEGENERATE_TRIANGLE, MeshEdge, TriangleMesh, check_vertices};
 use crate::GeomError;
 use crate::sphere::predicates::c3;
@@ -132,14 +132,12 @@ impl ConvexPolyhedron {
     /// surface faces away everywhere), while as a blocker it covers what
     /// [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) says.
     pub(crate) fn has_front_face(&self, x: DVec3) -> bool {
-        let b = self.mesh.bounding_sphere();
-        let rel = x - b.center;
-        let tol = FACE_TOLERANCE * (b.radius + rel.length());
+        let at = FacingAt::new(&self.mesh, x);
         self.mesh
             .normals()
             .iter()
             .zip(self.mesh.offsets())
-            .any(|(n, d)| Side::of(n.dot(rel) - d, tol) == Side::Front)
+            .any(|(n, &d)| at.front(*n, d))
     }
 }
 

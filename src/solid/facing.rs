@@ -84,6 +84,10 @@ impl Side {
 /// ```
 #[must_use]
 pub fn face_side(mesh: &TriangleMesh, f: usize, x: DVec3) -> Side {
+    // The arithmetic of `FacingAt::new(mesh, x).side(..)`, written out: through `FacingAt` the
+    // release build inlines differently elsewhere on the shading path and a shading point costs
+    // up to 4 instructions more (BENCHMARKS.md, "One facing formula"). The unit test below
+    // checks that both forms classify the same points the same way.
     let b = mesh.bounding_sphere();
     let rel = x - b.center;
     Side::of(
@@ -92,20 +96,82 @@ pub fn face_side(mesh: &TriangleMesh, f: usize, x: DVec3) -> Side {
     )
 }
 
+/// The facing predicate of [`face_side`] set up for one point and one mesh, for callers that
+/// decide many faces of the mesh from that point: the point relative to the mesh's bounding
+/// center and the tolerance there, computed once (one square root).
+/// Every facing decision in the crate goes through this type, so the distance formula and the
+/// tolerance exist once; its methods take a face by its unit normal and plane offset
+/// (`mesh.normals()[f]`, `mesh.offsets()[f]`) so that loops over the faces keep their own
+/// iteration.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FacingAt {
+    rel: DVec3,
+    tol: f64,
+}
+
+impl FacingAt {
+    /// The predicate at `x` for the faces of `mesh`.
+    #[inline]
+    #[must_use]
+    pub(crate) fn new(mesh: &TriangleMesh, x: DVec3) -> FacingAt {
+        let b = mesh.bounding_sphere();
+        let rel = x - b.center;
+        FacingAt {
+            rel,
+            tol: FACE_TOLERANCE * (b.radius + rel.length()),
+        }
+    }
+
+    /// The signed distance of the point in front of the face plane `(normal, offset)`.
+    #[inline]
+    #[must_use]
+    pub(crate) fn distance(self, normal: DVec3, offset: f64) -> f64 {
+        normal.dot(self.rel) - offset
+    }
+
+    /// The tolerance [`Side::of`] compares the distances with at this point.
+    #[inline]
+    #[must_use]
+    pub(crate) fn tol(self) -> f64 {
+        self.tol
+    }
+
+    /// [`face_side`] of the face plane `(normal, offset)`.
+    #[inline]
+    #[must_use]
+    pub(crate) fn side(self, normal: DVec3, offset: f64) -> Side {
+        Side::of(self.distance(normal, offset), self.tol)
+    }
+
+    /// Whether [`face_side`] of the face plane `(normal, offset)` is [`Side::Front`], as one
+    /// comparison.
+    #[inline]
+    #[must_use]
+    pub(crate) fn front(self, normal: DVec3, offset: f64) -> bool {
+        in_front(self.distance(normal, offset), self.tol)
+    }
+
+    /// The point relative to the mesh's bounding center.
+    #[inline]
+    #[must_use]
+    pub(crate) fn rel(self) -> DVec3 {
+        self.rel
+    }
+}
+
 /// The signed distances of `x` in front of every triangle's plane of `mesh`, written to `out` in
 /// triangle order, and the tolerance [`face_side`] compares them with: `Side::of(out[f], tol)` is
 /// `face_side(mesh, f, x)` for every `f`, with one square root for all faces.
 pub(crate) fn face_distances(mesh: &TriangleMesh, x: DVec3, out: &mut Vec<f64>) -> f64 {
-    let b = mesh.bounding_sphere();
-    let rel = x - b.center;
+    let at = FacingAt::new(mesh, x);
     out.clear();
     out.extend(
         mesh.normals()
             .iter()
             .zip(mesh.offsets())
-            .map(|(n, d)| n.dot(rel) - d),
+            .map(|(n, &d)| at.distance(*n, d)),
     );
-    FACE_TOLERANCE * (b.radius + rel.length())
+    at.tol()
 }
 
 /// The signed distance of `x` in front of the plane of triangle `f`, or exactly `0` where
@@ -113,10 +179,9 @@ pub(crate) fn face_distances(mesh: &TriangleMesh, x: DVec3, out: &mut Vec<f64>) 
 /// so that the cut and the facing decisions agree.
 #[must_use]
 pub(crate) fn snapped_distance(mesh: &TriangleMesh, f: usize, x: DVec3) -> f64 {
-    let b = mesh.bounding_sphere();
-    let rel = x - b.center;
-    let s = mesh.normals()[f].dot(rel) - mesh.offsets()[f];
-    match Side::of(s, FACE_TOLERANCE * (b.radius + rel.length())) {
+    let at = FacingAt::new(mesh, x);
+    let s = at.distance(mesh.normals()[f], mesh.offsets()[f]);
+    match Side::of(s, at.tol()) {
         Side::On => 0.0,
         _ => s,
     }
@@ -135,8 +200,9 @@ mod tests {
 
     #[test]
     fn every_form_of_the_predicate_agrees_on_and_near_face_planes() {
-        // The three forms the callers use (the batch of convex silhouettes and convexity checks,
-        // the per-triangle side, the snapped distance of the face-by-face cut) classify every
+        // The forms the callers use (the batch of convex silhouettes and convexity checks, the
+        // per-triangle side, the prepared predicate of the loops over a mesh's faces, the
+        // snapped distance of the face-by-face cut) classify every
         // point the same way, and the documented band holds: points in a face's plane are on it,
         // points 4 tolerances off are on their side, at every scale and offset.
         // Offset so that the coordinates' own rounding (ulps of 300) stays below the tolerance
@@ -200,6 +266,10 @@ mod tests {
                         assert_eq!(side, expect, "face {f} at {x}");
                         let t = face_distances(mesh, x, &mut dist);
                         assert_eq!(Side::of(dist[f], t), side, "batch, face {f} at {x}");
+                        let at = FacingAt::new(mesh, x);
+                        let (nf, df) = (mesh.normals()[f], mesh.offsets()[f]);
+                        assert_eq!(at.side(nf, df), side, "prepared, face {f} at {x}");
+                        assert_eq!(at.front(nf, df), side == Side::Front, "front, face {f}");
                         let s = snapped_distance(mesh, f, x);
                         let snapped = if s > 0.0 {
                             Side::Front

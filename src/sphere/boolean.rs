@@ -599,9 +599,9 @@ fn split(
         let s = |bit: u8| if k & bit == 0 { 1.0 } else { -1.0 };
         let (sx, sy, sz) = (s(1), s(2), s(4));
         let cut = |p: &SphericalPolygon| {
-            p.clip_to_hemisphere(DVec3::X * sx)
-                .clip_to_hemisphere(DVec3::Y * sy)
-                .clip_to_hemisphere(DVec3::Z * sz)
+            p.clip_to_axis_hemisphere(DVec3::X * sx)
+                .clip_to_axis_hemisphere(DVec3::Y * sy)
+                .clip_to_axis_hemisphere(DVec3::Z * sz)
         };
         let (pa, pb) = (cut(a), cut(b));
         if pa.is_empty() && pb.is_empty() {

@@ -51,9 +51,19 @@ const SNAP_CHORD2: f64 = 3.75;
 impl SphericalPolygon {
     /// The part of the region in the closed hemisphere `{p : p . normal >= 0}`.
     ///
-    /// `normal` need not be normalized. A zero or non-finite normal selects no hemisphere and
-    /// gives the empty polygon; use [`SphericalPolygon::try_clip_to_hemisphere`] to get an error
-    /// instead.
+    /// `normal` need not be normalized, but it must be finite and non-zero. This signature
+    /// (fixed by the crate's public contract) has no way to report a bad normal, so:
+    ///
+    /// - **Use [`SphericalPolygon::try_clip_to_hemisphere`] for any normal that comes from
+    ///   input** (a shading normal, a face normal of user geometry, anything computed from
+    ///   them): it returns [`GeomError::NonFiniteArgument`] or
+    ///   [`GeomError::ZeroLengthArgument`] instead. Every clip inside the crate whose normal is
+    ///   not a constant coordinate axis goes through it and passes the error on.
+    /// - **A zero or non-finite normal here gives the empty polygon**, in every build, without
+    ///   a panic (nothing in the crate panics on input). The empty region is the one answer
+    ///   that cannot make a caller's result too large: integrated, it adds no light and no
+    ///   solid angle. It is not a sign that the clip found nothing; only the checked form tells
+    ///   the two apart.
     ///
     /// The result is exact for the polygon whose vertices within [`HORIZON_TOLERANCE`] of the
     /// circle, and ends of edges lying along it within `2e-12` of their length, are moved onto
@@ -102,6 +112,18 @@ impl SphericalPolygon {
         }
         let n = normalize_any(normal).ok_or(GeomError::ZeroLengthArgument { what: WHAT })?;
         Ok(clip_polygon(self, n))
+    }
+
+    /// The clip at a unit normal the crate fixes itself (a coordinate axis), where no fault can
+    /// arise: [`SphericalPolygon::try_clip_to_hemisphere`] without the check, bit for bit the
+    /// same result (`normalize_any` returns an axis unchanged). Normals computed from input go
+    /// through the checked form instead.
+    pub(crate) fn clip_to_axis_hemisphere(&self, axis: DVec3) -> SphericalPolygon {
+        debug_assert!(
+            axis.abs().max_element() == 1.0 && axis.length_squared() == 1.0,
+            "not a coordinate axis: {axis}"
+        );
+        clip_polygon(self, axis)
     }
 }
 

@@ -346,8 +346,8 @@ fn solve(
     // 5. Cut by the next coordinate plane.
     if depth < 3 {
         let n = AXES[depth];
-        solve(&poly.clip_to_hemisphere(n), depth + 1, out)?;
-        return solve(&poly.clip_to_hemisphere(-n), depth + 1, out);
+        solve(&poly.clip_to_axis_hemisphere(n), depth + 1, out)?;
+        return solve(&poly.clip_to_axis_hemisphere(-n), depth + 1, out);
     }
     Err(GeomError::Undecidable(
         "no chart of an octant triangulates the polygon within rounding",

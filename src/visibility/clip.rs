@@ -881,7 +881,7 @@ const ABOVE_ARC: f64 = 1e-7;
 /// over itself along the circle), and would be integrated as a large part of the sky: it is a
 /// give-up, [`GeomError::Undecidable`]. One containment test per long horizon edge.
 fn upper_part(p: &SphericalPolygon) -> Result<SphericalPolygon, GeomError> {
-    let c = p.clip_to_hemisphere(DVec3::Z);
+    let c = p.clip_to_axis_hemisphere(DVec3::Z);
     // Most parts do not touch the horizon at all (a light above it): one pass over the
     // vertices, without the edge pairs.
     let mut touches = false;

@@ -83,7 +83,7 @@ use smallvec::SmallVec;
 use super::cull::{above_horizon, may_occlude};
 use super::{ClipVisibility, Method};
 use crate::GeomError;
-use crate::solid::facing::{FACE_TOLERANCE, Side, face_side, in_front};
+use crate::solid::facing::{FacingAt, Side, face_side};
 use crate::solid::silhouette::chain_by_index;
 use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE};
@@ -939,15 +939,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 // sees each with its own normal: the region is the outline only if it sees all
                 // of them from the front, and nothing if from none. (The facing predicate of
                 // `face_side`, with the tolerance computed once.)
-                let x = frame.origin();
-                let bound = m.bounding_sphere();
-                let rel = x - bound.center;
-                let tol = FACE_TOLERANCE * (bound.radius + rel.length());
+                let at = FacingAt::new(m, frame.origin());
                 let front = m
                     .normals()
                     .iter()
                     .zip(m.offsets())
-                    .filter(|&(nf, &d)| in_front(nf.dot(rel) - d, tol))
+                    .filter(|&(nf, &d)| at.front(*nf, d))
                     .count();
                 if front == 0 {
                     return true;
@@ -957,7 +954,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 }
                 // Lengths of the scene's scale would make the edge terms' products overflow or
                 // underflow far from 1: scaled by the inverse distance there.
-                let d2 = rel.length_squared();
+                let d2 = at.rel().length_squared();
                 let scale = if (1e-60..=1e60).contains(&d2) {
                     1.0
                 } else {
@@ -1069,21 +1066,19 @@ fn convex_silhouette_dirs(
     to_kv: bool,
 ) -> bool {
     let mesh = p.mesh();
-    let b = mesh.bounding_sphere();
-    let rel = frame.origin() - b.center;
-    let tol = FACE_TOLERANCE * (b.radius + rel.length());
+    let at = FacingAt::new(mesh, frame.origin());
     let normals = mesh.normals();
     let offsets = mesh.offsets();
     out.contour.clear();
     if normals.len() <= 64 && p.vertices().len() <= INLINE_VERTICES {
         let dirs = if to_kv { &mut out.kv } else { &mut out.dirs };
-        return small_silhouette_dirs(p, frame, rel, tol, dirs);
+        return small_silhouette_dirs(p, frame, at, dirs);
     }
     if normals.len() <= 64 {
         // Front faces as bits, without a buffer.
         let mut front = 0u64;
         for (f, (nf, &d)) in normals.iter().zip(offsets).enumerate() {
-            front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
+            front |= u64::from(at.front(*nf, d)) << f;
         }
         if front == 0 {
             return false;
@@ -1099,7 +1094,7 @@ fn convex_silhouette_dirs(
         out.front.clear();
         let mut any = false;
         for (nf, &d) in normals.iter().zip(offsets) {
-            let f = in_front(nf.dot(rel) - d, tol);
+            let f = at.front(*nf, d);
             any |= f;
             out.front.push(f);
         }
@@ -1117,7 +1112,7 @@ fn convex_silhouette_dirs(
     // Directions scaled by the inverse distance to the polyhedron's center (one division for
     // all), not normalized: the planes, turns and sides below are invariant under positive
     // scaling, and the lengths stay within a few units whatever the scene's scale.
-    let dist = rel.length();
+    let dist = at.rel().length();
     if !(dist > 0.0) {
         return false;
     }
@@ -1163,15 +1158,14 @@ fn convex_silhouette_dirs(
 fn small_silhouette_dirs(
     p: &ConvexPolyhedron,
     frame: &ShadingFrame,
-    rel: DVec3,
-    tol: f64,
+    at: FacingAt,
     dirs: &mut Ring,
 ) -> bool {
     const NONE: u32 = u32::MAX;
     let mesh = p.mesh();
     let mut front = 0u64;
     for (f, (nf, &d)) in mesh.normals().iter().zip(mesh.offsets()).enumerate() {
-        front |= u64::from(in_front(nf.dot(rel) - d, tol)) << f;
+        front |= u64::from(at.front(*nf, d)) << f;
     }
     if front == 0 {
         return false;
@@ -1199,7 +1193,7 @@ fn small_silhouette_dirs(
         return false;
     }
     // Scaled by the inverse distance to the polyhedron's center, as in `convex_silhouette_dirs`.
-    let dist = rel.length();
+    let dist = at.rel().length();
     if !(dist > 0.0) {
         return false;
     }

@@ -58,7 +58,7 @@ use super::cull::Shaft;
 use crate::GeomError;
 use crate::planar::predicates::vertices_inside_segment;
 use crate::planar::{BoolOp, FillRule, Shape, boolean};
-use crate::solid::facing::{FACE_TOLERANCE, Side};
+use crate::solid::facing::{FacingAt, Side};
 use crate::solid::silhouette::convex_silhouette;
 use crate::solid::{Body, BoundingSphere, Bvh, ShadingFrame, TriangleMesh};
 use crate::sphere::{COINCIDENT_TOLERANCE, Gnomonic, SphericalPolygon, enclosing_cap};
@@ -288,7 +288,7 @@ pub(crate) fn one_pass(
                     // The point is inside the blocker: it hides everything.
                     return Ok(Some(Vec::new()));
                 }
-                polygon_rings(&sil, &chart, &mut soup);
+                polygon_rings(&sil, &chart, &mut soup)?;
             }
             _ => {
                 let role = Role::Blocker(accel.closed.as_ref());
@@ -544,9 +544,7 @@ fn mesh_rings(
     let x = frame.origin();
     let up = frame.normal();
     // The facing predicate (`face_side`) with its scale-relative tolerance computed once.
-    let b = mesh.bounding_sphere();
-    let rel = x - b.center;
-    let tol = FACE_TOLERANCE * (b.radius + rel.length());
+    let at = FacingAt::new(mesh, x);
     let (normals, offsets, verts) = (mesh.normals(), mesh.offsets(), mesh.vertices());
     work.edges.clear();
     let edges = &mut work.edges;
@@ -555,7 +553,7 @@ fn mesh_rings(
     let tested = bvh.is_some() || role == Role::Light;
     let mut visit = |t: usize, inside: bool| {
         // The facing first: it needs no corner, and drops the back faces of closed components.
-        let side = Side::of(normals[t].dot(rel) - offsets[t], tol);
+        let side = at.side(normals[t], offsets[t]);
         // Seen from the front a triangle's corners run clockwise in the chart (its axes are
         // right-handed seen from outside the sphere): winding -1 as given, +1 reversed.
         let keep_order = match (side, role) {
@@ -672,7 +670,11 @@ fn clipped(dirs: &[DVec3; 3], chart: &Chart, horizon: bool) -> Option<Vec<DVec2>
 /// `-1` inside): projected as they are when every vertex lies in the zone of whole triangles and
 /// the region does not hold the chart's antipode (then the region lies in the chart's
 /// hemisphere), else after clipping it to the chart's cone by exact hemisphere clipping.
-fn polygon_rings(p: &SphericalPolygon, chart: &Chart, soup: &mut Vec<Vec<DVec2>>) {
+fn polygon_rings(
+    p: &SphericalPolygon,
+    chart: &Chart,
+    soup: &mut Vec<Vec<DVec2>>,
+) -> Result<(), GeomError> {
     let c = chart.g.center();
     let in_zone = |d: DVec3| {
         d.dot(c) >= MIN_WHOLE_COS
@@ -688,7 +690,10 @@ fn polygon_rings(p: &SphericalPolygon, chart: &Chart, soup: &mut Vec<Vec<DVec2>>
     } else {
         let mut c = p.clone();
         for n in chart.sides {
-            c = c.clip_to_hemisphere(n);
+            // The chart's sides are computed, not given: a bad one must not drop the blocker.
+            c = c
+                .try_clip_to_hemisphere(n)
+                .map_err(|e| e.give_up("a side of the union's chart is not a direction"))?;
         }
         clipped = c;
         &clipped
@@ -696,6 +701,7 @@ fn polygon_rings(p: &SphericalPolygon, chart: &Chart, soup: &mut Vec<Vec<DVec2>>
     for r in q.rings() {
         soup.push(r.iter().rev().map(|&d| chart.project(d)).collect());
     }
+    Ok(())
 }
 
 /// The directed edges of whole triangles in `work.edges` without the pairs that cancel (one

@@ -148,6 +148,7 @@ pub fn shape(plane: &Plane, loops: &[Vec<Seg2>]) -> BezierShape {
                 .map(|s| match *s {
                     CurveSegment::Line(p) => BezierSegment::Line(p),
                     CurveSegment::Cubic(p) => BezierSegment::Cubic(p),
+                    _ => panic!("a segment kind these tests do not know"),
                 })
                 .collect(),
         );
@@ -202,6 +203,7 @@ fn eval(s: &CurveSegment, t: f64) -> (DVec3, DVec3) {
             let dp = (b - a) * 3.0 * u * u + (c - b) * 6.0 * u * t + (d - c) * 3.0 * t * t;
             (p, dp)
         }
+        _ => panic!("a segment kind this reference does not know"),
     }
 }
 
@@ -319,6 +321,7 @@ pub fn flatten(segs: &[CurveSegment], n: usize) -> Vec<Vec<DVec3>> {
                     cur.push(eval(s, k as f64 / n as f64).0);
                 }
             }
+            _ => panic!("a segment kind this reference does not know"),
         }
         if Some(s.end()) == start {
             rings.push(std::mem::take(&mut cur));

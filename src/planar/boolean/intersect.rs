@@ -169,7 +169,7 @@ pub(crate) fn split_within(r: &mut Rings, scale: f64) -> Result<(), GeomError> {
             dirty.clear();
         }
     }
-    Err(GeomError::Degenerate(
+    Err(GeomError::Undecidable(
         "edge intersections did not settle; the rings have long nearly-overlapping edges",
     ))
 }

@@ -70,7 +70,7 @@ use super::triangulated::{
 };
 use super::{convex_silhouette, nonconvex_silhouette};
 use crate::GeomError;
-use crate::solid::facing::{FACE_TOLERANCE, Side, face_distances};
+use crate::solid::facing::{FacingAt, Side, face_distances, in_front};
 use crate::solid::{ClosedMesh, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 use crate::sphere::predicates::c3;
 use crate::sphere::{
@@ -544,10 +544,8 @@ impl SilhouetteBsp {
     /// only up to the tolerance.
     fn leaf_of(&self, x: DVec3, band: bool) -> Option<u32> {
         let mesh = self.source.mesh();
-        let b = mesh.bounding_sphere();
-        let rel = x - b.center;
-        // The facing predicate's tolerance at x (`face_side`), computed once.
-        let tol = FACE_TOLERANCE * (b.radius + rel.length());
+        // The facing predicate (`face_side`) at x, its tolerance computed once.
+        let at = FacingAt::new(mesh, x);
         let (normals, offsets, verts) = (mesh.normals(), mesh.offsets(), mesh.vertices());
         let mask = (1u32 << self.child_bits) - 1;
         let mut i = 0usize;
@@ -558,11 +556,11 @@ impl SilhouetteBsp {
             }
             let positive = match self.planes[(w >> self.child_bits) as usize] {
                 SplitPlane::Face(f) => {
-                    let s = normals[f as usize].dot(rel) - offsets[f as usize];
-                    if band && s.abs() <= tol {
+                    let s = at.distance(normals[f as usize], offsets[f as usize]);
+                    if band && s.abs() <= at.tol() {
                         return None;
                     }
-                    s > tol
+                    in_front(s, at.tol())
                 }
                 SplitPlane::Through([a, b, c]) => {
                     orient3d(
@@ -1185,16 +1183,14 @@ impl<'a> Builder<'a> {
         // Plane indices of the face planes are 0..faces.len() (interned first).
         let mut sides = vec![0u64; reps.len() * words];
         let m = self.mesh;
-        let b = m.bounding_sphere();
         for (k, &x) in reps.iter().enumerate() {
             // The facing predicate, with the tolerance at x computed once.
-            let rel = x - b.center;
-            let tol = FACE_TOLERANCE * (b.radius + rel.length());
+            let at = FacingAt::new(m, x);
             for &c in &faces {
                 let SplitPlane::Face(f) = self.planes[c as usize] else {
                     continue;
                 };
-                if m.normals()[f as usize].dot(rel) - m.offsets()[f as usize] > tol {
+                if at.front(m.normals()[f as usize], m.offsets()[f as usize]) {
                     sides[k * words + (c >> 6) as usize] |= 1 << (c & 63);
                 }
             }

@@ -54,7 +54,9 @@ pub fn convex_silhouette(
         for (f, &d) in s.iter().enumerate() {
             if Side::of(d, tol) == Side::On {
                 let n = frame.dir_to_local(poly.mesh().triangle_normal(f));
-                region = region.clip_to_hemisphere(-n);
+                region = region.try_clip_to_hemisphere(-n).map_err(|e| {
+                    e.give_up("a face normal of a convex polyhedron is not a direction")
+                })?;
             }
         }
         return Ok(region);

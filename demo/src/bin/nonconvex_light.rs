@@ -4,8 +4,8 @@
 //! polygon per light, with exact soft shadows (seed 000's visibility rule).
 //!
 //! ```sh
-//! cargo run --release --example nonconvex_light                 # 320 x 240, 2 threads
-//! cargo run --release --example nonconvex_light -- --width 640 --height 480 --threads 2
+//! cargo run --release -p arealight-demo --bin nonconvex_light   # 320 x 240, 2 threads
+//! cargo run --release -p arealight-demo --bin nonconvex_light -- --width 640 --height 480 --threads 2
 //! ```
 //!
 //! Writes `target/arealight-out/nonconvex_light.png`. Prints the render time, the number of
@@ -21,9 +21,7 @@ use arealight::shade::{
 };
 use std::time::Instant;
 
-#[path = "common/mod.rs"]
-mod common;
-use common::{image, trace};
+use arealight_demo::{image, trace};
 
 /// `mesh` scaled by `s`, rotated by `rot` and moved to `at`.
 fn moved(mesh: &TriangleMesh, s: f64, rot: DMat3, at: DVec3) -> TriangleMesh {

@@ -1,12 +1,20 @@
-//! Helpers shared by the scene-file examples (`scene_file`, `bake`): output folder, tone mapping
-//! and PNG, camera and ray casting, progress line, argument parsing.
-#![allow(dead_code)]
+//! Helpers shared by arealight's example programs (the binaries of this package): output folder,
+//! tone mapping and PNG, camera and ray casting, progress line, argument parsing.
 
 pub mod image;
 pub mod progress;
 pub mod trace;
 
+use std::path::{Path, PathBuf};
+
 use arealight::glam::DVec3;
+
+/// `rel` (a path relative to the repository's root, such as `scenes/cornell_box.gltf`) as an
+/// absolute path: this package is the repository's `demo/` folder.
+pub fn repo_path(rel: &str) -> PathBuf {
+    let demo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    demo.parent().unwrap_or(demo).join(rel)
+}
 
 /// The published Cornell box camera (metres): eye, target, up, vertical field of view
 /// (35 mm focal length on 25 mm film: `2 atan(12.5 / 35)`).

@@ -4,8 +4,8 @@
 //! same scene, with a Monte Carlo cross-check of the exact image.
 //!
 //! ```sh
-//! cargo run --release --example sdf_shadows                  # defaults: 240 x 180, both lights
-//! cargo run --release --example sdf_shadows -- --help        # the flags
+//! cargo run --release -p arealight-demo --bin sdf_shadows              # defaults: 240 x 180, both lights
+//! cargo run --release -p arealight-demo --bin sdf_shadows -- --help    # the flags
 //! ```
 //!
 //! The scene: a floor, a ball, a box with a pillar pushed into its corner (a concave corner)
@@ -53,7 +53,7 @@ use std::time::Instant;
 const HELP: &str = "\
 sdf_shadows: approximate SDF soft shadows (Quilez, seed 001) against the exact analytic shading
 
-USAGE: cargo run --release --example sdf_shadows -- [FLAGS]
+USAGE: cargo run --release -p arealight-demo --bin sdf_shadows -- [FLAGS]
 
   --width W        image width (default 240)
   --height H       image height (default 180)
@@ -61,7 +61,7 @@ USAGE: cargo run --release --example sdf_shadows -- [FLAGS]
   --epsilon E      accuracy of the minimal tangent cone search (default 0.05)
   --mc-stride S    Monte Carlo cross-check on every S-th pixel (default 23; 0 = none)
   --threads T      worker threads (default 2)
-  --out DIR        output directory (default target/arealight-out)
+  --out DIR        output directory (default target/arealight-out in the repository)
   --help           this text
 ";
 
@@ -89,7 +89,7 @@ fn parse_args() -> Result<Args, String> {
         epsilon: 0.05,
         mc_stride: 23,
         threads: 2,
-        out: PathBuf::from("target/arealight-out"),
+        out: arealight_demo::image::default_out(),
     };
     let mut it = std::env::args().skip(1);
     while let Some(flag) = it.next() {

@@ -3,9 +3,9 @@
 //! box (`scenes/cornell_box.gltf`) from the published camera.
 //!
 //! ```sh
-//! cargo run --release --features obj,gltf --example scene_file
-//! cargo run --release --features obj,gltf --example scene_file -- scenes/cornell_box.obj --width 640
-//! cargo run --release --features obj,gltf --example scene_file -- --help
+//! cargo run --release -p arealight-demo --features obj,gltf --bin scene_file
+//! cargo run --release -p arealight-demo --features obj,gltf --bin scene_file -- scenes/cornell_box.obj --width 640
+//! cargo run --release -p arealight-demo --features obj,gltf --bin scene_file -- --help
 //! ```
 //!
 //! Prints the scene, `Scene::validate`'s findings, and the time of each stage: loading (parse,
@@ -18,9 +18,6 @@
 //! Writes `target/arealight-out/<file stem>.png` (linear radiance tone mapped with
 //! `1 - exp(-exposure x)`, sRGB). Direct light only: the ceiling, which sees no light, is black.
 
-#[path = "common/mod.rs"]
-mod common;
-
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -28,15 +25,15 @@ use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::io::SceneFile;
 use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
-use common::image::{out_dir, to_bytes, write_png};
-use common::progress::Progress;
-use common::trace::{Camera, nearest};
-use common::{cornell_camera, parse_vec, with_threads};
+use arealight_demo::image::{out_dir, to_bytes, write_png};
+use arealight_demo::progress::Progress;
+use arealight_demo::trace::{Camera, nearest};
+use arealight_demo::{cornell_camera, parse_vec, with_threads};
 
 const HELP: &str = "\
 scene_file: render a scene file (OBJ or glTF) with exact soft shadows
 
-USAGE: cargo run --release --features obj,gltf --example scene_file -- [FILE] [FLAGS]
+USAGE: cargo run --release -p arealight-demo --features obj,gltf --bin scene_file -- [FILE] [FLAGS]
 
   FILE             .obj, .gltf or .glb (default scenes/cornell_box.gltf)
   --width W        image width (default 320)
@@ -63,10 +60,7 @@ struct Args {
 
 fn parse_args() -> Result<Args, String> {
     let mut a = Args {
-        file: PathBuf::from(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/scenes/cornell_box.gltf"
-        )),
+        file: arealight_demo::repo_path("scenes/cornell_box.gltf"),
         width: 320,
         height: 320,
         camera: cornell_camera(),

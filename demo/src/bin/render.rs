@@ -6,8 +6,8 @@
 //! the same comparison).
 //!
 //! ```sh
-//! cargo run --release --example render                 # defaults: 320 x 240, all cores
-//! cargo run --release --example render -- --help       # the flags
+//! cargo run --release -p arealight-demo              # defaults: 320 x 240, all cores
+//! cargo run --release -p arealight-demo -- --help    # the flags
 //! ```
 //!
 //! Prints a table, analytic first:
@@ -65,27 +65,17 @@ use arealight::glam::DVec3;
 use arealight::internals::{Demo, DemoConfig, demo_scene};
 use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scene};
 use arealight::visibility::{PluckerContext, PluckerVisibility};
+use arealight_demo::progress::Progress;
+use arealight_demo::trace::{Camera, ray_triangle};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::path::PathBuf;
 use std::time::Instant;
-use trace::{Camera, ray_triangle};
-
-#[path = "common/progress.rs"]
-mod progress;
-// Shared with the scene-file examples; `nearest` is theirs.
-#[allow(dead_code)]
-#[path = "common/trace.rs"]
-mod trace;
-use progress::Progress;
-
-/// Where the examples write their outputs.
-const OUT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/arealight-out");
 
 const HELP: &str = "\
 render: the seed paper's test scene, analytic vs ratio estimator vs Monte Carlo at equal time
 
-USAGE: cargo run --release --example render -- [FLAGS]
+USAGE: cargo run --release -p arealight-demo -- [FLAGS]
 
   --width W        image width (default 320)
   --height H       image height (default 240)
@@ -122,7 +112,7 @@ fn parse_args() -> Result<Args, String> {
         cache: true,
         cfg: DemoConfig::default(),
         threads: 0,
-        out: PathBuf::from(OUT_DIR),
+        out: arealight_demo::image::default_out(),
         time_factors: vec![1.0, 10.0],
         plucker: false,
     };

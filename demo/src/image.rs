@@ -1,15 +1,18 @@
-//! Tone mapping and PNG output shared by the scene-file examples.
+//! Tone mapping and PNG output shared by the example programs.
 
 use std::path::{Path, PathBuf};
 
 use arealight::glam::DVec3;
 
-/// Where the examples write their outputs: `target/arealight-out/` in the repository.
-pub const OUT_DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/arealight-out");
+/// Where the examples write their outputs: `target/arealight-out/` in the repository (this
+/// package is its `demo/` folder).
+pub fn default_out() -> PathBuf {
+    crate::repo_path("target/arealight-out")
+}
 
-/// The output folder, created if needed.
+/// The output folder, [`default_out`], created if needed.
 pub fn out_dir() -> Result<PathBuf, String> {
-    let d = PathBuf::from(OUT_DIR);
+    let d = default_out();
     std::fs::create_dir_all(&d).map_err(|e| format!("{}: {e}", d.display()))?;
     Ok(d)
 }

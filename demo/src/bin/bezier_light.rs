@@ -3,8 +3,8 @@
 //! from it (seed 004's free-form lights in a scene with seed 000's exact visibility).
 //!
 //! ```sh
-//! cargo run --release --example bezier_light                      # 240 x 180, 2 threads
-//! cargo run --release --example bezier_light -- --width 480 --height 360 --samples 1024
+//! cargo run --release -p arealight-demo --bin bezier_light   # 240 x 180, 2 threads
+//! cargo run --release -p arealight-demo --bin bezier_light -- --width 480 --height 360 --samples 1024
 //! ```
 //!
 //! Writes `target/arealight-out/bezier_light.png`: the analytic image (the scene's per-point
@@ -24,9 +24,7 @@ use arealight::shade::{
 };
 use std::time::Instant;
 
-#[path = "common/mod.rs"]
-mod common;
-use common::{image, trace};
+use arealight_demo::{image, trace};
 
 /// A 2D outline segment: a line to a point, or a cubic with two handles to a point.
 enum Seg {

@@ -4,8 +4,8 @@
 //! can hold), and the result is written as a PLY mesh with vertex colours, with a picture of it.
 //!
 //! ```sh
-//! cargo run --release --features obj,gltf --example bake
-//! cargo run --release --features obj,gltf --example bake -- scenes/cornell_box.obj --spacing 0.005
+//! cargo run --release -p arealight-demo --features obj,gltf --bin bake
+//! cargo run --release -p arealight-demo --features obj,gltf --bin bake -- scenes/cornell_box.obj --spacing 0.005
 //! ```
 //!
 //! Writes to `target/arealight-out/`:
@@ -21,9 +21,6 @@
 //! vertices whose shading gave up (`GeomError::Undecidable`), which are estimated by the Monte
 //! Carlo reference instead.
 
-#[path = "common/mod.rs"]
-mod common;
-
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -32,15 +29,15 @@ use std::time::Instant;
 use arealight::glam::DVec3;
 use arealight::io::SceneFile;
 use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
-use common::image::{out_dir, srgb, to_bytes, write_png};
-use common::progress::Progress;
-use common::trace::{Camera, nearest};
-use common::{cornell_camera, parse_vec, with_threads};
+use arealight_demo::image::{out_dir, srgb, to_bytes, write_png};
+use arealight_demo::progress::Progress;
+use arealight_demo::trace::{Camera, nearest};
+use arealight_demo::{cornell_camera, parse_vec, with_threads};
 
 const HELP: &str = "\
 bake: per-vertex direct lighting of a scene file, to PLY with vertex colours, and a picture
 
-USAGE: cargo run --release --features obj,gltf --example bake -- [FILE] [FLAGS]
+USAGE: cargo run --release -p arealight-demo --features obj,gltf --bin bake -- [FILE] [FLAGS]
 
   FILE             .obj, .gltf or .glb (default scenes/cornell_box.gltf)
   --spacing S      vertex spacing in scene units (default 0.01: 1 cm in the Cornell box)
@@ -67,10 +64,7 @@ struct Args {
 fn parse_args() -> Result<Args, String> {
     let (eye, target, _, _) = cornell_camera();
     let mut a = Args {
-        file: PathBuf::from(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/scenes/cornell_box.gltf"
-        )),
+        file: arealight_demo::repo_path("scenes/cornell_box.gltf"),
         spacing: 0.01,
         width: 320,
         height: 320,
