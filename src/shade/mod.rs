@@ -90,6 +90,6 @@ pub use curved::{CurvedShading, DEFAULT_DIFFUSE_SUBDIVISION};
 pub use material::Material;
 pub use query::{LightShading, ShadeContext};
 pub use ratio::{LightRatio, RatioEstimator};
-pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf};
+pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf, Techniques};
 pub use scene::{Light, Scene};
 pub use validate::{SceneIssue, SceneReport};

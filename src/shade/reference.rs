@@ -24,10 +24,37 @@
 //! (rejection from its bounding box; `curved_reference.rs`), whatever the [`LightSampling`], so
 //! that the analytic path's per-point flattening is checked too; visibility as above.
 //!
+//! Near-mirror lobes (GGX roughness `0.05` and below, `alpha <= 0.0025`) are narrower than
+//! anything light sampling resolves with a few thousand samples: the estimate and its standard
+//! error both miss the peak. [`Techniques::LightAndBrdf`] adds a second technique per sample, a
+//! direction drawn from the BRDF itself (the cosine lobe, and the LTC distribution
+//! ([`crate::ltc::Ltc::sample`]) for [`ReferenceBrdf::Ltc`] or the GGX visible normals
+//! ([`crate::ltc::ggx_sample_vndf`], \[Hei18\]) for [`ReferenceBrdf::True`]), and combines the
+//! two by multiple importance sampling with the balance heuristic (\[Vea97\] section 9.2.2,
+//! one sample per technique): each sample of either technique contributes
+//! `f(l) V(l) / (p_light(l) + p_brdf(l))`, which is unbiased wherever either density is
+//! positive and has bounded variance for any lobe width. The BRDF's samples are traced to the
+//! light's nearest triangle (which must emit towards the point), so they also cover any part of
+//! a light that a region of [`LightSampling::Silhouette`] would miss: there `p_light = 0` and
+//! the BRDF sample counts whole.
+//!
+//! Which reference checks [`Scene::shade`]: the analytic path integrates the LTC lobe of the
+//! table ([`crate::ltc::lookup`], scaled by [`crate::ltc::LtcLookup::specular_scale`]) and the
+//! Lambertian lobe over the visible region exactly, so [`ReferenceBrdf::Ltc`] estimates the
+//! same integral and any difference beyond the confidence bound is an error of the geometry
+//! (visibility, clipping, integration). [`ReferenceBrdf::True`] estimates the true GGX
+//! reflection instead; it differs from the analytic value by the table's fitting error as well,
+//! which is checked separately (tests/ltc_robust.rs against brute-force VNDF albedos) and must
+//! not be mistaken for a geometric error.
+//!
 //! Only the outer (front) side of a light emits: a shading point inside a closed light sees none
-//! of its triangles from the front and gets nothing here, where the analytic silhouette path
-//! counts the whole sphere (the one configuration where the two differ; no scene meant for
-//! rendering has it).
+//! of its triangles from the front and gets nothing, here as on both analytic paths.
+//!
+//! # References
+//!
+//! - \[Vea97\] E. Veach. *Robust Monte Carlo methods for light transport simulation.* PhD
+//!   thesis, Stanford, 1997 (chapter 9, multiple importance sampling).
+//! - \[Hei18\] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
 
 use alloc::vec::Vec;
 
@@ -36,7 +63,7 @@ use glam::{DVec2, DVec3};
 use super::material::Material;
 use super::scene::Scene;
 use crate::GeomError;
-use crate::ltc::{Ltc, lookup};
+use crate::ltc::{Ltc, cosine_sample, ggx_sample_vndf, ggx_vndf_pdf, lookup};
 use crate::math::sqrt;
 use crate::solid::{Body, BoundingSphere, ShadingFrame, Side, TriangleMesh, face_side};
 use crate::sphere::{SphericalPolygon, SphericalTriangle};
@@ -129,13 +156,74 @@ pub enum LightSampling {
     Faces,
 }
 
+/// Which sampling techniques the estimator draws each light's samples with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Techniques {
+    /// Directions towards the light only ([`LightSampling`]): enough for diffuse and moderately
+    /// glossy lobes, blind to near-mirror ones.
+    #[default]
+    Light,
+    /// Per sample, one direction towards the light and one drawn from the BRDF (the Lambertian
+    /// lobe or the specular one, chosen at random in proportion to their weights), combined by
+    /// multiple importance sampling with the balance heuristic (\[Vea97\] section 9.2; see the
+    /// module documentation). Twice the rays of [`Techniques::Light`] per sample; resolves
+    /// lobes of any width, down to [`crate::ltc::GGX_MIN_ALPHA`].
+    LightAndBrdf,
+}
+
 /// A Monte Carlo estimate: the mean and its standard error, per RGB channel.
+///
+/// The standard error is itself estimated from the samples, so it misleads where the integrand
+/// is concentrated on a set that few samples hit (a sliver of a light seen in a near-mirror
+/// lobe: no sample may hit it, and the estimate and its error both read near zero). Where one
+/// step's contribution has a known bound, [`Estimate::bernstein_halfwidth`] gives a confidence
+/// interval that holds regardless.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     /// The estimated radiance.
     pub mean: DVec3,
     /// The estimated standard deviation of `mean` (sample standard deviation over `sqrt(n)`).
     pub std_error: DVec3,
+    /// The number of steps `n` averaged (samples per light; a step of
+    /// [`Techniques::LightAndBrdf`] is one sample of each technique).
+    pub samples: u32,
+    /// An upper bound on one step's contribution, summed over the lights (every step's value
+    /// lies in `[0, sample_bound]`), or infinite where none is known (light sampling alone with
+    /// a specular lobe, whose peak density is not bounded in advance; lights bounded by Bezier
+    /// curves).
+    pub sample_bound: DVec3,
+}
+
+impl Estimate {
+    /// The half-width of a two-sided confidence interval for the true value around `mean`, of
+    /// level at least `1 - delta`, that holds however skewed the steps' distribution is: the
+    /// empirical Bernstein bound (Maurer and Pontil 2009, theorem 4, with `delta / 2` per side)
+    /// for steps in `[0, B]`,
+    ///
+    /// ```text
+    /// sqrt(2 V ln(4 / delta) / n) + 7 B ln(4 / delta) / (3 (n - 1)),
+    /// ```
+    ///
+    /// with `V = n std_error^2` the steps' sample variance and `B` = [`Estimate::sample_bound`].
+    /// Infinite where `B` is, or for fewer than two steps. (With several lights the steps'
+    /// variance is taken as the sum of the lights', which it equals in expectation.)
+    ///
+    /// # References
+    ///
+    /// A. Maurer, M. Pontil. *Empirical Bernstein bounds and sample variance penalization.*
+    /// COLT 2009.
+    #[must_use]
+    pub fn bernstein_halfwidth(&self, delta: f64) -> DVec3 {
+        if self.samples < 2 {
+            return DVec3::INFINITY;
+        }
+        let n = f64::from(self.samples);
+        let log = crate::math::ln(4.0 / delta);
+        let v = self.std_error * self.std_error * n;
+        let spread = (v * (2.0 * log / n)).map(sqrt);
+        spread + self.sample_bound * (7.0 * log / (3.0 * (n - 1.0)))
+    }
 }
 
 /// Monte Carlo estimator settings.
@@ -147,6 +235,8 @@ pub struct MonteCarlo {
     pub brdf: ReferenceBrdf,
     /// Where directions towards each light are drawn.
     pub sampling: LightSampling,
+    /// Whether the BRDF is sampled too ([`Techniques::LightAndBrdf`]).
+    pub techniques: Techniques,
 }
 
 /// Relative distance along a ray, short of the point where it meets the light, within which a
@@ -227,7 +317,14 @@ struct BrdfEval {
     /// The LTC distribution and its per-channel scale ([`ReferenceBrdf::Ltc`] with a specular
     /// lobe).
     ltc: Option<(Ltc, DVec3)>,
+    /// The probability with which a BRDF sample is drawn from the Lambertian lobe (the rest
+    /// from the specular one).
+    p_diffuse: f64,
 }
+
+/// The smallest probability with which [`BrdfEval::sample`] picks a lobe that the material has:
+/// the lobes' weights are only estimates of their shares, so neither is starved.
+const MIN_LOBE_PICK: f64 = 0.25;
 
 impl BrdfEval {
     fn eval(&self, l: DVec3) -> DVec3 {
@@ -245,6 +342,84 @@ impl BrdfEval {
             }
         }
     }
+
+    /// A bound on `f(l) / pdf(l)` per channel over all directions (per unit radiance): with
+    /// `f = albedo cos / pi + s(l)` and `pdf = p_d cos / pi + (1 - p_d) p_s(l)`, the ratio is at
+    /// most the larger of `albedo / p_d` and the specular lobe's `s / ((1 - p_d) p_s)`, which is
+    /// the LTC scale over `1 - p_d` for [`ReferenceBrdf::Ltc`] (`s` is the scale times the
+    /// density sampled) and at most `1 / (1 - p_d)` for [`ReferenceBrdf::True`] (Fresnel at most
+    /// one, and `f_ggx cos / pdf_vndf = G2 / G1 <= 1`, \[Hei18\]).
+    fn ratio_bound(&self) -> DVec3 {
+        let diffuse = if self.p_diffuse > 0.0 {
+            self.material.albedo() / self.p_diffuse
+        } else {
+            DVec3::ZERO
+        };
+        let specular = if self.p_diffuse < 1.0 {
+            match (self.kind, &self.ltc) {
+                (ReferenceBrdf::Ltc, Some((_, scale))) => *scale / (1.0 - self.p_diffuse),
+                (ReferenceBrdf::Ltc, None) => DVec3::ZERO,
+                (ReferenceBrdf::True, _) => DVec3::splat(1.0 / (1.0 - self.p_diffuse)),
+            }
+        } else {
+            DVec3::ZERO
+        };
+        diffuse.max(specular)
+    }
+
+    /// A direction in the shading frame drawn from the BRDF's sampling density ([`Self::pdf`])
+    /// with the uniform numbers `u` (the direction) and `pick` (the lobe), both in `[0, 1)`.
+    /// It may lie below the horizon, where the BRDF is zero.
+    fn sample(&self, u: DVec2, pick: f64) -> DVec3 {
+        if pick < self.p_diffuse {
+            return cosine_sample(u);
+        }
+        match (self.kind, &self.ltc) {
+            (ReferenceBrdf::Ltc, Some((d, _))) => d.sample(u),
+            _ => ggx_sample_vndf(self.view, self.material.alpha(), u),
+        }
+    }
+
+    /// The density per unit solid angle (over the whole sphere) with which [`Self::sample`]
+    /// draws `l`: the mixture of the cosine density and the specular lobe's sampling density.
+    fn pdf(&self, l: DVec3) -> f64 {
+        let diffuse = if l.z > 0.0 {
+            l.z / core::f64::consts::PI
+        } else {
+            0.0
+        };
+        let specular = if self.p_diffuse < 1.0 {
+            match (self.kind, &self.ltc) {
+                (ReferenceBrdf::Ltc, Some((d, _))) => d.density(l),
+                _ => ggx_vndf_pdf(self.view, l, self.material.alpha()),
+            }
+        } else {
+            0.0
+        };
+        self.p_diffuse * diffuse + (1.0 - self.p_diffuse) * specular
+    }
+}
+
+/// The probability of drawing a BRDF sample from the Lambertian lobe: the lobes' weights (the
+/// largest diffuse albedo, the largest specular albedo the table gives at this view) in
+/// proportion, each kept at least [`MIN_LOBE_PICK`] when the material has it; `1` without a
+/// specular lobe, `0` without a diffuse one.
+fn diffuse_pick(material: &Material, cos_v: f64) -> f64 {
+    let wd = material.albedo().max_element();
+    if !material.has_specular() {
+        return 1.0;
+    }
+    if wd <= 0.0 {
+        return 0.0;
+    }
+    let ws = lookup(cos_v, material.alpha()).map_or(material.f0().max_element(), |look| {
+        let f0 = material.f0();
+        look.albedo * look.specular_scale(f0.max_element()) / look.norm
+    });
+    if !(ws > 0.0) {
+        return 1.0;
+    }
+    (wd / (wd + ws)).clamp(MIN_LOBE_PICK, 1.0 - MIN_LOBE_PICK)
 }
 
 /// The directions of one light at one shading point that samples are drawn from: spherical
@@ -348,6 +523,7 @@ impl<'a> PointSampler<'a> {
                 material: *material,
                 view: v,
                 ltc,
+                p_diffuse: diffuse_pick(material, v.z),
             },
             blockers,
         })
@@ -361,6 +537,13 @@ impl<'a> PointSampler<'a> {
     /// The BRDF times the cosine for the direction `l` in the shading frame.
     pub(crate) fn brdf(&self, l: DVec3) -> DVec3 {
         self.brdf.eval(l)
+    }
+
+    /// A direction in the shading frame drawn from the BRDF ([`Techniques::LightAndBrdf`]), and
+    /// the density it was drawn with.
+    fn brdf_sample(&self, u: DVec2, pick: f64) -> (DVec3, f64) {
+        let l = self.brdf.sample(u, pick);
+        (l, self.brdf.pdf(l))
     }
 
     /// Fills `out` with the directions of light `light` to sample by `sampling` (see
@@ -530,6 +713,51 @@ impl<'a> PointSampler<'a> {
         }
     }
 
+    /// Traces a direction `l` (shading frame) drawn from the BRDF towards light `light`: what it
+    /// finds, and the density with which the light technique over `domain` would have drawn it
+    /// with the same outcome (for the balance heuristic).
+    ///
+    /// Inside a region's triangulation ([`LightSampling::Silhouette`]) the direction is traced
+    /// exactly as the light's own samples are ([`Self::trace_region`]), with density
+    /// `1 / domain.total()`. Elsewhere, and for [`LightSampling::Faces`], the ray must meet the
+    /// light first on a triangle that emits towards the point (the light's own nearer triangles
+    /// hide farther ones) and nothing else before it; the light technique draws such a
+    /// direction only through that triangle's projection, so with density `1 / domain.total()`
+    /// when the triangle is one of the domain's faces and zero otherwise (outside a region, or
+    /// a face whose projection could not be built).
+    fn trace_brdf(&self, light: usize, domain: &LightDomain, l: DVec3) -> (f64, Outcome) {
+        if l.z <= 0.0 {
+            return (0.0, Outcome::Miss);
+        }
+        let w = self.frame.dir_to_world(l);
+        let density = if domain.is_empty() {
+            0.0
+        } else {
+            1.0 / domain.total()
+        };
+        if domain.local && domain.tris.iter().any(|t| spherical_triangle_holds(t, l)) {
+            return (density, self.trace_region(light, w));
+        }
+        let x = self.frame.origin();
+        let mesh = self.scene.lights()[light].shape().mesh();
+        let Some((t, j)) = nearest_hit(x, w, mesh) else {
+            return (0.0, Outcome::Miss);
+        };
+        if !self.emits_towards(light, mesh, j) {
+            return (0.0, Outcome::Miss);
+        }
+        let p = if !domain.local && domain.faces.contains(&j) {
+            density
+        } else {
+            0.0
+        };
+        if self.blocked(light, w, t) {
+            (p, Outcome::Blocked)
+        } else {
+            (p, Outcome::Visible)
+        }
+    }
+
     /// Whether another object than light `light` has a triangle on the ray from the shading
     /// point along `w` strictly between its start and `t_light` (short of `t_light` by the
     /// relative margin [`RAY_EPS`]; see [`hits_before`] for the start).
@@ -556,6 +784,30 @@ fn hits_before(x: DVec3, w: DVec3, m: &TriangleMesh, skip: Option<usize>, t_max:
             && ray_triangle(x, w, m.triangle(j), 0.0).is_some_and(|t| t < t_max)
             && face_side(m, j, x) != Side::On
     })
+}
+
+/// The distance along `w` from `x` to the nearest triangle of `mesh` the ray meets (within
+/// [`LIGHT_HIT_SLACK`]), and that triangle's index. Triangles seen edge-on from `x` are skipped,
+/// as in [`hits_before`].
+fn nearest_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<(f64, usize)> {
+    let mut best: Option<(f64, usize)> = None;
+    for j in 0..mesh.triangle_count() {
+        if let Some(t) = ray_triangle(x, w, mesh.triangle(j), LIGHT_HIT_SLACK)
+            && best.is_none_or(|(b, _)| t < b)
+            && face_side(mesh, j, x) != Side::On
+        {
+            best = Some((t, j));
+        }
+    }
+    best
+}
+
+/// Whether the spherical triangle `t` (minor-arc edges, positive orientation: the intersection
+/// of the three half-spaces on the left of its edges) holds the direction `l`, boundary
+/// included.
+fn spherical_triangle_holds(t: &SphericalTriangle, l: DVec3) -> bool {
+    let [a, b, c] = t.vertices();
+    a.cross(b).dot(l) >= 0.0 && b.cross(c).dot(l) >= 0.0 && c.cross(a).dot(l) >= 0.0
 }
 
 /// The distance along `w` from `x` to the nearest triangle of `mesh`, if the ray meets one and
@@ -606,7 +858,16 @@ impl MonteCarlo {
             samples_per_light,
             brdf,
             sampling: LightSampling::Silhouette,
+            techniques: Techniques::Light,
         }
+    }
+
+    /// The same settings sampling the BRDF too, combined with the light samples by multiple
+    /// importance sampling ([`Techniques::LightAndBrdf`]): for glossy lobes of any width.
+    #[must_use]
+    pub fn with_brdf_sampling(mut self) -> Self {
+        self.techniques = Techniques::LightAndBrdf;
+        self
     }
 
     /// The same settings drawing directions by `sampling`.
@@ -637,26 +898,46 @@ impl MonteCarlo {
         let mut mean = DVec3::ZERO;
         let mut var = DVec3::ZERO;
         let mut domain = LightDomain::default();
+        let mut bound = DVec3::ZERO;
         for (li, light) in scene.lights().iter().enumerate() {
             if let Body::Bezier(shape) = light.shape() {
                 let two = light.is_two_sided();
                 let (m, s2) = super::curved_reference::estimate(&ps, li, shape, two, n, &mut rng);
                 mean += m * light.radiance();
                 var += s2 * light.radiance() * light.radiance();
+                bound = DVec3::INFINITY;
                 continue;
             }
             ps.domain(li, self.sampling, &mut domain);
-            if domain.is_empty() {
+            let mis = self.techniques == Techniques::LightAndBrdf;
+            if domain.is_empty() && !mis {
                 continue;
             }
             let total = domain.total();
             let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
             for _ in 0..n {
-                let (l, outcome) = ps.trace(li, &domain, rng.next_2d());
-                if outcome != Outcome::Visible {
-                    continue;
+                // One sample of each technique per step; with the balance heuristic
+                // (Vea97 eq. 9.6, one sample per technique) either contributes
+                // f / (p_light + p_brdf), and their sum is one independent, unbiased sample of
+                // the light's integral, so the steps' spread gives the standard error.
+                let mut f = DVec3::ZERO;
+                if !domain.is_empty() {
+                    let (l, outcome) = ps.trace(li, &domain, rng.next_2d());
+                    if outcome == Outcome::Visible {
+                        f += if mis {
+                            ps.brdf(l) * light.radiance() / (1.0 / total + ps.brdf.pdf(l))
+                        } else {
+                            ps.brdf(l) * light.radiance() * total
+                        };
+                    }
                 }
-                let f = ps.brdf(l) * light.radiance() * total;
+                if mis {
+                    let (l, p_brdf) = ps.brdf_sample(rng.next_2d(), rng.next_f64());
+                    let (p_light, outcome) = ps.trace_brdf(li, &domain, l);
+                    if outcome == Outcome::Visible && p_brdf + p_light > 0.0 {
+                        f += ps.brdf(l) * light.radiance() / (p_brdf + p_light);
+                    }
+                }
                 sum += f;
                 sum2 += f * f;
             }
@@ -670,10 +951,23 @@ impl MonteCarlo {
             };
             mean += m;
             var += s2 / nf;
+            // One step: each technique's term is at most f / p_brdf; light sampling alone gives
+            // f * total, bounded for the Lambertian lobe (f <= albedo / pi).
+            bound += if mis {
+                2.0 * ps.brdf.ratio_bound() * light.radiance()
+            } else if ps.brdf.ltc.is_none()
+                && !(ps.brdf.kind == ReferenceBrdf::True && material.has_specular())
+            {
+                material.albedo() * light.radiance() * (total / core::f64::consts::PI)
+            } else {
+                DVec3::INFINITY
+            };
         }
         Ok(Estimate {
             mean,
             std_error: DVec3::new(sqrt(var.x), sqrt(var.y), sqrt(var.z)),
+            samples: n,
+            sample_bound: bound,
         })
     }
 }
