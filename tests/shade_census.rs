@@ -400,9 +400,10 @@ fn census_of_the_shade_families() {
                 LIGHT_KINDS[(case % 4) as usize],
                 POINT_KINDS[i % 3]
             );
-            // Monte Carlo on every eighth point, sampling the light's unoccluded region.
+            // Monte Carlo on every eighth point, sampling the light's front faces (independent
+            // of the visibility and sphere code under test).
             let mc = (i % 8 == 0 || inside).then_some(McCheck {
-                sampling: LightSampling::Silhouette,
+                sampling: LightSampling::Faces,
                 samples: 4096,
                 seed: case * 1000 + i as u64,
             });

@@ -3,13 +3,17 @@
 //! input, or a give-up. Each is checked against the Monte Carlo
 //! reference (`ReferenceBrdf::Ltc`, the BRDF the analytic path models, so that only visibility
 //! differs) at 4.5 standard errors plus a relative 1e-6 for its rounding, or against an exact
-//! identity (a light shaded twice, a light in a scene of its own).
+//! identity (a light shaded twice, a light in a scene of its own). The reference samples each
+//! light twice: by its front faces (`LightSampling::Faces`, which uses nothing of the visibility
+//! and sphere code under test, so a light region both got wrong cannot hide an error) and by
+//! its unoccluded region (the default, whose samples are not wasted); both must agree.
 
 use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::internals::torus;
 use arealight::shade::{
-    ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene, TriangleMesh,
+    ConvexPolyhedron, Light, LightSampling, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
+    TriangleMesh,
 };
 
 fn v(x: f64, y: f64, z: f64) -> DVec3 {
@@ -21,23 +25,27 @@ fn diffuse() -> Material {
 }
 
 /// `scene.shade` at the point equals the Monte Carlo estimate within 4.5 standard errors (plus
-/// relative 1e-6 and absolute 1e-12 for rounding), channel by channel.
+/// relative 1e-6 and absolute 1e-12 for rounding), channel by channel, for the lights sampled
+/// by their front faces and by their unoccluded regions.
 fn assert_matches_mc(what: &str, scene: &Scene, x: DVec3, n: DVec3, view: DVec3, m: &Material) {
     let got = scene
         .shade(x, n, view, m)
         .unwrap_or_else(|e| panic!("{what}: {e:?}"));
-    let mc = MonteCarlo::new(100_000, ReferenceBrdf::Ltc)
-        .estimate(scene, x, n, view, m, 24)
-        .unwrap();
-    for c in 0..3 {
-        let bound = 4.5 * mc.std_error[c] + 1e-6 * mc.mean[c].abs() + 1e-12;
-        assert!(
-            (got[c] - mc.mean[c]).abs() <= bound,
-            "{what}: shade {} vs Monte Carlo {} +- {}",
-            got[c],
-            mc.mean[c],
-            mc.std_error[c]
-        );
+    for sampling in [LightSampling::Faces, LightSampling::Silhouette] {
+        let mc = MonteCarlo::new(100_000, ReferenceBrdf::Ltc)
+            .with_sampling(sampling)
+            .estimate(scene, x, n, view, m, 24)
+            .unwrap();
+        for c in 0..3 {
+            let bound = 4.5 * mc.std_error[c] + 1e-6 * mc.mean[c].abs() + 1e-12;
+            assert!(
+                (got[c] - mc.mean[c]).abs() <= bound,
+                "{what}: shade {} vs Monte Carlo ({sampling:?}) {} +- {}",
+                got[c],
+                mc.mean[c],
+                mc.std_error[c]
+            );
+        }
     }
 }
 
@@ -203,6 +211,15 @@ fn reproducer_8_point_inside_a_closed_light_receives_nothing() {
                 DVec3::ZERO,
                 "{method:?} {x}"
             );
+            assert_matches_mc("reproducer 8c, cube", &scene, x, DVec3::Z, DVec3::Z, &m);
+        }
+        // Just outside the cube's top face, looking up at nothing, and beside it, looking at
+        // its side: the reference sees what the analytic path sees.
+        for (x, n) in [
+            (v(0.1, 0.2, 1.5 + 1e-9), DVec3::Z),
+            (v(0.9, 0.1, 1.0), v(-1.0, 0.0, 0.0)),
+        ] {
+            assert_matches_mc("reproducer 8c, cube outside", &scene, x, n, n, &m);
         }
     }
     let tube = torus(1.0, 0.4, 12, 8).unwrap();
