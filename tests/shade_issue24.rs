@@ -716,3 +716,189 @@ fn point_in_a_face_band_methods_differ_by_the_band_at_most() {
         "{a} vs {b}, band spread {spread}"
     );
 }
+
+/// A point inside a box that cuts through a two-sheet light, on the top face of a second box
+/// touching the light's lower plane from below, `2.2e-16` under the lower sheet (census case 307
+/// at `CENSUS_CASES=64`). Both analytic paths give 0 (the point is inside an opaque box). The
+/// Monte Carlo reference gave 0.217: it decided the sheet's facing by the sign of the distance
+/// alone, so the sheet, in the point's plane by the facing predicate, emitted towards the point
+/// and its rays, `1e-16` long, met nothing. It now uses the facing predicate, as the analytic
+/// path does: a point in a light's plane sees it edge-on.
+#[test]
+fn point_in_a_light_plane_gets_nothing_from_it() {
+    let z = 1.889478148309195;
+    let sheets = two_sheets([
+        v(-0.04992437992921994, -0.9160163829738076, z),
+        v(-0.04992437992921994, 0.08406243346082765, z),
+        v(0.9501544365054153, 0.08406243346082765, z),
+        v(0.9501544365054153, -0.9160163829738076, z),
+        v(0.06813039812787336, -0.9160163829738076, 2.3747271966348524),
+        v(0.06813039812787336, 0.08406243346082765, 2.3747271966348524),
+        v(1.0682092145625086, 0.08406243346082765, 2.3747271966348524),
+        v(1.0682092145625086, -0.9160163829738076, 2.3747271966348524),
+    ]);
+    let box_mesh = |lo: DVec3, hi: DVec3| -> ConvexPolyhedron {
+        ConvexPolyhedron::from_mesh(
+            &TriangleMesh::new(
+                vec![
+                    v(hi.x, hi.y, hi.z),
+                    v(lo.x, hi.y, hi.z),
+                    v(lo.x, lo.y, hi.z),
+                    v(lo.x, lo.y, lo.z),
+                    v(hi.x, lo.y, lo.z),
+                    v(lo.x, hi.y, lo.z),
+                    v(hi.x, hi.y, lo.z),
+                    v(hi.x, lo.y, hi.z),
+                ],
+                vec![
+                    [0, 1, 2],
+                    [2, 1, 3],
+                    [2, 3, 4],
+                    [3, 1, 5],
+                    [4, 3, 5],
+                    [1, 0, 5],
+                    [4, 5, 6],
+                    [5, 0, 6],
+                    [0, 4, 6],
+                    [4, 0, 7],
+                    [2, 4, 7],
+                    [0, 2, 7],
+                ],
+            )
+            .unwrap(),
+        )
+        .unwrap()
+    };
+    let top = 1.8894781483091947;
+    let through = box_mesh(
+        v(0.6003715346387004, -0.9427121108175012, 1.510219177469558),
+        v(0.8124298291283758, -0.5592273562224122, 2.268737119148832),
+    );
+    let below = box_mesh(
+        v(0.6238755697299854, -0.99225171685167, 1.1309602066299211),
+        v(0.8359338642196608, -0.608766962256581, top),
+    );
+    let scene = Scene::new(
+        vec![Light::new(sheets, DVec3::new(1.0, 0.8, 0.6)).unwrap()],
+        vec![through.into(), below.into()],
+    )
+    .unwrap();
+    let x = v(0.7588221087004304, -0.7736668591779706, top);
+    let view = v(
+        -0.09257094400627686,
+        0.23224686494950086,
+        0.9019025395381173,
+    );
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    for method in [Method::Silhouette, Method::PerTriangle] {
+        let got = scene
+            .clone()
+            .with_method(method)
+            .shade(x, DVec3::Z, view, &m)
+            .unwrap();
+        assert_eq!(got, DVec3::ZERO, "{method:?}");
+    }
+    for sampling in [LightSampling::Faces, LightSampling::Silhouette] {
+        let e = MonteCarlo::new(10_000, ReferenceBrdf::Ltc)
+            .with_sampling(sampling)
+            .with_brdf_sampling()
+            .estimate(&scene, x, DVec3::Z, view, &m, 5)
+            .unwrap();
+        assert_eq!(
+            e.mean,
+            DVec3::ZERO,
+            "{sampling:?}: {} +- {}",
+            e.mean,
+            e.std_error
+        );
+    }
+}
+
+/// A point `1.3e-12` inside a box occluder's face (just outside the facing band), under two
+/// sheet lights, with a near-mirror lobe (roughness 0.01) whose mirror direction runs along that
+/// face (near-face census case 1573 at `CENSUS_CASES=64`). The point is inside an opaque box:
+/// it gets nothing, and the silhouette path says exactly that. The per-triangle path subtracts
+/// the box's twelve faces one by one and leaves a gap of `1.3e-10` sr along the face plane,
+/// within the sphere layer's resolution: `2e-11` of the diffuse value, but `7.5e-6` of the
+/// specular one, the gap lying on the lobe's peak. That is within the agreement the census
+/// states for a lobe of width `alpha` (`1e-9 / alpha` of the specular value, the change a
+/// boundary moved by `1e-9` rad makes), and it is checked to stay there.
+#[test]
+fn point_just_inside_a_box_face_under_a_mirror_lobe() {
+    let sheets = two_sheets([
+        v(-1.6065112258489538, -1.4273569966932609, 2.020410400741447),
+        v(-1.6065112258489538, 1.1954288237555466, 2.020410400741447),
+        v(1.0162745945998537, 1.1954288237555466, 2.020410400741447),
+        v(1.0162745945998537, -1.4273569966932609, 2.020410400741447),
+        v(-1.7367903158337064, -1.5183433753251367, 1.9578116749672358),
+        v(0.8859955046151011, -1.5183433753251367, 1.9578116749672358),
+        v(0.8859955046151011, 1.1044424451236707, 1.9578116749672358),
+        v(-1.7367903158337064, 1.1044424451236707, 1.9578116749672358),
+    ]);
+    let (x0, x1) = (-1.1014970285661103, -1.078018529727802);
+    let (y0, y1) = (-0.803605513223678, -0.7625683620567426);
+    let (z0, z1) = (1.9583156022225399, 1.9902535138298945);
+    let cube = ConvexPolyhedron::from_mesh(
+        &TriangleMesh::new(
+            vec![
+                v(x1, y0, z1),
+                v(x1, y1, z0),
+                v(x1, y1, z1),
+                v(x0, y0, z0),
+                v(x1, y0, z0),
+                v(x0, y1, z0),
+                v(x0, y0, z1),
+                v(x0, y1, z1),
+            ],
+            vec![
+                [0, 1, 2],
+                [3, 1, 4],
+                [1, 0, 4],
+                [0, 3, 4],
+                [1, 3, 5],
+                [2, 1, 5],
+                [3, 0, 6],
+                [5, 3, 6],
+                [0, 2, 6],
+                [5, 6, 7],
+                [6, 2, 7],
+                [2, 5, 7],
+            ],
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let scene = Scene::new(
+        vec![Light::new(sheets, DVec3::ONE).unwrap()],
+        vec![cube.into()],
+    )
+    .unwrap();
+    let x = v(-1.0922688337434285, -0.803605513222403, 1.9586336874973191);
+    let n = v(0.0, 0.0, -1.0);
+    let view = v(0.9987999539873287, 0.0, -0.048976034087195676);
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.01).unwrap();
+    let per_light = |method: Method| {
+        scene
+            .clone()
+            .with_method(method)
+            .shade_per_light(x, n, view, &m)
+            .unwrap()[0]
+    };
+    let s = per_light(Method::Silhouette);
+    assert_eq!(s.shadowed(), DVec3::ZERO);
+    let p = per_light(Method::PerTriangle);
+    let u = p.unshadowed_diffuse.x;
+    assert!(p.diffuse.x <= 1e-9 * u, "{} of {u}", p.diffuse.x);
+    let us = p.unshadowed_specular.x;
+    assert!(
+        p.specular.x <= (1e-9 + 1e-9 / m.alpha().max(1e-4)) * us,
+        "{} of {us}",
+        p.specular.x
+    );
+    let e = MonteCarlo::new(10_000, ReferenceBrdf::Ltc)
+        .with_sampling(LightSampling::Faces)
+        .with_brdf_sampling()
+        .estimate(&scene, x, n, view, &m, 9)
+        .unwrap();
+    assert_eq!(e.mean, DVec3::ZERO, "{} +- {}", e.mean, e.std_error);
+}

@@ -12,9 +12,10 @@
 //! Every sample has density `1 / Omega`, `Omega` the summed solid angle of the triangles.
 //!
 //! Visibility is exact and brute force, the same opacity model as [`Scene`]'s: the sample's ray
-//! is intersected with every triangle of every occluder and of every other light whose bounding
-//! sphere it meets (no culling and no separating planes, so the analytic path's shortcuts are
-//! checked too), and of the light's own mesh for non-convex mesh lights (self-occlusion); any
+//! must meet the light first on a triangle that emits towards the point (its own nearer
+//! triangles hide farther ones), and it is intersected with every triangle of every occluder
+//! and of every other light whose bounding sphere it meets (no culling and no separating
+//! planes, so the analytic path's shortcuts are checked too); any
 //! hit strictly before the point the ray meets on the light blocks the sample, except on a
 //! triangle whose plane holds the shading point (seen edge-on by the facing predicate, as in
 //! the analytic path: a point on a surface is not hidden by it). The estimator
@@ -144,10 +145,12 @@ pub enum LightSampling {
     /// to [`LightSampling::Faces`] at that point.
     ///
     /// The region comes from the visibility layer the estimate is meant to check: a region that
-    /// is too large only wastes samples (each ray must still meet the light's front side), but a
-    /// light region that misses part of the light would be missed by both. Tests of the lights'
-    /// own regions (silhouettes of non-convex lights, unions of front faces) use
-    /// [`LightSampling::Faces`]; occlusion is checked independently either way.
+    /// is too large only wastes samples (each ray must still meet the light's emitting side
+    /// first), but a part of the light that the region misses would be missed by light samples
+    /// and the analytic path alike; only the BRDF's samples of [`Techniques::LightAndBrdf`]
+    /// reach it. Tests that check the analytic value use [`LightSampling::Faces`], which shares
+    /// no code with the visibility and sphere layers; occlusion is checked independently either
+    /// way.
     #[default]
     Silhouette,
     /// Every front-facing triangle of the light, projected, chosen in proportion to its solid
@@ -598,14 +601,19 @@ impl<'a> PointSampler<'a> {
         Ok(())
     }
 
-    /// Whether triangle `i` of light `light`'s mesh `mesh` emits towards the shading point: it
-    /// faces the point (the point is on its centroid's front side), or the light is two-sided
-    /// ([`super::Light::two_sided`]) and the point is strictly behind it.
+    /// Whether triangle `i` of light `light`'s mesh `mesh` emits towards the shading point, by
+    /// the facing predicate the analytic path decides it with ([`face_side`]): the point is in
+    /// front of it, or behind it and the light is two-sided ([`super::Light::two_sided`]). A
+    /// point within the predicate's tolerance of the triangle's plane sees it edge-on and gets
+    /// nothing from it, as on the analytic path (a point on a box's top face `2e-16` below a
+    /// sheet light facing down is in the sheet's plane; by the sign alone the reference counted
+    /// the whole sheet there, 0.22 where the analytic value is 0).
     fn emits_towards(&self, light: usize, mesh: &TriangleMesh, i: usize) -> bool {
-        let [a, b, c] = mesh.triangle(i);
-        let centroid = (a + b + c) / 3.0;
-        let facing = mesh.triangle_normal(i).dot(self.frame.origin() - centroid);
-        facing > 0.0 || (facing < 0.0 && self.scene.lights()[light].is_two_sided())
+        match face_side(mesh, i, self.frame.origin()) {
+            Side::Front => true,
+            Side::Behind => self.scene.lights()[light].is_two_sided(),
+            Side::On => false,
+        }
     }
 
     /// Fills `out` with the projections of light `light`'s front faces ([`LightSampling::Faces`]).
@@ -674,88 +682,56 @@ impl<'a> PointSampler<'a> {
         }
     }
 
-    /// A direction `w` (world) sampled in light `light`'s unoccluded region.
+    /// A direction `w` (world) sampled in light `light`'s unoccluded region: traced as any
+    /// direction is ([`Self::trace_light`]), so a region larger than the light only wastes
+    /// samples.
     fn trace_region(&self, light: usize, w: DVec3) -> Outcome {
+        self.trace_light(light, w).1
+    }
+
+    /// What the ray from the shading point along `w` (world) finds of light `light`: the light
+    /// triangle it meets first (within [`LIGHT_HIT_SLACK`], triangles seen edge-on skipped) if
+    /// that one emits towards the point, and whether another object hides it. The light's own
+    /// nearer triangles hide farther ones; a ray that meets none of its triangles, or meets one
+    /// that does not emit towards the point first (a back face, the inside of a closed light),
+    /// is a [`Outcome::Miss`].
+    fn trace_light(&self, light: usize, w: DVec3) -> (Option<usize>, Outcome) {
         let x = self.frame.origin();
-        let body = self.scene.lights()[light].shape();
-        let mesh = body.mesh();
-        // A non-planar mesh light is traced to its nearest triangle first (which must face x);
-        // convex and planar lights only when another object's bounding sphere is on the ray.
-        let mut t_light = None;
-        if matches!(body, Body::Mesh(_)) && !mesh.is_planar() {
-            match nearest_front_hit(x, w, mesh) {
-                Some(t) => t_light = Some(t),
-                None => return Outcome::Miss,
-            }
-        }
-        let bound = mesh.bounding_sphere();
-        let t_far = t_light.unwrap_or_else(|| (bound.center - x).length() + bound.radius);
-        let own = self.scene.occluders().len() + light;
-        let candidate = self
-            .blockers
-            .iter()
-            .enumerate()
-            .any(|(j, (_, b))| j != own && ray_meets_sphere(x, w, b.center, b.radius, t_far));
-        if !candidate {
-            return Outcome::Visible;
-        }
-        let t_light = match t_light {
-            Some(t) => t,
-            None => match entry_distance(x, w, body, self.scene.lights()[light].is_two_sided()) {
-                Some(t) => t,
-                None => return Outcome::Miss,
-            },
+        let mesh = self.scene.lights()[light].shape().mesh();
+        let Some((t, j)) = nearest_hit(x, w, mesh) else {
+            return (None, Outcome::Miss);
         };
-        if self.blocked(light, w, t_light) {
-            Outcome::Blocked
+        if !self.emits_towards(light, mesh, j) {
+            return (Some(j), Outcome::Miss);
+        }
+        if self.blocked(light, w, t) {
+            (Some(j), Outcome::Blocked)
         } else {
-            Outcome::Visible
+            (Some(j), Outcome::Visible)
         }
     }
 
-    /// Traces a direction `l` (shading frame) drawn from the BRDF towards light `light`: what it
-    /// finds, and the density with which the light technique over `domain` would have drawn it
-    /// with the same outcome (for the balance heuristic).
-    ///
-    /// Inside a region's triangulation ([`LightSampling::Silhouette`]) the direction is traced
-    /// exactly as the light's own samples are ([`Self::trace_region`]), with density
-    /// `1 / domain.total()`. Elsewhere, and for [`LightSampling::Faces`], the ray must meet the
-    /// light first on a triangle that emits towards the point (the light's own nearer triangles
-    /// hide farther ones) and nothing else before it; the light technique draws such a
-    /// direction only through that triangle's projection, so with density `1 / domain.total()`
-    /// when the triangle is one of the domain's faces and zero otherwise (outside a region, or
-    /// a face whose projection could not be built).
+    /// Traces a direction `l` (shading frame) drawn from the BRDF towards light `light`
+    /// ([`Self::trace_light`]): what it finds, and the density with which the light technique
+    /// over `domain` draws that direction (for the balance heuristic): `1 / domain.total()`
+    /// inside a region's triangulation ([`LightSampling::Silhouette`]), or where the triangle
+    /// the ray meets is one of the domain's faces ([`LightSampling::Faces`]: the light technique
+    /// reaches a direction only through the projection of the triangle it meets first), and
+    /// zero elsewhere (outside a region, or on a face whose projection could not be built).
     fn trace_brdf(&self, light: usize, domain: &LightDomain, l: DVec3) -> (f64, Outcome) {
         if l.z <= 0.0 {
             return (0.0, Outcome::Miss);
         }
-        let w = self.frame.dir_to_world(l);
-        let density = if domain.is_empty() {
-            0.0
-        } else {
-            1.0 / domain.total()
-        };
-        if domain.local && domain.tris.iter().any(|t| spherical_triangle_holds(t, l)) {
-            return (density, self.trace_region(light, w));
+        let (face, outcome) = self.trace_light(light, self.frame.dir_to_world(l));
+        if outcome != Outcome::Visible || domain.is_empty() {
+            return (0.0, outcome);
         }
-        let x = self.frame.origin();
-        let mesh = self.scene.lights()[light].shape().mesh();
-        let Some((t, j)) = nearest_hit(x, w, mesh) else {
-            return (0.0, Outcome::Miss);
-        };
-        if !self.emits_towards(light, mesh, j) {
-            return (0.0, Outcome::Miss);
-        }
-        let p = if !domain.local && domain.faces.contains(&j) {
-            density
+        let drawn = if domain.local {
+            domain.tris.iter().any(|t| spherical_triangle_holds(t, l))
         } else {
-            0.0
+            face.is_some_and(|j| domain.faces.contains(&j))
         };
-        if self.blocked(light, w, t) {
-            (p, Outcome::Blocked)
-        } else {
-            (p, Outcome::Visible)
-        }
+        (if drawn { 1.0 / domain.total() } else { 0.0 }, outcome)
     }
 
     /// Whether another object than light `light` has a triangle on the ray from the shading
@@ -808,45 +784,6 @@ fn nearest_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<(f64, usize)> 
 fn spherical_triangle_holds(t: &SphericalTriangle, l: DVec3) -> bool {
     let [a, b, c] = t.vertices();
     a.cross(b).dot(l) >= 0.0 && b.cross(c).dot(l) >= 0.0 && c.cross(a).dot(l) >= 0.0
-}
-
-/// The distance along `w` from `x` to the nearest triangle of `mesh`, if the ray meets one and
-/// that one faces `x` (the emitting side). Triangles seen edge-on from `x` are skipped, as in
-/// [`hits_before`].
-fn nearest_front_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<f64> {
-    let mut best: Option<(f64, usize)> = None;
-    for j in 0..mesh.triangle_count() {
-        if let Some(t) = ray_triangle(x, w, mesh.triangle(j), LIGHT_HIT_SLACK)
-            && best.is_none_or(|(b, _)| t < b)
-            && face_side(mesh, j, x) != Side::On
-        {
-            best = Some((t, j));
-        }
-    }
-    let (t, j) = best?;
-    (mesh.triangle_normal(j).dot(w) < 0.0).then_some(t)
-}
-
-/// The distance along `w` from `x` (outside the light) at which the ray enters a convex or
-/// planar light, for a direction known to lie in its region: for a convex light the largest
-/// distance to a face plane the ray enters through (the entry point of an intersection of
-/// half-spaces; no edge test, so directions on the silhouette's rim still get their distance),
-/// for a planar one the distance to its plane from the front side (from either side for a
-/// two-sided light).
-fn entry_distance(x: DVec3, w: DVec3, body: &Body, two_sided: bool) -> Option<f64> {
-    let mesh = body.mesh();
-    let plane_t = |j: usize| {
-        let n = mesh.triangle_normal(j);
-        let den = n.dot(w);
-        (den < 0.0 || (two_sided && den > 0.0)).then(|| n.dot(mesh.triangle(j)[0] - x) / den)
-    };
-    let t = match body {
-        Body::Convex(_) => (0..mesh.triangle_count())
-            .filter_map(plane_t)
-            .fold(f64::NEG_INFINITY, f64::max),
-        Body::Mesh(_) | Body::Bezier(_) => plane_t(0)?,
-    };
-    (t > 0.0 && t.is_finite()).then_some(t)
 }
 
 impl MonteCarlo {
