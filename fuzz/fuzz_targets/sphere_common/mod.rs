@@ -69,7 +69,7 @@ pub fn clip(p: &SphericalPolygon, n: DVec3) {
         .flat_map(|r| (0..r.len()).map(move |k| 2.0 / (r[k] + r[(k + 1) % r.len()]).length()))
         .fold(1.0, f64::max);
     let (wu, wd, w) = (up.solid_angle(), down.solid_angle(), p.solid_angle());
-    let tol = 1e-9 * 4.0 * PI + 1e-14 * bulge * p.vertex_count() as f64;
+    let tol = 1e-10 * 4.0 * PI + 1e-14 * bulge * p.vertex_count() as f64;
     assert!((wu + wd - w).abs() <= tol, "clip partition: {wu} + {wd} vs {w}\nP = {p:?}\nn = {n}");
     let twice = up.clip_to_hemisphere(n).solid_angle();
     assert!((twice - wu).abs() <= 1e-12 + 1e-15 * bulge, "clip not idempotent: {twice} vs {wu}\nP = {p:?}\nn = {n}");
@@ -96,7 +96,7 @@ pub fn boolean(a: &SphericalPolygon, b: &SphericalPolygon) {
         return;
     };
     let (wa, wb) = (a.solid_angle(), b.solid_angle());
-    let tol = 1e-9 * 4.0 * PI;
+    let tol = 1e-10 * 4.0 * PI;
     assert!((d + i - wa).abs() <= tol, "A-B + AnB = A: {d} + {i} vs {wa}\nA = {a:?}\nB = {b:?}");
     assert!((u - (wa + wb - i)).abs() <= tol, "AuB: {u} vs {wa} + {wb} - {i}\nA = {a:?}\nB = {b:?}");
     assert!((x - (u - i)).abs() <= tol, "xor: {x} vs {u} - {i}\nA = {a:?}\nB = {b:?}");
