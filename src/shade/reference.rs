@@ -171,7 +171,8 @@ pub enum Techniques {
     /// lobe or the specular one, chosen at random in proportion to their weights), combined by
     /// multiple importance sampling with the balance heuristic (\[Vea97\] section 9.2; see the
     /// module documentation). Twice the rays of [`Techniques::Light`] per sample; resolves
-    /// lobes of any width, down to [`crate::ltc::GGX_MIN_ALPHA`].
+    /// lobes of any width, down to [`crate::ltc::GGX_MIN_ALPHA`]. Lights bounded by Bezier
+    /// curves are still sampled by area alone.
     LightAndBrdf,
 }
 
