@@ -237,3 +237,155 @@ fn issue24_repro8_pinched_ring_is_valid_and_crossing_pinch_is_not() {
     // The same ring touching at a2 itself (a shared vertex) is a valid pinch.
     assert!(SphericalPolygon::new(vec![vec![c, a1, a2], vec![a2, d1, d2]]).is_ok());
 }
+
+/// Van Oosterom-Strackee: the signed solid angle of the triangle of unit vectors `p, q, r`, with
+/// the triple product taken on edge differences (accurate for tiny triangles too).
+fn triangle_area(p: DVec3, q: DVec3, r: DVec3) -> f64 {
+    let (p, q, r) = (p.normalize(), q.normalize(), r.normalize());
+    2.0 * p
+        .dot((q - p).cross(r - p))
+        .atan2(1.0 + p.dot(q) + q.dot(r) + r.dot(p))
+}
+
+/// Found by the `sphere_sliver` fuzz target (a fault of its bound, not of the operation): a
+/// triangle with a nearly antipodal edge (`pi - 0.045`), its vertex on that edge moved by
+/// `2e-9` rad. The thin triangles the move sweeps have areas `moved tan(L / 2)` for the
+/// adjacent edges of length `L`, 44 times the move for the long edge, so `A xor B` is `9.1e-8`
+/// sr, not at most `moved` times the perimeter (`1.3e-8`) as the target assumed. Checked both
+/// ways: at least the difference of the two triangles' areas, at most the swept bound.
+#[test]
+fn xor_of_a_triangle_with_a_nearly_antipodal_edge_and_its_moved_copy() {
+    use arealight::planar::BoolOp;
+    let ring = [v(22.0, -1.0, 0.0), v(1.0, 0.0, -1.0), v(-1.0, 0.0, 0.0)].map(DVec3::normalize);
+    let a = SphericalPolygon::new(vec![ring.to_vec()]).unwrap();
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = (0..3).map(|k| arc(ring[k], ring[(k + 1) % 3])).sum();
+    let moved = per / 3.0 * 1e-9;
+    let (u, _) = ring[0].any_orthonormal_pair();
+    let mut rb = ring;
+    rb[0] = (ring[0] + u * moved).normalize();
+    let b = SphericalPolygon::new(vec![rb.to_vec()]).unwrap();
+    let x = a.boolean(&b, BoolOp::Xor).unwrap().solid_angle();
+    let tan_half = |p: DVec3, q: DVec3| (p - q).length() / (p + q).length();
+    let sweep = moved * (tan_half(ring[2], ring[0]) + tan_half(ring[0], ring[1]));
+    let difference =
+        (triangle_area(ring[0], ring[1], ring[2]) - triangle_area(rb[0], rb[1], rb[2])).abs();
+    assert!(sweep > 40.0 * moved, "{sweep} vs {moved}");
+    assert!(
+        x >= difference * (1.0 - 1e-6) && x <= sweep * 1.01 + 1e-13,
+        "xor {x:e}, difference of areas {difference:e}, swept bound {sweep:e}"
+    );
+}
+
+/// Found by the `sphere_tiny` fuzz target (a fault of its expectation, not of the operation):
+/// two triangles `8e-10` rad across at antipodal points, both rings clockwise, so each polygon
+/// is the large region outside its tiny triangle. `A n not B` is then B's tiny triangle (A's
+/// outside holds it), `9.1e-16` sr, which the target expected to be A's area, `4 pi`. Checked
+/// against the tiny triangle's Van Oosterom-Strackee area.
+#[test]
+fn intersection_of_the_outsides_of_antipodal_tiny_triangles() {
+    use arealight::planar::BoolOp;
+    let c = v(-1.0, -1.0, -1.0).normalize();
+    let size = 1e-7 / 128.0;
+    let (u, w) = c.any_orthonormal_pair();
+    let ring = |center: DVec3, pts: &[(f64, f64)], off: (f64, f64)| -> Vec<DVec3> {
+        let (u, w) = if center.dot(c) < 0.0 { (u, -w) } else { (u, w) };
+        pts.iter()
+            .map(|&(x, y)| (center + (u * (x + off.0) + w * (y + off.1)) * size).normalize())
+            .collect()
+    };
+    let ra = ring(c, &[(65.0, -69.0), (0.0, 65.0), (33.0, 0.0)], (0.0, 0.0));
+    let rb = ring(-c, &[(0.0, 47.0), (1.0, 0.0), (-64.0, 65.0)], (47.0, 1.0));
+    let (a, b) = (
+        SphericalPolygon::new(vec![ra.clone()]).unwrap(),
+        SphericalPolygon::new(vec![rb.clone()]).unwrap(),
+    );
+    let (ta, tb) = (
+        triangle_area(ra[0], ra[1], ra[2]),
+        triangle_area(rb[0], rb[1], rb[2]),
+    );
+    // Both rings clockwise: each polygon is the outside of its triangle.
+    assert!(ta < 0.0 && tb < 0.0, "{ta:e} {tb:e}");
+    let got = a
+        .boolean(&b.complement(), BoolOp::Intersection)
+        .unwrap()
+        .solid_angle();
+    assert!(
+        (got + tb).abs() <= 1e-6 * tb.abs(),
+        "{got:e} vs the tiny triangle's {:e}",
+        -tb
+    );
+}
+
+/// Found by the `sphere_tiny` fuzz target with the issue's bounds: a triangle and a hexagon
+/// about `1e-10` rad across (the low end of the issue's tiny range), the triangle's ring
+/// clockwise (so `A` is everything but it). `A n B` (B less the triangle, `7.5e-21` sr) comes
+/// back as a ring that crosses itself: an output that is not a valid input. Fails today; the
+/// sphere layer's booleans lose validity when the result's vertices, rounded to unit vectors
+/// (`1e-16` absolute), are `1e-6` of the polygon's size apart.
+#[test]
+#[ignore = "sphere layer: booleans of polygons 1e-10 rad across can return self-crossing rings"]
+fn intersection_of_tiny_polygons_is_a_valid_polygon() {
+    use arealight::planar::BoolOp;
+    let c = v(127.0, -1.0, 65.0).normalize();
+    let size = 1e-10 / 128.0;
+    let (u, w) = c.any_orthonormal_pair();
+    let ring = |pts: &[(f64, f64)]| -> Vec<DVec3> {
+        pts.iter()
+            .map(|&(x, y)| (c + (u * x + w * y) * size).normalize())
+            .collect()
+    };
+    let a = SphericalPolygon::new(vec![ring(&[(11., 45.), (-63., -1.), (-81., -1.)])]).unwrap();
+    let b = SphericalPolygon::new(vec![ring(&[
+        (4., -116.),
+        (43., 65.),
+        (-117., -1.),
+        (-1., 10.),
+        (-1., -1.),
+        (-119., -1.),
+    ])])
+    .unwrap();
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        let r = p.boolean(q, BoolOp::Intersection).unwrap();
+        r.validate().unwrap_or_else(|e| panic!("{e}: {r:?}"));
+    }
+}
+
+/// Found by the `sphere_sliver` fuzz target once its identities were checked at the issue's
+/// `1e-10 * 4 pi` (they were at `1e-9 * 4 pi`): a triangle larger than a hemisphere with a
+/// nearly antipodal edge (`|a + b| = 0.0137`), and its copy with that edge's vertex moved by
+/// `2.1e-9`. `A - B` comes back empty and `A n B` `1.7e-9` sr short of `A`: the sliver between
+/// the two near-antipodal edges, a lever of `2 / |a + b| = 146` on the move, is lost.
+/// `area(A - B) + area(A n B) = area(A)` misses by `1.4` times the bound. Fails today.
+#[test]
+#[ignore = "sphere layer: set identities near nearly antipodal edges miss 1e-10 * 4 pi"]
+fn difference_identity_next_to_a_nearly_antipodal_edge() {
+    use arealight::planar::BoolOp;
+    let a = SphericalPolygon::new(vec![vec![
+        v(
+            0.013728934738115898,
+            -0.7070401390129688,
+            -0.7070401390129688,
+        ),
+        v(0.0, 0.7071067811865475, 0.7071067811865475),
+        v(-0.36439934858051226, 0.9312427797057535, 0.0),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(
+            0.013728936829898225,
+            -0.7070401390010729,
+            -0.7070401389842478,
+        ),
+        v(0.0, 0.7071067811865475, 0.7071067811865475),
+        v(-0.36439934858051226, 0.9312427797057535, 0.0),
+    ]])
+    .unwrap();
+    let d = a.boolean(&b, BoolOp::Difference).unwrap().solid_angle();
+    let i = a.boolean(&b, BoolOp::Intersection).unwrap().solid_angle();
+    let wa = a.solid_angle();
+    assert!(
+        (d + i - wa).abs() <= 1e-10 * 4.0 * std::f64::consts::PI,
+        "{d} + {i} vs {wa}"
+    );
+}

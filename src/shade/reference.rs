@@ -250,7 +250,7 @@ pub struct MonteCarlo {
 /// The start needs no such margin and has none: a ray starting on a surface is not blocked by
 /// that surface because the shading point lies in its plane, which [`face_side`] decides with
 /// the tolerance the analytic path uses (a triangle seen edge-on covers nothing there, see
-/// [`hits_between`]). A margin relative to the ray's length would instead let a ray through a
+/// [`hits_before`]). A margin relative to the ray's length would instead let a ray through a
 /// blocker triangle that the point lies a little behind: from a point `1.5e-11` inside a face
 /// of an icosphere occluder, rays that meet a light face a few units away passed through that
 /// face, and the estimate read 0.49 where the visible light gives 0.027.
