@@ -910,9 +910,13 @@ fn point_just_inside_a_box_face_under_a_mirror_lobe() {
 /// (the census's and the fuzz target's floor), and the reference agrees with both.
 #[test]
 fn box_light_far_in_a_mirror_lobes_tail() {
-    let light = ConvexPolyhedron::cuboid(v(12.25, 0.0, 0.0), v(1.0 / 16.0, 14.0 / 16.0, 0.5)).unwrap();
-    let scene = Scene::new(vec![Light::new(light, DVec3::new(1.0, 0.8, 0.6)).unwrap()], vec![])
-        .unwrap();
+    let light =
+        ConvexPolyhedron::cuboid(v(12.25, 0.0, 0.0), v(1.0 / 16.0, 14.0 / 16.0, 0.5)).unwrap();
+    let scene = Scene::new(
+        vec![Light::new(light, DVec3::new(1.0, 0.8, 0.6)).unwrap()],
+        vec![],
+    )
+    .unwrap();
     let x = v(11.75, 11.75, 0.0);
     let view = v(0.8314696081451971, 0.555570230241751, 0.0001);
     let m = Material::new(DVec3::ZERO, DVec3::splat(24.0 / 255.0), 0.0).unwrap();
