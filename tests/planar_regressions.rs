@@ -109,7 +109,7 @@ fn union_with_vertex_copies_ulps_apart_within_one_operand() {
 }
 
 /// "Result boundary does not close" on a nearly shared edge (Issue 3, item 3): the planar shapes
-/// of `shade_known_failures::difference_with_nearly_shared_edge` in the sphere layer's
+/// of `sphere_shade_regressions::difference_with_nearly_shared_edge` in the sphere layer's
 /// projection (before its weld). A's edge from vertex 4 to 5 and B's edge from 0 to 1 are the
 /// same edge up to `1.5e-15`, just over the snapping distance `1.3e-15`, so the vertices stay
 /// distinct; each is inserted into the other operand's edge, and B's closing edge, passing within

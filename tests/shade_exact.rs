@@ -89,7 +89,7 @@ fn run(scene: &Scene, method: Method, count: usize, h: f64, seed: u64) -> Report
             // A give-up is a documented answer (the renderer falls back), not a wrong value;
             // they are counted below and must stay rare. The one these scenes meet is the sphere
             // layer's horizon clip of an edge within 1e-14 of the horizon (issue 24,
-            // tests/shade_known_failures.rs).
+            // tests/sphere_shade_regressions.rs).
             Err(e) if e.is_undecidable() => {
                 eprintln!("point {i} x {x}: gave up: {e}");
                 gave_up += 1;

@@ -121,7 +121,7 @@ fn check_against_mc(cfg: DemoConfig, count: usize, samples: u32, seed: u64) -> f
     );
     // The per-triangle path runs hundreds of spherical differences of triangles sharing edges;
     // every one must succeed (the hardest configurations met are kept in
-    // tests/shade_known_failures.rs).
+    // tests/sphere_shade_regressions.rs).
     assert!(
         per_tri_errors.is_empty(),
         "per-triangle path errors:\n{}",

@@ -47,7 +47,7 @@ fn quad_light_seen_from_just_inside_an_icosphere_light() {
     // A quad light and an icosphere light (1.875 across), the point 2^-k inside a facet of the
     // icosphere, per-triangle method. The quad's front triangles minus the icosphere's triangles
     // (the icosphere light blocks the quad) run through a horizon sliver whose spherical
-    // difference comes back invalid (tests/shade_known_failures.rs, issue 24), and the next
+    // difference comes back invalid (tests/sphere_shade_regressions.rs, issue 24), and the next
     // difference returned the full sphere: the quad's radiance came out 57 times its unoccluded
     // value. A region outside the upper hemisphere is now a give-up.
     let ico = ConvexPolyhedron::icosphere(grid(-41, 43, -11), 30.0 / 16.0, 1).unwrap();
@@ -99,7 +99,7 @@ fn icosphere_light_face_with_one_vertex_just_above_the_horizon() {
     // path), seen from a point 7e-12 behind that sheet, normal down: one of the icosphere's front
     // triangles has a single vertex 8e-12 above
     // the horizon, and the horizon clip returned the whole upper hemisphere for it
-    // (tests/shade_known_failures.rs, issue 24), making the light 26 000 times brighter than
+    // (tests/sphere_shade_regressions.rs, issue 24), making the light 26 000 times brighter than
     // unoccluded. Clips that add a long horizon arc are now checked against the clipped
     // polygon's solid angle.
     let h = 2.0;
@@ -161,7 +161,7 @@ fn cylinder_through_a_cuboid_light_shaded_next_to_the_light() {
     // The "piercing convex lights" scene of tests/shade_exact.rs, shaded on the tilted cylinder
     // 0.009 outside the cuboid light's corner, normal facing away from the light's top: a cut
     // cylinder triangle runs within 1.2e-14 of the horizon, its clip came back as a ring running
-    // over itself (tests/shade_known_failures.rs, issue 24), and the face-by-face path lost 18%
+    // over itself (tests/sphere_shade_regressions.rs, issue 24), and the face-by-face path lost 18%
     // of the light (analytic 0.1616 against Monte Carlo 0.1958 +- 0.0006 in red). The result must
     // agree with the Monte Carlo reference (4.5 sigma, 2^15 samples) or be a give-up.
     let cuboid = |c, h| ConvexPolyhedron::cuboid(c, h).unwrap();
@@ -224,7 +224,7 @@ fn icosphere_light_cut_by_a_sheet_light_seen_from_just_outside_a_face() {
     // An icosphere light (radius 1.5) with an open two-sheet mesh light through its middle, shaded
     // 4.5e-4 outside one of its faces, the normal pointing into it: in the face-by-face path one
     // face's part minus a cut sheet triangle came back as the whole upper hemisphere
-    // (tests/shade_known_failures.rs, issue 24: nearly antipodal vertices), 0.7% above the
+    // (tests/sphere_shade_regressions.rs, issue 24: nearly antipodal vertices), 0.7% above the
     // light's unoccluded value. A face's piece larger than the face is now a give-up.
     let h = 31.0 / 16.0;
     let c = grid(-1, -1, -1);

@@ -277,8 +277,8 @@ fn check(
             if area <= 1e-10 * 4.0 * PI {
                 return true;
             }
-            // The set operations can be wrong themselves (see the ignored test below): decide
-            // with exact cone tests where they disagree with the silhouette.
+            // The set operations have a resolution of their own (snapping): decide with exact
+            // cone tests where they disagree with the silhouette.
             let wrong = (0..2000)
                 .filter(|_| {
                     let d = rng.dir();

@@ -1,7 +1,5 @@
 //! Failures of the clipping backend found by comparing it with the Pluecker backend and exact
-//! rays, whose cause lay outside the `visibility` layer. A test still failing is `#[ignore]`d and
-//! names the layer to fix; run those with
-//! `cargo test --test visibility_backend_regressions -- --ignored`.
+//! rays, whose cause lay outside the `visibility` layer (all fixed now; none is ignored).
 
 use arealight::glam::DVec3;
 use arealight::internals::{TriangleRole, triangle_polygon};

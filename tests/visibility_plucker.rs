@@ -13,8 +13,8 @@
 //! Both the per-call path ([`Visibility::visible_region`]) and the reused trees of a
 //! [`PluckerContext`] are checked, on tiles of coherent points.
 //!
-//! The clipping backend has known failures of its own (the sphere layer, issue 24); where the two
-//! backends disagree, the Monte Carlo reference decides: this backend must agree with it at 4.5
+//! The clipping backend rests on the sphere layer's set operations, whose resolution differs
+//! from this backend's; where the two backends disagree, the Monte Carlo reference decides: this backend must agree with it at 4.5
 //! sigma (with a second, 16 times larger estimate before a failure is believed, as in
 //! tests/shade_exact.rs), and the disagreement is reported as a clipping-backend failure only
 //! when the clipping backend is itself outside 6 sigma of that second estimate. When both are

@@ -6,8 +6,9 @@
 //! clip written here (Sutherland-Hodgman on convex rings, with its own area and clamped-cosine
 //! sums), continuity bounds derived from the geometry, and exact identities. Default 256 cases
 //! per property; `PROPTEST_CASES=N` for more. `census_*` runs each generator on fixed seeds and
-//! reports how often anything fails (`cargo test --test sphere_robust_props census --
-//! --nocapture`; `SPHERE_CENSUS=N` cases per family, default 2000).
+//! reports how often anything fails (`cargo test -p arealight-compare --test
+//! sphere_robust_props census -- --nocapture`; `SPHERE_CENSUS=N` cases per family, default
+//! 2000).
 
 // The crate's shared test helpers, from the package next door; this file lives in the
 // `compare` member because its planar reference is i_overlay.

@@ -56,6 +56,7 @@ pub use curved::{
     ggx_curved_integral, specular_eps,
 };
 pub use distribution::Ltc;
+pub(crate) use distribution::cosine_sample;
 pub use ggx::{
     GGX_MIN_ALPHA, ggx_brdf_cos, ggx_ndf, ggx_sample_vndf, ggx_vndf_pdf, ggx_vndf_weight,
 };

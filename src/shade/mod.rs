@@ -14,8 +14,9 @@
 //!   flattening goes through the same visibility as any light, so occluders cast shadows from
 //!   them; [`Light::shade_curved`] shades one unshadowed by the curved integrals directly.
 //! - [`MonteCarlo`]: an estimator of the same radiance (solid-angle sampling of the lights'
-//!   triangulated silhouettes or of their faces, [`LightSampling`]; exact ray-triangle
-//!   visibility), with its standard error, for tests and comparisons.
+//!   triangulated silhouettes or of their faces, [`LightSampling`], optionally combined with
+//!   BRDF sampling by multiple importance sampling for near-mirror lobes, [`Techniques`]; exact
+//!   ray-triangle visibility), with its standard error, for tests and comparisons.
 //! - [`RatioEstimator`]: the analytic unshadowed radiance times a Monte Carlo estimate of the
 //!   shadow ratio (\[HHM18\], the baseline of seed 000 section 4.2).
 //!
@@ -30,12 +31,22 @@
 //!   light go face by face (one spherical triangle per front face, minus cut blocker
 //!   triangles): exact, but many spherical booleans, so much slower than the silhouette path.
 //!   Open non-planar mesh lights always go face by face (their own back faces can hide them).
-//! - A shading point inside a closed light: the silhouette path counts the whole sphere, the
-//!   face-by-face path and the Monte Carlo reference nothing (no front face is seen).
-//! - The per-triangle path (meshes, and [`Method::PerTriangle`]) chains many spherical booleans
-//!   of edge-sharing triangles; on a few near-degenerate configurations the `sphere` layer may
-//!   give up with [`crate::GeomError::Undecidable`] (none in the current tests). The silhouette path
-//!   of convex shapes has not been seen to fail.
+//! - A shading point inside a closed light receives nothing from it on every path (its surface
+//!   emits outwards; no front face is seen).
+//! - Where a value cannot be decided within rounding the query says so,
+//!   [`crate::GeomError::Undecidable`], rather than return a doubtful value. The census of
+//!   issue 24's regimes (tests/shade_census.rs: slivers, horizons through light vertices,
+//!   grazing near-mirror views, interpenetrating and coplanar objects, points on surfaces)
+//!   measures how often, per family; the rates are in BENCHMARKS.md ("never a silently wrong
+//!   value (issue 24): give-up rates"). Most give-ups are on the per-triangle path
+//!   ([`Method::PerTriangle`], and meshes), which chains many spherical booleans of
+//!   edge-sharing triangles.
+//! - A shading point within the facing predicate's tolerance of a face plane
+//!   ([`crate::solid::FACE_TOLERANCE`]) lies on that plane for every facing decision, but the
+//!   two methods place the rest of the object differently there (the silhouette as seen from
+//!   the plane, the per-triangle path from the point as it is); their values differ by no more
+//!   than moving the point across that band changes them, which only a near-mirror lobe whose
+//!   peak runs along the face makes visible (`3.5e-7` of the value seen).
 //!
 //! # Examples
 //!
@@ -90,6 +101,6 @@ pub use curved::{CurvedShading, DEFAULT_DIFFUSE_SUBDIVISION};
 pub use material::Material;
 pub use query::{LightShading, ShadeContext};
 pub use ratio::{LightRatio, RatioEstimator};
-pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf};
+pub use reference::{Estimate, LightSampling, MonteCarlo, ReferenceBrdf, Techniques};
 pub use scene::{Light, Scene};
 pub use validate::{SceneIssue, SceneReport};

@@ -162,6 +162,9 @@ impl RatioEstimator {
         Ok(Estimate {
             mean,
             std_error: DVec3::new(sqrt(var.x), sqrt(var.y), sqrt(var.z)),
+            samples: self.samples_per_light.max(1),
+            // A ratio of two means, not a mean of bounded steps: no Bernstein interval.
+            sample_bound: DVec3::INFINITY,
         })
     }
 

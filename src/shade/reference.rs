@@ -12,9 +12,10 @@
 //! Every sample has density `1 / Omega`, `Omega` the summed solid angle of the triangles.
 //!
 //! Visibility is exact and brute force, the same opacity model as [`Scene`]'s: the sample's ray
-//! is intersected with every triangle of every occluder and of every other light whose bounding
-//! sphere it meets (no culling and no separating planes, so the analytic path's shortcuts are
-//! checked too), and of the light's own mesh for non-convex mesh lights (self-occlusion); any
+//! must meet the light first on a triangle that emits towards the point (its own nearer
+//! triangles hide farther ones), and it is intersected with every triangle of every occluder
+//! and of every other light whose bounding sphere it meets (no culling and no separating
+//! planes, so the analytic path's shortcuts are checked too); any
 //! hit strictly before the point the ray meets on the light blocks the sample, except on a
 //! triangle whose plane holds the shading point (seen edge-on by the facing predicate, as in
 //! the analytic path: a point on a surface is not hidden by it). The estimator
@@ -24,10 +25,37 @@
 //! (rejection from its bounding box; `curved_reference.rs`), whatever the [`LightSampling`], so
 //! that the analytic path's per-point flattening is checked too; visibility as above.
 //!
+//! Near-mirror lobes (GGX roughness `0.05` and below, `alpha <= 0.0025`) are narrower than
+//! anything light sampling resolves with a few thousand samples: the estimate and its standard
+//! error both miss the peak. [`Techniques::LightAndBrdf`] adds a second technique per sample, a
+//! direction drawn from the BRDF itself (the cosine lobe, and the LTC distribution
+//! ([`crate::ltc::Ltc::sample`]) for [`ReferenceBrdf::Ltc`] or the GGX visible normals
+//! ([`crate::ltc::ggx_sample_vndf`], \[Hei18\]) for [`ReferenceBrdf::True`]), and combines the
+//! two by multiple importance sampling with the balance heuristic (\[Vea97\] section 9.2.2,
+//! one sample per technique): each sample of either technique contributes
+//! `f(l) V(l) / (p_light(l) + p_brdf(l))`, which is unbiased wherever either density is
+//! positive and has bounded variance for any lobe width. The BRDF's samples are traced to the
+//! light's nearest triangle (which must emit towards the point), so they also cover any part of
+//! a light that a region of [`LightSampling::Silhouette`] would miss: there `p_light = 0` and
+//! the BRDF sample counts whole.
+//!
+//! Which reference checks [`Scene::shade`]: the analytic path integrates the LTC lobe of the
+//! table ([`crate::ltc::lookup`], scaled by [`crate::ltc::LtcLookup::specular_scale`]) and the
+//! Lambertian lobe over the visible region exactly, so [`ReferenceBrdf::Ltc`] estimates the
+//! same integral and any difference beyond the confidence bound is an error of the geometry
+//! (visibility, clipping, integration). [`ReferenceBrdf::True`] estimates the true GGX
+//! reflection instead; it differs from the analytic value by the table's fitting error as well,
+//! which is checked separately (tests/ltc_robust.rs against brute-force VNDF albedos) and must
+//! not be mistaken for a geometric error.
+//!
 //! Only the outer (front) side of a light emits: a shading point inside a closed light sees none
-//! of its triangles from the front and gets nothing here, where the analytic silhouette path
-//! counts the whole sphere (the one configuration where the two differ; no scene meant for
-//! rendering has it).
+//! of its triangles from the front and gets nothing, here as on both analytic paths.
+//!
+//! # References
+//!
+//! - \[Vea97\] E. Veach. *Robust Monte Carlo methods for light transport simulation.* PhD
+//!   thesis, Stanford, 1997 (chapter 9, multiple importance sampling).
+//! - \[Hei18\] E. Heitz. *Sampling the GGX distribution of visible normals.* JCGT 7(4), 2018.
 
 use alloc::vec::Vec;
 
@@ -35,7 +63,7 @@ use glam::{DVec2, DVec3};
 
 use super::material::Material;
 use super::scene::Scene;
-use crate::ltc::{Ltc, lookup};
+use crate::ltc::{Ltc, cosine_sample, ggx_sample_vndf, ggx_vndf_pdf, lookup};
 use crate::math::sqrt;
 use crate::solid::{Body, BoundingSphere, ShadingFrame, Side, TriangleMesh, face_side};
 use crate::sphere::{SphericalPolygon, SphericalTriangle};
@@ -117,10 +145,12 @@ pub enum LightSampling {
     /// to [`LightSampling::Faces`] at that point.
     ///
     /// The region comes from the visibility layer the estimate is meant to check: a region that
-    /// is too large only wastes samples (each ray must still meet the light's front side), but a
-    /// light region that misses part of the light would be missed by both. Tests of the lights'
-    /// own regions (silhouettes of non-convex lights, unions of front faces) use
-    /// [`LightSampling::Faces`]; occlusion is checked independently either way.
+    /// is too large only wastes samples (each ray must still meet the light's emitting side
+    /// first), but a part of the light that the region misses would be missed by light samples
+    /// and the analytic path alike; only the BRDF's samples of [`Techniques::LightAndBrdf`]
+    /// reach it. Tests that check the analytic value use [`LightSampling::Faces`], which shares
+    /// no code with the visibility and sphere layers; occlusion is checked independently either
+    /// way.
     #[default]
     Silhouette,
     /// Every front-facing triangle of the light, projected, chosen in proportion to its solid
@@ -129,13 +159,75 @@ pub enum LightSampling {
     Faces,
 }
 
+/// Which sampling techniques the estimator draws each light's samples with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Techniques {
+    /// Directions towards the light only ([`LightSampling`]): enough for diffuse and moderately
+    /// glossy lobes, blind to near-mirror ones.
+    #[default]
+    Light,
+    /// Per sample, one direction towards the light and one drawn from the BRDF (the Lambertian
+    /// lobe or the specular one, chosen at random in proportion to their weights), combined by
+    /// multiple importance sampling with the balance heuristic (\[Vea97\] section 9.2; see the
+    /// module documentation). Twice the rays of [`Techniques::Light`] per sample; resolves
+    /// lobes of any width, down to [`crate::ltc::GGX_MIN_ALPHA`]. Lights bounded by Bezier
+    /// curves are still sampled by area alone.
+    LightAndBrdf,
+}
+
 /// A Monte Carlo estimate: the mean and its standard error, per RGB channel.
+///
+/// The standard error is itself estimated from the samples, so it misleads where the integrand
+/// is concentrated on a set that few samples hit (a sliver of a light seen in a near-mirror
+/// lobe: no sample may hit it, and the estimate and its error both read near zero). Where one
+/// step's contribution has a known bound, [`Estimate::bernstein_halfwidth`] gives a confidence
+/// interval that holds regardless.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
     /// The estimated radiance.
     pub mean: DVec3,
     /// The estimated standard deviation of `mean` (sample standard deviation over `sqrt(n)`).
     pub std_error: DVec3,
+    /// The number of steps `n` averaged (samples per light; a step of
+    /// [`Techniques::LightAndBrdf`] is one sample of each technique).
+    pub samples: u32,
+    /// An upper bound on one step's contribution, summed over the lights (every step's value
+    /// lies in `[0, sample_bound]`), or infinite where none is known (light sampling alone with
+    /// a specular lobe, whose peak density is not bounded in advance; lights bounded by Bezier
+    /// curves).
+    pub sample_bound: DVec3,
+}
+
+impl Estimate {
+    /// The half-width of a two-sided confidence interval for the true value around `mean`, of
+    /// level at least `1 - delta`, that holds however skewed the steps' distribution is: the
+    /// empirical Bernstein bound (Maurer and Pontil 2009, theorem 4, with `delta / 2` per side)
+    /// for steps in `[0, B]`,
+    ///
+    /// ```text
+    /// sqrt(2 V ln(4 / delta) / n) + 7 B ln(4 / delta) / (3 (n - 1)),
+    /// ```
+    ///
+    /// with `V = n std_error^2` the steps' sample variance and `B` = [`Estimate::sample_bound`].
+    /// Infinite where `B` is, or for fewer than two steps. (With several lights the steps'
+    /// variance is taken as the sum of the lights', which it equals in expectation.)
+    ///
+    /// # References
+    ///
+    /// A. Maurer, M. Pontil. *Empirical Bernstein bounds and sample variance penalization.*
+    /// COLT 2009.
+    #[must_use]
+    pub fn bernstein_halfwidth(&self, delta: f64) -> DVec3 {
+        if self.samples < 2 {
+            return DVec3::INFINITY;
+        }
+        let n = f64::from(self.samples);
+        let log = crate::math::ln(4.0 / delta);
+        let v = self.std_error * self.std_error * n;
+        let spread = (v * (2.0 * log / n)).map(sqrt);
+        spread + self.sample_bound * (7.0 * log / (3.0 * (n - 1.0)))
+    }
 }
 
 /// Monte Carlo estimator settings.
@@ -147,6 +239,8 @@ pub struct MonteCarlo {
     pub brdf: ReferenceBrdf,
     /// Where directions towards each light are drawn.
     pub sampling: LightSampling,
+    /// Whether the BRDF is sampled too ([`Techniques::LightAndBrdf`]).
+    pub techniques: Techniques,
 }
 
 /// Relative distance along a ray, short of the point where it meets the light, within which a
@@ -156,7 +250,7 @@ pub struct MonteCarlo {
 /// The start needs no such margin and has none: a ray starting on a surface is not blocked by
 /// that surface because the shading point lies in its plane, which [`face_side`] decides with
 /// the tolerance the analytic path uses (a triangle seen edge-on covers nothing there, see
-/// [`hits_between`]). A margin relative to the ray's length would instead let a ray through a
+/// [`hits_before`]). A margin relative to the ray's length would instead let a ray through a
 /// blocker triangle that the point lies a little behind: from a point `1.5e-11` inside a face
 /// of an icosphere occluder, rays that meet a light face a few units away passed through that
 /// face, and the estimate read 0.49 where the visible light gives 0.027.
@@ -227,7 +321,14 @@ struct BrdfEval {
     /// The LTC distribution and its per-channel scale ([`ReferenceBrdf::Ltc`] with a specular
     /// lobe).
     ltc: Option<(Ltc, DVec3)>,
+    /// The probability with which a BRDF sample is drawn from the Lambertian lobe (the rest
+    /// from the specular one).
+    p_diffuse: f64,
 }
+
+/// The smallest probability with which [`BrdfEval::sample`] picks a lobe that the material has:
+/// the lobes' weights are only estimates of their shares, so neither is starved.
+const MIN_LOBE_PICK: f64 = 0.25;
 
 impl BrdfEval {
     fn eval(&self, l: DVec3) -> DVec3 {
@@ -245,6 +346,84 @@ impl BrdfEval {
             }
         }
     }
+
+    /// A bound on `f(l) / pdf(l)` per channel over all directions (per unit radiance): with
+    /// `f = albedo cos / pi + s(l)` and `pdf = p_d cos / pi + (1 - p_d) p_s(l)`, the ratio is at
+    /// most the larger of `albedo / p_d` and the specular lobe's `s / ((1 - p_d) p_s)`, which is
+    /// the LTC scale over `1 - p_d` for [`ReferenceBrdf::Ltc`] (`s` is the scale times the
+    /// density sampled) and at most `1 / (1 - p_d)` for [`ReferenceBrdf::True`] (Fresnel at most
+    /// one, and `f_ggx cos / pdf_vndf = G2 / G1 <= 1`, \[Hei18\]).
+    fn ratio_bound(&self) -> DVec3 {
+        let diffuse = if self.p_diffuse > 0.0 {
+            self.material.albedo() / self.p_diffuse
+        } else {
+            DVec3::ZERO
+        };
+        let specular = if self.p_diffuse < 1.0 {
+            match (self.kind, &self.ltc) {
+                (ReferenceBrdf::Ltc, Some((_, scale))) => *scale / (1.0 - self.p_diffuse),
+                (ReferenceBrdf::Ltc, None) => DVec3::ZERO,
+                (ReferenceBrdf::True, _) => DVec3::splat(1.0 / (1.0 - self.p_diffuse)),
+            }
+        } else {
+            DVec3::ZERO
+        };
+        diffuse.max(specular)
+    }
+
+    /// A direction in the shading frame drawn from the BRDF's sampling density ([`Self::pdf`])
+    /// with the uniform numbers `u` (the direction) and `pick` (the lobe), both in `[0, 1)`.
+    /// It may lie below the horizon, where the BRDF is zero.
+    fn sample(&self, u: DVec2, pick: f64) -> DVec3 {
+        if pick < self.p_diffuse {
+            return cosine_sample(u);
+        }
+        match (self.kind, &self.ltc) {
+            (ReferenceBrdf::Ltc, Some((d, _))) => d.sample(u),
+            _ => ggx_sample_vndf(self.view, self.material.alpha(), u),
+        }
+    }
+
+    /// The density per unit solid angle (over the whole sphere) with which [`Self::sample`]
+    /// draws `l`: the mixture of the cosine density and the specular lobe's sampling density.
+    fn pdf(&self, l: DVec3) -> f64 {
+        let diffuse = if l.z > 0.0 {
+            l.z / core::f64::consts::PI
+        } else {
+            0.0
+        };
+        let specular = if self.p_diffuse < 1.0 {
+            match (self.kind, &self.ltc) {
+                (ReferenceBrdf::Ltc, Some((d, _))) => d.density(l),
+                _ => ggx_vndf_pdf(self.view, l, self.material.alpha()),
+            }
+        } else {
+            0.0
+        };
+        self.p_diffuse * diffuse + (1.0 - self.p_diffuse) * specular
+    }
+}
+
+/// The probability of drawing a BRDF sample from the Lambertian lobe: the lobes' weights (the
+/// largest diffuse albedo, the largest specular albedo the table gives at this view) in
+/// proportion, each kept at least [`MIN_LOBE_PICK`] when the material has it; `1` without a
+/// specular lobe, `0` without a diffuse one.
+fn diffuse_pick(material: &Material, cos_v: f64) -> f64 {
+    let wd = material.albedo().max_element();
+    if !material.has_specular() {
+        return 1.0;
+    }
+    if wd <= 0.0 {
+        return 0.0;
+    }
+    let ws = lookup(cos_v, material.alpha()).map_or(material.f0().max_element(), |look| {
+        let f0 = material.f0();
+        look.albedo * look.specular_scale(f0.max_element()) / look.norm
+    });
+    if !(ws > 0.0) {
+        return 1.0;
+    }
+    (wd / (wd + ws)).clamp(MIN_LOBE_PICK, 1.0 - MIN_LOBE_PICK)
 }
 
 /// The directions of one light at one shading point that samples are drawn from: spherical
@@ -348,6 +527,7 @@ impl<'a> PointSampler<'a> {
                 material: *material,
                 view: v,
                 ltc,
+                p_diffuse: diffuse_pick(material, v.z),
             },
             blockers,
         })
@@ -361,6 +541,13 @@ impl<'a> PointSampler<'a> {
     /// The BRDF times the cosine for the direction `l` in the shading frame.
     pub(crate) fn brdf(&self, l: DVec3) -> DVec3 {
         self.brdf.eval(l)
+    }
+
+    /// A direction in the shading frame drawn from the BRDF ([`Techniques::LightAndBrdf`]), and
+    /// the density it was drawn with.
+    fn brdf_sample(&self, u: DVec2, pick: f64) -> (DVec3, f64) {
+        let l = self.brdf.sample(u, pick);
+        (l, self.brdf.pdf(l))
     }
 
     /// Fills `out` with the directions of light `light` to sample by `sampling` (see
@@ -415,16 +602,20 @@ impl<'a> PointSampler<'a> {
         Ok(())
     }
 
-    /// Whether triangle `i` of light `light`'s mesh `mesh` emits towards the shading point: it
-    /// faces the point, or the light is two-sided ([`super::Light::two_sided`]) and the point is
-    /// behind it; a point in its plane sees it edge-on and gets nothing.
+    /// Whether triangle `i` of light `light`'s mesh `mesh` emits towards the shading point, by
+    /// the facing predicate the analytic path decides it with ([`face_side`]): the point is in
+    /// front of it, or behind it and the light is two-sided ([`super::Light::two_sided`]). A
+    /// point within the predicate's tolerance of the triangle's plane sees it edge-on and gets
+    /// nothing from it, as on the analytic path (a point on a box's top face `2e-16` below a
+    /// sheet light facing down is in the sheet's plane; by the sign alone the reference counted
+    /// the whole sheet there, 0.22 where the analytic value is 0).
     ///
-    /// The facing predicate ([`face_side`]) is the analytic path's on purpose. Which side of a
-    /// face a point within rounding of its plane is on is a convention of the model (like the
-    /// opacity model, which [`hits_before`] shares for the same reason), not something the
-    /// reference could check: the face covers a solid angle of the order of the tolerance
-    /// there. What the reference checks independently is the rest: which directions reach the
-    /// light (its own ray casts) and what they carry (sampling, the BRDF).
+    /// The facing predicate is the analytic path's on purpose. Which side of a face a point
+    /// within rounding of its plane is on is a convention of the model (like the opacity model,
+    /// which [`hits_before`] shares for the same reason), not something the reference could
+    /// check: the face covers a solid angle of the order of the tolerance there. What the
+    /// reference checks independently is the rest: which directions reach the light (its own
+    /// ray casts) and what they carry (sampling, the BRDF).
     fn emits_towards(&self, light: usize, mesh: &TriangleMesh, i: usize) -> bool {
         match face_side(mesh, i, self.frame.origin()) {
             Side::Front => true,
@@ -499,43 +690,56 @@ impl<'a> PointSampler<'a> {
         }
     }
 
-    /// A direction `w` (world) sampled in light `light`'s unoccluded region.
+    /// A direction `w` (world) sampled in light `light`'s unoccluded region: traced as any
+    /// direction is ([`Self::trace_light`]), so a region larger than the light only wastes
+    /// samples.
     fn trace_region(&self, light: usize, w: DVec3) -> Outcome {
+        self.trace_light(light, w).1
+    }
+
+    /// What the ray from the shading point along `w` (world) finds of light `light`: the light
+    /// triangle it meets first (within [`LIGHT_HIT_SLACK`], triangles seen edge-on skipped) if
+    /// that one emits towards the point, and whether another object hides it. The light's own
+    /// nearer triangles hide farther ones; a ray that meets none of its triangles, or meets one
+    /// that does not emit towards the point first (a back face, the inside of a closed light),
+    /// is a [`Outcome::Miss`].
+    fn trace_light(&self, light: usize, w: DVec3) -> (Option<usize>, Outcome) {
         let x = self.frame.origin();
-        let body = self.scene.lights()[light].shape();
-        let mesh = body.mesh();
-        // A non-planar mesh light is traced to its nearest triangle first (which must face x);
-        // convex and planar lights only when another object's bounding sphere is on the ray.
-        let mut t_light = None;
-        if matches!(body, Body::Mesh(_)) && !mesh.is_planar() {
-            match nearest_front_hit(x, w, mesh) {
-                Some(t) => t_light = Some(t),
-                None => return Outcome::Miss,
-            }
-        }
-        let bound = mesh.bounding_sphere();
-        let t_far = t_light.unwrap_or_else(|| (bound.center - x).length() + bound.radius);
-        let own = self.scene.occluders().len() + light;
-        let candidate = self
-            .blockers
-            .iter()
-            .enumerate()
-            .any(|(j, (_, b))| j != own && ray_meets_sphere(x, w, b.center, b.radius, t_far));
-        if !candidate {
-            return Outcome::Visible;
-        }
-        let t_light = match t_light {
-            Some(t) => t,
-            None => match entry_distance(x, w, body, self.scene.lights()[light].is_two_sided()) {
-                Some(t) => t,
-                None => return Outcome::Miss,
-            },
+        let mesh = self.scene.lights()[light].shape().mesh();
+        let Some((t, j)) = nearest_hit(x, w, mesh) else {
+            return (None, Outcome::Miss);
         };
-        if self.blocked(light, w, t_light) {
-            Outcome::Blocked
-        } else {
-            Outcome::Visible
+        if !self.emits_towards(light, mesh, j) {
+            return (Some(j), Outcome::Miss);
         }
+        if self.blocked(light, w, t) {
+            (Some(j), Outcome::Blocked)
+        } else {
+            (Some(j), Outcome::Visible)
+        }
+    }
+
+    /// Traces a direction `l` (shading frame) drawn from the BRDF towards light `light`
+    /// ([`Self::trace_light`]): what it finds, and the density with which the light technique
+    /// over `domain` draws that direction (for the balance heuristic): `1 / domain.total()`
+    /// inside a region's triangulation ([`LightSampling::Silhouette`]), or where the triangle
+    /// the ray meets is one of the domain's faces ([`LightSampling::Faces`]: the light technique
+    /// reaches a direction only through the projection of the triangle it meets first), and
+    /// zero elsewhere (outside a region, or on a face whose projection could not be built).
+    fn trace_brdf(&self, light: usize, domain: &LightDomain, l: DVec3) -> (f64, Outcome) {
+        if l.z <= 0.0 {
+            return (0.0, Outcome::Miss);
+        }
+        let (face, outcome) = self.trace_light(light, self.frame.dir_to_world(l));
+        if outcome != Outcome::Visible || domain.is_empty() {
+            return (0.0, outcome);
+        }
+        let drawn = if domain.local {
+            domain.tris.iter().any(|t| spherical_triangle_holds(t, l))
+        } else {
+            face.is_some_and(|j| domain.faces.contains(&j))
+        };
+        (if drawn { 1.0 / domain.total() } else { 0.0 }, outcome)
     }
 
     /// Whether another object than light `light` has a triangle on the ray from the shading
@@ -566,10 +770,10 @@ fn hits_before(x: DVec3, w: DVec3, m: &TriangleMesh, skip: Option<usize>, t_max:
     })
 }
 
-/// The distance along `w` from `x` to the nearest triangle of `mesh`, if the ray meets one and
-/// that one faces `x` (the emitting side). Triangles seen edge-on from `x` are skipped, as in
-/// [`hits_before`].
-fn nearest_front_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<f64> {
+/// The distance along `w` from `x` to the nearest triangle of `mesh` the ray meets (within
+/// [`LIGHT_HIT_SLACK`]), and that triangle's index. Triangles seen edge-on from `x` are skipped,
+/// as in [`hits_before`].
+fn nearest_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<(f64, usize)> {
     let mut best: Option<(f64, usize)> = None;
     for j in 0..mesh.triangle_count() {
         if let Some(t) = ray_triangle(x, w, mesh.triangle(j), LIGHT_HIT_SLACK)
@@ -579,30 +783,15 @@ fn nearest_front_hit(x: DVec3, w: DVec3, mesh: &TriangleMesh) -> Option<f64> {
             best = Some((t, j));
         }
     }
-    let (t, j) = best?;
-    (mesh.triangle_normal(j).dot(w) < 0.0).then_some(t)
+    best
 }
 
-/// The distance along `w` from `x` (outside the light) at which the ray enters a convex or
-/// planar light, for a direction known to lie in its region: for a convex light the largest
-/// distance to a face plane the ray enters through (the entry point of an intersection of
-/// half-spaces; no edge test, so directions on the silhouette's rim still get their distance),
-/// for a planar one the distance to its plane from the front side (from either side for a
-/// two-sided light).
-fn entry_distance(x: DVec3, w: DVec3, body: &Body, two_sided: bool) -> Option<f64> {
-    let mesh = body.mesh();
-    let plane_t = |j: usize| {
-        let n = mesh.triangle_normal(j);
-        let den = n.dot(w);
-        (den < 0.0 || (two_sided && den > 0.0)).then(|| n.dot(mesh.triangle(j)[0] - x) / den)
-    };
-    let t = match body {
-        Body::Convex(_) => (0..mesh.triangle_count())
-            .filter_map(plane_t)
-            .fold(f64::NEG_INFINITY, f64::max),
-        Body::Mesh(_) | Body::Bezier(_) => plane_t(0)?,
-    };
-    (t > 0.0 && t.is_finite()).then_some(t)
+/// Whether the spherical triangle `t` (minor-arc edges, positive orientation: the intersection
+/// of the three half-spaces on the left of its edges) holds the direction `l`, boundary
+/// included.
+fn spherical_triangle_holds(t: &SphericalTriangle, l: DVec3) -> bool {
+    let [a, b, c] = t.vertices();
+    a.cross(b).dot(l) >= 0.0 && b.cross(c).dot(l) >= 0.0 && c.cross(a).dot(l) >= 0.0
 }
 
 impl MonteCarlo {
@@ -614,7 +803,16 @@ impl MonteCarlo {
             samples_per_light,
             brdf,
             sampling: LightSampling::Silhouette,
+            techniques: Techniques::Light,
         }
+    }
+
+    /// The same settings sampling the BRDF too, combined with the light samples by multiple
+    /// importance sampling ([`Techniques::LightAndBrdf`]): for glossy lobes of any width.
+    #[must_use]
+    pub fn with_brdf_sampling(mut self) -> Self {
+        self.techniques = Techniques::LightAndBrdf;
+        self
     }
 
     /// The same settings drawing directions by `sampling`.
@@ -646,26 +844,46 @@ impl MonteCarlo {
         let mut mean = DVec3::ZERO;
         let mut var = DVec3::ZERO;
         let mut domain = LightDomain::default();
+        let mut bound = DVec3::ZERO;
         for (li, light) in scene.lights().iter().enumerate() {
             if let Body::Bezier(shape) = light.shape() {
                 let two = light.is_two_sided();
                 let (m, s2) = super::curved_reference::estimate(&ps, li, shape, two, n, &mut rng);
                 mean += m * light.radiance();
                 var += s2 * light.radiance() * light.radiance();
+                bound = DVec3::INFINITY;
                 continue;
             }
             ps.domain(li, self.sampling, &mut domain);
-            if domain.is_empty() {
+            let mis = self.techniques == Techniques::LightAndBrdf;
+            if domain.is_empty() && !mis {
                 continue;
             }
             let total = domain.total();
             let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
             for _ in 0..n {
-                let (l, outcome) = ps.trace(li, &domain, rng.next_2d());
-                if outcome != Outcome::Visible {
-                    continue;
+                // One sample of each technique per step; with the balance heuristic
+                // (Vea97 eq. 9.6, one sample per technique) either contributes
+                // f / (p_light + p_brdf), and their sum is one independent, unbiased sample of
+                // the light's integral, so the steps' spread gives the standard error.
+                let mut f = DVec3::ZERO;
+                if !domain.is_empty() {
+                    let (l, outcome) = ps.trace(li, &domain, rng.next_2d());
+                    if outcome == Outcome::Visible {
+                        f += if mis {
+                            ps.brdf(l) * light.radiance() / (1.0 / total + ps.brdf.pdf(l))
+                        } else {
+                            ps.brdf(l) * light.radiance() * total
+                        };
+                    }
                 }
-                let f = ps.brdf(l) * light.radiance() * total;
+                if mis {
+                    let (l, p_brdf) = ps.brdf_sample(rng.next_2d(), rng.next_f64());
+                    let (p_light, outcome) = ps.trace_brdf(li, &domain, l);
+                    if outcome == Outcome::Visible && p_brdf + p_light > 0.0 {
+                        f += ps.brdf(l) * light.radiance() / (p_brdf + p_light);
+                    }
+                }
                 sum += f;
                 sum2 += f * f;
             }
@@ -679,10 +897,23 @@ impl MonteCarlo {
             };
             mean += m;
             var += s2 / nf;
+            // One step: each technique's term is at most f / p_brdf; light sampling alone gives
+            // f * total, bounded for the Lambertian lobe (f <= albedo / pi).
+            bound += if mis {
+                2.0 * ps.brdf.ratio_bound() * light.radiance()
+            } else if ps.brdf.ltc.is_none()
+                && !(ps.brdf.kind == ReferenceBrdf::True && material.has_specular())
+            {
+                material.albedo() * light.radiance() * (total / core::f64::consts::PI)
+            } else {
+                DVec3::INFINITY
+            };
         }
         Ok(Estimate {
             mean,
             std_error: DVec3::new(sqrt(var.x), sqrt(var.y), sqrt(var.z)),
+            samples: n,
+            sample_bound: bound,
         })
     }
 }

@@ -533,14 +533,21 @@ fn edge_adjacency(triangles: &[[u32; 3]]) -> (Vec<MeshEdge>, bool) {
 
 /// Unit normal of the triangle `(a, b, c)` (counter-clockwise seen from the side it points to),
 /// or `None` when the triangle is degenerate in the sense of [`DEGENERATE_TRIANGLE`].
+///
+/// The normal is the direction of the exact cross product `(b - a) x (c - a)` of the given
+/// vertices, rounded ([`accurate_cross`]), so its error is a few ulps whatever the triangle's
+/// shape. A plain floating-point cross product errs by a few `1e-16` of the squared edge
+/// length, which for a sliver (twice its area `1e-12` of its squared longest edge) turns the
+/// normal by up to `1e-4` rad: a point interpolated on the sliver then lay `5e-5` of its size
+/// in front of its plane by the facing predicate, far outside the predicate's tolerance, and
+/// the sliver covered a hemisphere seen from a point on it.
 fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
     let (e0, e1, e2) = (b - a, c - b, a - c);
     let longest2 = e0
         .length_squared()
         .max(e1.length_squared())
         .max(e2.length_squared());
-    // The cross product of the two edges adjacent to the largest angle is the best conditioned.
-    let n = e0.cross(-e2);
+    let n = accurate_cross(a, b, c);
     let len = n.length();
     if len.is_nan() || len <= DEGENERATE_TRIANGLE * longest2 || !len.is_finite() {
         return None;
@@ -548,11 +555,126 @@ fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
     Some(n / len)
 }
 
+/// `a + b` as the unevaluated sum `s + e` with `s = fl(a + b)` (Knuth's TwoSum).
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// `a` split into two halves of 26 significant bits each, `a = hi + lo` (Veltkamp).
+#[inline]
+fn split(a: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * a; // 2^27 + 1
+    let hi = c - (c - a);
+    (hi, a - hi)
+}
+
+/// `a * b` as the unevaluated sum `p + e` exactly (Dekker's TwoProduct; exact while nothing
+/// overflows or underflows, which mesh coordinates up to [`MAX_MESH_COORD`] guarantee for
+/// products of coordinate differences above about `1e-150`).
+#[inline]
+fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    let (ah, al) = split(a);
+    let (bh, bl) = split(b);
+    (p, al * bl - (((p - ah * bh) - al * bh) - ah * bl))
+}
+
+/// `u * v - w * x` for coordinate differences given exactly as unevaluated sums `(hi, lo)`,
+/// accurate to about one ulp of the result: the sixteen partial products are exact
+/// (`two_prod`), and their sum is taken as in twice the working precision (Ogita, Rump and
+/// Oishi 2005, algorithm Sum2: error at most `eps |sum| + gamma_15^2 sum |terms|`, so `1e-29`
+/// of the squared edge length at most, against results of at least `1e-12` of it for the
+/// triangles [`DEGENERATE_TRIANGLE`] accepts).
+fn exact_2x2(u: (f64, f64), v: (f64, f64), w: (f64, f64), x: (f64, f64)) -> f64 {
+    let mut s = 0.0;
+    let mut err = 0.0;
+    let mut add = |t: f64| {
+        let (ns, e) = two_sum(s, t);
+        s = ns;
+        err += e;
+    };
+    for (p, q, sign) in [(u, v, 1.0), (w, x, -1.0)] {
+        for a in [p.0, p.1] {
+            for b in [q.0, q.1] {
+                let (h, l) = two_prod(a, b);
+                add(sign * h);
+                add(sign * l);
+            }
+        }
+    }
+    s + err
+}
+
+/// The cross product `(b - a) x (c - a)` of the exact differences of the given coordinates,
+/// each component rounded from its exact value to within about one ulp ([`exact_2x2`]): the
+/// normal of the triangle the vertices define, accurate however thin it is.
+fn accurate_cross(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let d = |p: f64, q: f64| two_sum(p, -q);
+    let (e0x, e0y, e0z) = (d(b.x, a.x), d(b.y, a.y), d(b.z, a.z));
+    let (e2x, e2y, e2z) = (d(c.x, a.x), d(c.y, a.y), d(c.z, a.z));
+    DVec3::new(
+        exact_2x2(e0y, e2z, e0z, e2y),
+        exact_2x2(e0z, e2x, e0x, e2z),
+        exact_2x2(e0x, e2y, e0y, e2x),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::solid::ConvexPolyhedron;
     use alloc::vec;
+
+    /// Slivers with integer coordinates times `2^-40` (so that the exact cross product is an
+    /// `i128` computation), one vertex `1e-12..1e-4` of the length off the line of the others:
+    /// the mesh's normal is the exact one to a few ulps, where the plain cross product is off
+    /// by up to `1e-4`.
+    #[test]
+    fn sliver_normals_are_exact_to_a_few_ulps() {
+        let mut state = 0x5EED_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let unit = (-40f64).exp2();
+        let mut worst_plain = 0f64;
+        for k in 0..2000 {
+            let mut p = || {
+                [next(), next(), next()].map(|u| ((u - 0.5) * (1u64 << 41) as f64).round() as i64)
+            };
+            let (a, b) = (p(), p());
+            // The third vertex on the segment, moved off it by a relative 1e-12..1e-4.
+            let t = next();
+            let off = 10f64.powf(-12.0 + 8.0 * (k as f64 / 2000.0));
+            let len = ((0..3).map(|i| ((b[i] - a[i]) as f64).powi(2)).sum::<f64>()).sqrt();
+            let dir = [next() - 0.5, next() - 0.5, next() - 0.5];
+            let c: [i64; 3] = core::array::from_fn(|i| {
+                (a[i] as f64 + t * (b[i] - a[i]) as f64 + dir[i] * off * len).round() as i64
+            });
+            let e0: [i128; 3] = core::array::from_fn(|i| i128::from(b[i] - a[i]));
+            let e2: [i128; 3] = core::array::from_fn(|i| i128::from(c[i] - a[i]));
+            let exact = [
+                e0[1] * e2[2] - e0[2] * e2[1],
+                e0[2] * e2[0] - e0[0] * e2[2],
+                e0[0] * e2[1] - e0[1] * e2[0],
+            ];
+            let to = |v: [i64; 3]| DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64) * unit;
+            let Some(n) = triangle_normal(to(a), to(b), to(c)) else {
+                continue;
+            };
+            let want = DVec3::new(exact[0] as f64, exact[1] as f64, exact[2] as f64).normalize();
+            assert!((n - want).length() < 1e-15, "{k}: {n} vs {want}");
+            let plain = (to(b) - to(a)).cross(to(c) - to(a)).normalize();
+            worst_plain = worst_plain.max((plain - want).length());
+        }
+        // The test can fail: the plain cross product misses by far more.
+        assert!(worst_plain > 1e-6, "{worst_plain}");
+    }
 
     #[test]
     fn closedness() {

@@ -1,5 +1,6 @@
-//! Configurations of the spherical boolean met by the shading layer's per-triangle path (over
-//! 3000 ground points of the demo scene) that the `sphere` layer must handle: repeated directions
+//! Regressions of the `sphere` layer found through the shading layer: spherical booleans and
+//! horizon clips that the per-triangle path met (over 3000 ground points of the demo scene, and
+//! in the `shade` fuzz target) and that once failed or gave wrong results. Repeated directions
 //! after unprojection must be dropped, and a planar failure in one projection must be retried
 //! through the octant split. Each is checked by an identity of areas (difference plus
 //! intersection, inclusion-exclusion).

@@ -1,0 +1,387 @@
+//! Issue 24's sphere-layer reproducers 1, 5 and 8 (sphere part), each checked against a value
+//! computed independently of the code under test: a closed form, an exact identity, or
+//! Van Oosterom-Strackee areas of the input triangles. (Reproducer 4 and the minimized failures
+//! of the sphere generators, some checked against i_overlay, are in
+//! compare/tests/sphere_robust.rs, run by `cargo test -p arealight-compare`.)
+
+mod support;
+
+use arealight::glam::DVec3;
+use arealight::sphere::SphericalPolygon;
+
+fn v(x: f64, y: f64, z: f64) -> DVec3 {
+    DVec3::new(x, y, z)
+}
+
+/// Issue 24, reproducer 1: a triangle with one vertex `h = 1e-13` above the horizon and two
+/// below. The part above is the tiny triangle cut off near the apex; in the gnomonic plane about
+/// `+x` (great circles are lines, the horizon is the line `t = 0`) it has the apex `(0, h)` and
+/// its base on `t = 0` at `y = +-0.3 h / (0.3 + h)`, so its planar area is
+/// `A = 0.3 h^2 / (0.3 + h)`. Its solid angle is the integral of `(1 + r^2)^-3/2` over it, within
+/// `1.5 r^2 < 1e-25` (relative) of `A`; its clamped-cosine integral is `(1/pi)` times the
+/// integral of `t / (1 + r^2)^2`, within as little of `A * (h / 3) / pi` (the centroid's height).
+/// Before the fix the clip returned the whole upper hemisphere (2 pi) and the integral was 1.
+#[test]
+fn issue24_repro1_vertex_just_above_the_horizon() {
+    for h in [1e-13, 3e-14, 1.5e-14, 2e-13, 1e-12] {
+        let p = SphericalPolygon::new(vec![vec![
+            v(1.0, 0.0, h),
+            v(1.0, -0.3, -0.3),
+            v(1.0, 0.3, -0.3),
+        ]])
+        .unwrap();
+        let clipped = p.clip_to_hemisphere(DVec3::Z);
+        let area = 0.3 * h * h / (0.3 + h);
+        let w = clipped.solid_angle();
+        assert!(
+            (w - area).abs() <= 1e-6 * area,
+            "h = {h:e}: {w:e} sr vs {area:e}"
+        );
+        // The integral is far below what its sum of edge terms can resolve (about 1e-16 per
+        // term): the check is that it is that small, not 1.
+        let expect = area * (h / 3.0) / std::f64::consts::PI;
+        for cc in [
+            arealight::ltc::clamped_cosine_integral(&p),
+            arealight::ltc::clamped_cosine_integral(&clipped),
+        ] {
+            assert!(
+                (cc - expect).abs() <= 1e-15,
+                "h = {h:e}: {cc:e} vs {expect:e}"
+            );
+        }
+    }
+}
+
+/// Issue 24, reproducer 5: B is A with vertex 1 moved by 2e-12 (inside A). A - B is the sliver
+/// between the two paths a0 -> a1 -> a2 and a0 -> b1 -> a2, of area
+/// `area(a0, a1, a2) - area(a0, b1, a2)` (about 9e-13 sr) over a perimeter of about 3.5 rad:
+/// thinner than validation's ZeroArea limit, and the boolean's resolution (it welds vertex
+/// copies 1e-11 apart) makes B equal to A. The result used to be a ring that `new` rejected as
+/// SelfIntersecting (a 4e-13 rad wedge at a2). Whatever the result, it must be a valid input,
+/// and within the documented resolution of the exact sliver.
+#[test]
+fn issue24_repro5_difference_of_a_polygon_and_its_jittered_copy() {
+    use arealight::planar::BoolOp;
+    let a = vec![
+        v(0.10233659699160604, 0.25398986142578966, 0.9617777140322425),
+        v(0.39331240650366617, 0.7847612292732739, 0.4790147846567948),
+        v(-0.3058421822761067, 0.8568233840972002, 0.4151075137898743),
+    ];
+    let mut b = a.clone();
+    b[1] = v(0.3933124065018691, 0.7847612292738442, 0.47901478465733544);
+    let (pa, pb) = (
+        SphericalPolygon::new(vec![a.clone()]).unwrap(),
+        SphericalPolygon::new(vec![b.clone()]).unwrap(),
+    );
+    // The exact sliver, by Van Oosterom-Strackee on the two triangles sharing a0 and a2.
+    let tri = |p: DVec3, q: DVec3, r: DVec3| {
+        let (p, q, r) = (p.normalize(), q.normalize(), r.normalize());
+        2.0 * p
+            .dot((q - p).cross(r - p))
+            .atan2(1.0 + p.dot(q) + q.dot(r) + r.dot(p))
+    };
+    let sliver = tri(a[0], a[1], a[2]) - tri(b[0], b[1], b[2]);
+    assert!(sliver > 0.0 && sliver < 1e-12, "{sliver:e}");
+    for op in [
+        BoolOp::Difference,
+        BoolOp::Xor,
+        BoolOp::Intersection,
+        BoolOp::Union,
+    ] {
+        let r = pa.boolean(&pb, op).unwrap();
+        r.validate()
+            .unwrap_or_else(|e| panic!("{op:?}: {e}: {r:?}"));
+        let again = SphericalPolygon::new(r.rings().map(<[DVec3]>::to_vec).collect());
+        assert!(again.is_ok(), "{op:?}: {again:?}");
+        // B lies inside A.
+        let expect = match op {
+            BoolOp::Difference | BoolOp::Xor => sliver,
+            BoolOp::Intersection => pb.solid_angle(),
+            BoolOp::Union => pa.solid_angle(),
+        };
+        // Snap rounding at 1e-11 moves edges by at most that: the area by that times their
+        // length (3.5 rad per operand).
+        assert!(
+            (r.solid_angle() - expect).abs() <= 1e-11 * 7.0,
+            "{op:?}: {:e} vs {expect:e}",
+            r.solid_angle()
+        );
+    }
+}
+
+/// Issue 24, reproducer 5: the seed's per-triangle workflow over a planar grid whose triangles
+/// carry their own copies of the shared vertices, jittered by 1e-12 (relative): a quad light
+/// minus each of the 72 triangles in turn. Used to fail with SelfIntersecting and
+/// Degenerate("edge intersections did not settle"). Every intermediate result must be a valid
+/// input, and the final one the light minus the grid's outline (exact, unjittered) up to the
+/// jitter times the edges' length.
+#[test]
+fn issue24_repro5_per_triangle_chain_over_a_jittered_grid() {
+    use arealight::planar::BoolOp;
+    let light = SphericalPolygon::new(vec![vec![
+        v(-1.0, -1.0, 3.0),
+        v(1.0, -1.0, 3.0),
+        v(1.0, 1.0, 3.0),
+        v(-1.0, 1.0, 3.0),
+    ]])
+    .unwrap();
+    // A fixed pseudo-random jitter, 1e-12 of the distance in each coordinate.
+    let mut rng = support::Rng::from_state(24);
+    let mut jitter = |p: DVec3| {
+        let mut unit = || rng.range(-1.0, 1.0);
+        p + v(unit(), unit(), unit()) * 1e-12 * p.length()
+    };
+    let k = 6;
+    let corner = |i: usize, j: usize| {
+        v(
+            -0.7 + 1.1 * i as f64 / k as f64,
+            -0.4 + 0.9 * j as f64 / k as f64,
+            1.8,
+        )
+    };
+    let mut chain = light.clone();
+    let mut edges = 0.0;
+    for i in 0..k {
+        for j in 0..k {
+            let quad = [
+                corner(i, j),
+                corner(i + 1, j),
+                corner(i + 1, j + 1),
+                corner(i, j + 1),
+            ];
+            for t in [[0, 1, 2], [0, 2, 3]] {
+                let tri: Vec<DVec3> = t.iter().map(|&c| jitter(quad[c])).collect();
+                let tri = SphericalPolygon::new(vec![tri]).unwrap();
+                edges += 3.0 * 0.2;
+                chain = chain
+                    .boolean(&tri, BoolOp::Difference)
+                    .unwrap_or_else(|e| panic!("cell ({i}, {j}): {e}"));
+                chain
+                    .validate()
+                    .unwrap_or_else(|e| panic!("cell ({i}, {j}): {e}: {chain:?}"));
+            }
+        }
+    }
+    let outline = SphericalPolygon::new(vec![vec![
+        corner(0, 0),
+        corner(k, 0),
+        corner(k, k),
+        corner(0, k),
+    ]])
+    .unwrap();
+    let expect = light
+        .boolean(&outline, BoolOp::Difference)
+        .unwrap()
+        .solid_angle();
+    let w = chain.solid_angle();
+    assert!((w - expect).abs() <= 1e-11 * edges, "{w} vs {expect}");
+}
+
+/// Issue 24, reproducer 8 (sphere part): "a spherical polygon touching itself at a vertex is
+/// accepted though the docs say it is rejected". Pinches are allowed, as ARCHITECTURE.md says
+/// (operations produce them: a hole touching its outer ring, two parts meeting at a corner);
+/// the docs now say so. A ring visiting the pole twice, with a lobe on each side, is valid and
+/// is the same region as the two lobes as separate rings sharing the pole; visits that cross at
+/// the pinch are rejected, and so is touching at a point that is a vertex of only one ring.
+#[test]
+fn issue24_repro8_pinched_ring_is_valid_and_crossing_pinch_is_not() {
+    use arealight::GeomError;
+    let c = v(0.0, 0.0, 1.0);
+    let (a1, a2) = (v(0.3, -0.1, 1.0), v(0.3, 0.1, 1.0));
+    let (b1, b2) = (v(-0.3, 0.1, 1.0), v(-0.3, -0.1, 1.0));
+    // Van Oosterom-Strackee on unit vectors: each lobe's area, independently of the crate.
+    let tri = |p: DVec3, q: DVec3, r: DVec3| {
+        let (p, q, r) = (p.normalize(), q.normalize(), r.normalize());
+        2.0 * p
+            .dot(q.cross(r))
+            .atan2(1.0 + p.dot(q) + q.dot(r) + r.dot(p))
+    };
+    let lobes = tri(c, a1, a2) + tri(c, b1, b2);
+    let pinched =
+        SphericalPolygon::new(vec![vec![c, a1, a2, c, b1, b2]]).expect("a pinch is valid");
+    pinched.validate().unwrap();
+    assert!(
+        (pinched.solid_angle() - lobes).abs() <= 1e-15,
+        "{} vs {lobes}",
+        pinched.solid_angle()
+    );
+    let two = SphericalPolygon::new(vec![vec![c, a1, a2], vec![c, b1, b2]])
+        .expect("rings sharing a vertex");
+    assert!((two.solid_angle() - lobes).abs() <= 1e-15);
+    for (q, inside) in [
+        (v(0.2, 0.0, 1.0), true),
+        (v(-0.2, 0.0, 1.0), true),
+        (v(0.0, 0.2, 1.0), false),
+        (v(0.0, -0.2, 1.0), false),
+    ] {
+        assert_eq!(pinched.contains(q), inside, "{q}");
+        assert_eq!(two.contains(q), inside, "{q}");
+    }
+    // The second lobe run the other way: the visits interleave around the pole (they cross).
+    assert!(matches!(
+        SphericalPolygon::new(vec![vec![c, a1, a2, c, b2, b1]]),
+        Err(GeomError::SelfIntersecting { .. })
+    ));
+    // A ring touching the first lobe at the midpoint of its edge a1-a2 (exactly on it: a1 + a2),
+    // which is a vertex of the touching ring only.
+    let m = a1 + a2;
+    let (d1, d2) = (v(0.6, -0.2, 1.0), v(0.6, 0.2, 1.0));
+    assert!(matches!(
+        SphericalPolygon::new(vec![vec![c, a1, a2], vec![m, d1, d2]]),
+        Err(GeomError::SelfIntersecting { .. })
+    ));
+    // The same ring touching at a2 itself (a shared vertex) is a valid pinch.
+    assert!(SphericalPolygon::new(vec![vec![c, a1, a2], vec![a2, d1, d2]]).is_ok());
+}
+
+/// Van Oosterom-Strackee: the signed solid angle of the triangle of unit vectors `p, q, r`, with
+/// the triple product taken on edge differences (accurate for tiny triangles too).
+fn triangle_area(p: DVec3, q: DVec3, r: DVec3) -> f64 {
+    let (p, q, r) = (p.normalize(), q.normalize(), r.normalize());
+    2.0 * p
+        .dot((q - p).cross(r - p))
+        .atan2(1.0 + p.dot(q) + q.dot(r) + r.dot(p))
+}
+
+/// Found by the `sphere_sliver` fuzz target (a fault of its bound, not of the operation): a
+/// triangle with a nearly antipodal edge (`pi - 0.045`), its vertex on that edge moved by
+/// `2e-9` rad. The thin triangles the move sweeps have areas `moved tan(L / 2)` for the
+/// adjacent edges of length `L`, 44 times the move for the long edge, so `A xor B` is `9.1e-8`
+/// sr, not at most `moved` times the perimeter (`1.3e-8`) as the target assumed. Checked both
+/// ways: at least the difference of the two triangles' areas, at most the swept bound.
+#[test]
+fn xor_of_a_triangle_with_a_nearly_antipodal_edge_and_its_moved_copy() {
+    use arealight::planar::BoolOp;
+    let ring = [v(22.0, -1.0, 0.0), v(1.0, 0.0, -1.0), v(-1.0, 0.0, 0.0)].map(DVec3::normalize);
+    let a = SphericalPolygon::new(vec![ring.to_vec()]).unwrap();
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = (0..3).map(|k| arc(ring[k], ring[(k + 1) % 3])).sum();
+    let moved = per / 3.0 * 1e-9;
+    let (u, _) = ring[0].any_orthonormal_pair();
+    let mut rb = ring;
+    rb[0] = (ring[0] + u * moved).normalize();
+    let b = SphericalPolygon::new(vec![rb.to_vec()]).unwrap();
+    let x = a.boolean(&b, BoolOp::Xor).unwrap().solid_angle();
+    let tan_half = |p: DVec3, q: DVec3| (p - q).length() / (p + q).length();
+    let sweep = moved * (tan_half(ring[2], ring[0]) + tan_half(ring[0], ring[1]));
+    let difference =
+        (triangle_area(ring[0], ring[1], ring[2]) - triangle_area(rb[0], rb[1], rb[2])).abs();
+    assert!(sweep > 40.0 * moved, "{sweep} vs {moved}");
+    assert!(
+        x >= difference * (1.0 - 1e-6) && x <= sweep * 1.01 + 1e-13,
+        "xor {x:e}, difference of areas {difference:e}, swept bound {sweep:e}"
+    );
+}
+
+/// Found by the `sphere_tiny` fuzz target (a fault of its expectation, not of the operation):
+/// two triangles `8e-10` rad across at antipodal points, both rings clockwise, so each polygon
+/// is the large region outside its tiny triangle. `A n not B` is then B's tiny triangle (A's
+/// outside holds it), `9.1e-16` sr, which the target expected to be A's area, `4 pi`. Checked
+/// against the tiny triangle's Van Oosterom-Strackee area.
+#[test]
+fn intersection_of_the_outsides_of_antipodal_tiny_triangles() {
+    use arealight::planar::BoolOp;
+    let c = v(-1.0, -1.0, -1.0).normalize();
+    let size = 1e-7 / 128.0;
+    let (u, w) = c.any_orthonormal_pair();
+    let ring = |center: DVec3, pts: &[(f64, f64)], off: (f64, f64)| -> Vec<DVec3> {
+        let (u, w) = if center.dot(c) < 0.0 { (u, -w) } else { (u, w) };
+        pts.iter()
+            .map(|&(x, y)| (center + (u * (x + off.0) + w * (y + off.1)) * size).normalize())
+            .collect()
+    };
+    let ra = ring(c, &[(65.0, -69.0), (0.0, 65.0), (33.0, 0.0)], (0.0, 0.0));
+    let rb = ring(-c, &[(0.0, 47.0), (1.0, 0.0), (-64.0, 65.0)], (47.0, 1.0));
+    let (a, b) = (
+        SphericalPolygon::new(vec![ra.clone()]).unwrap(),
+        SphericalPolygon::new(vec![rb.clone()]).unwrap(),
+    );
+    let (ta, tb) = (
+        triangle_area(ra[0], ra[1], ra[2]),
+        triangle_area(rb[0], rb[1], rb[2]),
+    );
+    // Both rings clockwise: each polygon is the outside of its triangle.
+    assert!(ta < 0.0 && tb < 0.0, "{ta:e} {tb:e}");
+    let got = a
+        .boolean(&b.complement(), BoolOp::Intersection)
+        .unwrap()
+        .solid_angle();
+    assert!(
+        (got + tb).abs() <= 1e-6 * tb.abs(),
+        "{got:e} vs the tiny triangle's {:e}",
+        -tb
+    );
+}
+
+/// Found by the `sphere_tiny` fuzz target with the issue's bounds: a triangle and a hexagon
+/// about `1e-10` rad across (the low end of the issue's tiny range), the triangle's ring
+/// clockwise (so `A` is everything but it). `A n B` (B less the triangle, `7.5e-21` sr) comes
+/// back as a ring that crosses itself: an output that is not a valid input. Fails today; the
+/// sphere layer's booleans lose validity when the result's vertices, rounded to unit vectors
+/// (`1e-16` absolute), are `1e-6` of the polygon's size apart.
+#[test]
+#[ignore = "sphere layer: booleans of polygons 1e-10 rad across can return self-crossing rings"]
+fn intersection_of_tiny_polygons_is_a_valid_polygon() {
+    use arealight::planar::BoolOp;
+    let c = v(127.0, -1.0, 65.0).normalize();
+    let size = 1e-10 / 128.0;
+    let (u, w) = c.any_orthonormal_pair();
+    let ring = |pts: &[(f64, f64)]| -> Vec<DVec3> {
+        pts.iter()
+            .map(|&(x, y)| (c + (u * x + w * y) * size).normalize())
+            .collect()
+    };
+    let a = SphericalPolygon::new(vec![ring(&[(11., 45.), (-63., -1.), (-81., -1.)])]).unwrap();
+    let b = SphericalPolygon::new(vec![ring(&[
+        (4., -116.),
+        (43., 65.),
+        (-117., -1.),
+        (-1., 10.),
+        (-1., -1.),
+        (-119., -1.),
+    ])])
+    .unwrap();
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        let r = p.boolean(q, BoolOp::Intersection).unwrap();
+        r.validate().unwrap_or_else(|e| panic!("{e}: {r:?}"));
+    }
+}
+
+/// Found by the `sphere_sliver` fuzz target once its identities were checked at the issue's
+/// `1e-10 * 4 pi` (they were at `1e-9 * 4 pi`): a triangle larger than a hemisphere with a
+/// nearly antipodal edge (`|a + b| = 0.0137`), and its copy with that edge's vertex moved by
+/// `2.1e-9`. `A - B` comes back empty and `A n B` `1.7e-9` sr short of `A`: the sliver between
+/// the two near-antipodal edges, a lever of `2 / |a + b| = 146` on the move, is lost.
+/// `area(A - B) + area(A n B) = area(A)` misses by `1.4` times the bound. Fails today.
+#[test]
+#[ignore = "sphere layer: set identities near nearly antipodal edges miss 1e-10 * 4 pi"]
+fn difference_identity_next_to_a_nearly_antipodal_edge() {
+    use arealight::planar::BoolOp;
+    let a = SphericalPolygon::new(vec![vec![
+        v(
+            0.013728934738115898,
+            -0.7070401390129688,
+            -0.7070401390129688,
+        ),
+        v(0.0, 0.7071067811865475, 0.7071067811865475),
+        v(-0.36439934858051226, 0.9312427797057535, 0.0),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(
+            0.013728936829898225,
+            -0.7070401390010729,
+            -0.7070401389842478,
+        ),
+        v(0.0, 0.7071067811865475, 0.7071067811865475),
+        v(-0.36439934858051226, 0.9312427797057535, 0.0),
+    ]])
+    .unwrap();
+    let d = a.boolean(&b, BoolOp::Difference).unwrap().solid_angle();
+    let i = a.boolean(&b, BoolOp::Intersection).unwrap().solid_angle();
+    let wa = a.solid_angle();
+    assert!(
+        (d + i - wa).abs() <= 1e-10 * 4.0 * std::f64::consts::PI,
+        "{d} + {i} vs {wa}"
+    );
+}
