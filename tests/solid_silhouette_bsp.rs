@@ -14,13 +14,14 @@ mod support;
 use arealight::GeomError;
 use arealight::glam::{DMat3, DQuat, DVec3};
 use arealight::internals::{
-    bumpy_sphere, convex_silhouette, extruded_star, thesis_polyhedra, torus,
+    bumpy_sphere, convex_silhouette, convex_silhouette_rings, extruded_star, thesis_polyhedra,
+    torus,
 };
 use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::solid::{
-    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, SilhouetteSampler, TriangleMesh,
-    TriangleSource, nonconvex_silhouette,
+    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, SilhouetteRings, SilhouetteSampler,
+    TriangleMesh, TriangleSource, nonconvex_silhouette,
 };
 use arealight::sphere::{SphericalPolygon, SphericalTriangle};
 use robust::orient3d;
@@ -116,14 +117,56 @@ fn same_set(a: &SphericalPolygon, b: &SphericalPolygon, rng: &mut Rng) -> bool {
     }
 }
 
+/// Whether `r` and `p` have the same rings and their vertices, once normalized, the same
+/// directions within rounding (`1e-15`: a vertex of `p` may be normalized twice).
+fn same_vertices(r: &SilhouetteRings, p: &SphericalPolygon) -> bool {
+    r.is_full() == p.is_full()
+        && r.ring_count() == p.ring_count()
+        && r.rings().zip(p.rings()).all(|(a, b)| {
+            a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(u, v)| (u.normalize() - *v).length() <= 1e-15)
+        })
+}
+
+/// The ring forms of the query and of the convex silhouette (vertices not normalized, for the
+/// clip-free integrals) give the same rings as the polygon forms, vertex for vertex once
+/// normalized, and fail where they fail.
+fn check_rings(
+    bsp: &SilhouetteBsp,
+    solid: &ClosedMesh,
+    frame: &ShadingFrame,
+    rings: &mut SilhouetteRings,
+) {
+    let x = frame.origin();
+    match (bsp.query(frame), bsp.query_rings(frame, rings)) {
+        (Ok(q), Ok(())) => assert!(same_vertices(rings, &q), "x {x}: {rings:?} vs {q:?}"),
+        (Err(a), Err(b)) => assert_eq!(a, b, "x {x}"),
+        (q, r) => panic!("x {x}: query {q:?}, query_rings {r:?}"),
+    }
+    if let Ok(p) = ConvexPolyhedron::from_mesh(solid.mesh()) {
+        match (
+            convex_silhouette(&p, frame),
+            convex_silhouette_rings(&p, frame, rings),
+        ) {
+            (Ok(q), Ok(())) => assert!(same_vertices(rings, &q), "x {x}: {rings:?} vs {q:?}"),
+            (Err(a), Err(b)) => assert_eq!(a, b, "x {x}"),
+            (q, r) => panic!("x {x}: convex {q:?}, rings {r:?}"),
+        }
+    }
+}
+
 fn check_solid(name: &str, solid: &ClosedMesh, rng: &mut Rng, n: usize) -> (usize, usize) {
     let mesh = solid.mesh();
     let bsp = SilhouetteBsp::build(solid).unwrap();
     assert!(bsp.leaf_count() > 1 && bsp.node_count() == 2 * bsp.leaf_count() - 1);
     let (mut checked, mut gave_up) = (0, 0);
+    let mut rings = SilhouetteRings::new();
     for _ in 0..n {
         let x = sample(&bsp, mesh, rng);
         let frame = ShadingFrame::new(x, DVec3::Z, DVec3::new(0.2, 0.1, 1.0)).unwrap();
+        check_rings(&bsp, solid, &frame, &mut rings);
         match (bsp.query(&frame), direct(solid, &frame)) {
             (Ok(q), Ok(d)) => {
                 let same = same_set(&q, &d, rng);

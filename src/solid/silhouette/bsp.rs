@@ -62,8 +62,9 @@ use smallvec::SmallVec;
 
 use super::convex::chain_by_index;
 use super::nonconvex::{
-    Arc, ORDER_ERROR, Outline, collinear, evaluate_rings, outline, outline_with,
+    Arc, ORDER_ERROR, Outline, collinear, evaluate_rings_into, outline, outline_with,
 };
+use super::rings::{SilhouetteRings, spaced};
 use super::triangulated::{
     CellCorners, Extra, OnFace, SNAP_REL, TriangleSource, certified_triangulation, evaluate_stored,
     fan_or_list, raw_stored,
@@ -152,6 +153,9 @@ impl Source {
 pub struct SilhouetteBsp {
     source: Source,
     planes: Vec<SplitPlane>,
+    /// The leading face planes of `planes` as unit normal and offset from the bounding sphere's
+    /// center (the facing predicate's form), read by the descent without a dispatch.
+    face_eqs: Vec<(DVec3, f64)>,
     nodes: Vec<u32>,
     /// Bits of an inner node word that hold the right child's index; the plane index is above.
     child_bits: u32,
@@ -309,7 +313,7 @@ impl SilhouetteBsp {
         let Some(leaf) = self.leaf_of(x, matches!(self.source, Source::Solid(_))) else {
             return self.direct(frame);
         };
-        let mut at = leaf as usize;
+        let at = leaf as usize;
         match &self.source {
             Source::Convex(poly) => match self.convex_loop(poly, at, frame) {
                 Some(out) => {
@@ -320,34 +324,149 @@ impl SilhouetteBsp {
             },
             Source::Solid(solid) => {
                 let header = self.read(at);
-                at += 1;
                 match header {
                     EMPTY => Ok(SphericalPolygon::empty()),
                     FULL => Ok(SphericalPolygon::full()),
                     DIRECT => nonconvex_silhouette(solid, frame),
                     _ => {
-                        let (arcs, ends) = self.read_rings(header, &mut at);
-                        let rings = evaluate_rings(solid.mesh(), &arcs, &ends, frame)?;
-                        let mut verts: SmallVec<[DVec3; 12]> = SmallVec::new();
-                        let mut ring_ends: SmallVec<[u32; 2]> = SmallVec::new();
-                        for r in &rings {
-                            let n = r.len();
-                            let ok = n >= 3
-                                && (0..n).all(|k| {
-                                    let (a, b) = (r[k], r[(k + 1) % n]);
-                                    (a - b).length() > COINCIDENT_TOLERANCE
-                                        && (a + b).length() > ANTIPODAL_TOLERANCE
-                                });
-                            if !ok {
-                                return Err(GeomError::Undecidable(GIVE_UP_QUERY));
-                            }
-                            verts.extend_from_slice(r);
-                            ring_ends.push(verts.len() as u32);
-                        }
-                        Ok(SphericalPolygon::from_parts(verts, ring_ends))
+                        let mut out = SilhouetteRings::new();
+                        self.solid_rings(solid, at, frame, &mut out)?;
+                        // Unit vectors, and the checks `solid_rings` made.
+                        Ok(out.into_polygon_unchecked())
                     }
                 }
             }
+        }
+    }
+
+    /// [`SilhouetteBsp::query`] written to `out` as rings of directions that need not be unit
+    /// vectors ([`SilhouetteRings`]), for the clip-free integrals
+    /// ([`clamped_cosine_integral_rings`](crate::ltc::clamped_cosine_integral_rings),
+    /// [`ltc_integral_rings`](crate::ltc::ltc_integral_rings)), which need none: for a convex
+    /// polyhedron the stored loop's vertices in the local frame as they are (no normalization;
+    /// the spacing test decided as the query decides it), for a closed non-convex mesh the
+    /// query's rings; where the query answers with the direct algorithm, a copy of its polygon's
+    /// rings. The same region as [`SilhouetteBsp::query`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::internals::thesis_polyhedra;
+    /// use arealight::ltc::{clamped_cosine_integral, clamped_cosine_integral_rings};
+    /// use arealight::solid::{ClosedMesh, ShadingFrame, SilhouetteBsp, SilhouetteRings};
+    /// let (_, bowl) = thesis_polyhedra()?.pop().unwrap();
+    /// let bsp = SilhouetteBsp::build(&ClosedMesh::new(bowl)?)?;
+    /// let frame = ShadingFrame::new(DVec3::new(0.3, -0.2, 3.0), DVec3::Z, DVec3::Z)?;
+    /// let mut rings = SilhouetteRings::new();
+    /// bsp.query_rings(&frame, &mut rings)?;
+    /// let fast = clamped_cosine_integral_rings(rings.rings())?;
+    /// assert!((fast - clamped_cosine_integral(&bsp.query(&frame)?)).abs() < 1e-14);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::query`].
+    pub fn query_rings(
+        &self,
+        frame: &ShadingFrame,
+        out: &mut SilhouetteRings,
+    ) -> Result<(), GeomError> {
+        out.clear();
+        let x = frame.origin();
+        let leaf = if x.cmpge(self.lo).all() && x.cmple(self.hi).all() {
+            self.leaf_of(x, matches!(self.source, Source::Solid(_)))
+        } else {
+            None
+        };
+        let Some(leaf) = leaf else {
+            out.set_polygon(&self.direct(frame)?);
+            return Ok(());
+        };
+        let at = leaf as usize;
+        match &self.source {
+            Source::Convex(poly) => {
+                if !self.convex_loop_raw(poly, at, frame, out) {
+                    out.set_polygon(&convex_silhouette(poly, frame)?);
+                }
+                Ok(())
+            }
+            Source::Solid(solid) => match self.read(at) {
+                EMPTY => Ok(()),
+                FULL => {
+                    out.set_full();
+                    Ok(())
+                }
+                DIRECT => {
+                    out.set_polygon(&nonconvex_silhouette(solid, frame)?);
+                    Ok(())
+                }
+                _ => self.solid_rings(solid, at, frame, out),
+            },
+        }
+    }
+
+    /// The rings of a non-convex solid's leaf with rings at `at` evaluated at the point
+    /// ([`evaluate_rings_into`]: unit vectors) into `out`, checked as the query checks them: at
+    /// least three vertices per ring, consecutive ones neither coincident nor antipodal.
+    fn solid_rings(
+        &self,
+        solid: &ClosedMesh,
+        mut at: usize,
+        frame: &ShadingFrame,
+        out: &mut SilhouetteRings,
+    ) -> Result<(), GeomError> {
+        let header = self.read(at);
+        at += 1;
+        let (arcs, ends) = self.read_rings(header, &mut at);
+        evaluate_rings_into(solid.mesh(), &arcs, &ends, frame, out)?;
+        for r in out.rings() {
+            let n = r.len();
+            let ok = n >= 3
+                && (0..n).all(|k| {
+                    let (a, b) = (r[k], r[(k + 1) % n]);
+                    (a - b).length() > COINCIDENT_TOLERANCE
+                        && (a + b).length() > ANTIPODAL_TOLERANCE
+                });
+            if !ok {
+                return Err(GeomError::Undecidable(GIVE_UP_QUERY));
+            }
+        }
+        Ok(())
+    }
+
+    /// The stored loop of a convex polyhedron's leaf at `at` written to `out` as the vertices in
+    /// the local frame, not normalized, where [`SilhouetteBsp::convex_loop`] returns it (the same
+    /// spacing decisions, [`spaced`]); `false` where it returns `None`.
+    fn convex_loop_raw(
+        &self,
+        poly: &ConvexPolyhedron,
+        at: usize,
+        frame: &ShadingFrame,
+        out: &mut SilhouetteRings,
+    ) -> bool {
+        let len = self.read(at) as usize;
+        if len == 0 {
+            return false;
+        }
+        let verts = poly.vertices();
+        let first = frame.to_local(verts[self.read(at + 1) as usize]);
+        out.push(first);
+        let mut prev = first;
+        let mut ok = true;
+        for k in 1..len {
+            let cur = frame.to_local(verts[self.read(at + 1 + k) as usize]);
+            ok &= spaced(prev, cur, MATCH_TOLERANCE, ANTIPODAL_TOLERANCE);
+            out.push(cur);
+            prev = cur;
+        }
+        if ok && spaced(prev, first, MATCH_TOLERANCE, ANTIPODAL_TOLERANCE) {
+            out.close_ring();
+            true
+        } else {
+            out.clear();
+            false
         }
     }
 
@@ -548,7 +667,7 @@ impl SilhouetteBsp {
         let rel = x - b.center;
         // The facing predicate's tolerance at x (`face_side`), computed once.
         let tol = FACE_TOLERANCE * (b.radius + rel.length());
-        let (normals, offsets, verts) = (mesh.normals(), mesh.offsets(), mesh.vertices());
+        let verts = mesh.vertices();
         let mask = (1u32 << self.child_bits) - 1;
         let mut i = 0usize;
         loop {
@@ -556,9 +675,20 @@ impl SilhouetteBsp {
             if w & LEAF != 0 {
                 return Some(w & !LEAF);
             }
-            let positive = match self.planes[(w >> self.child_bits) as usize] {
+            let p = (w >> self.child_bits) as usize;
+            // Face planes (interned first) from their own table: one load of the plane, no
+            // dispatch; the distance is the facing predicate's, bit for bit.
+            if let Some(&(n, d)) = self.face_eqs.get(p) {
+                let s = n.dot(rel) - d;
+                if band && s.abs() <= tol {
+                    return None;
+                }
+                i = if s > tol { (w & mask) as usize } else { i + 1 };
+                continue;
+            }
+            let positive = match self.planes[p] {
                 SplitPlane::Face(f) => {
-                    let s = normals[f as usize].dot(rel) - offsets[f as usize];
+                    let s = mesh.normals()[f as usize].dot(rel) - mesh.offsets()[f as usize];
                     if band && s.abs() <= tol {
                         return None;
                     }
@@ -702,6 +832,7 @@ impl SilhouetteBsp {
         4 * self.nodes.len()
             + self.data.len()
             + core::mem::size_of::<SplitPlane>() * self.planes.len()
+            + core::mem::size_of::<(DVec3, f64)>() * self.face_eqs.len()
     }
 
     /// The box of points answered by the tree.
@@ -1718,8 +1849,20 @@ impl<'a> Builder<'a> {
         for &x in &self.data {
             data.extend_from_slice(&x.to_le_bytes()[..width as usize]);
         }
+        let face_eqs = self
+            .planes
+            .iter()
+            .map_while(|p| match *p {
+                SplitPlane::Face(f) => Some((
+                    self.mesh.normals()[f as usize],
+                    self.mesh.offsets()[f as usize],
+                )),
+                _ => None,
+            })
+            .collect();
         Ok(SilhouetteBsp {
             source,
+            face_eqs,
             planes: self.planes,
             nodes,
             child_bits,
