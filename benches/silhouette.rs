@@ -276,7 +276,7 @@ impl Shading {
     /// Faces, front faces and silhouette vertices per point over the frames: the edges each
     /// row integrates (twice, diffuse and GGX).
     fn census(&self, name: &str, frames: &[(ShadingFrame, DMat3)]) -> String {
-        let (mut front, mut edges, mut sil) = (0usize, 0usize, 0usize);
+        let (mut front, mut edges, mut sil, mut direct) = (0usize, 0usize, 0usize, 0usize);
         let mut rings = SilhouetteRings::new();
         for (f, _) in frames {
             for face in &self.faces {
@@ -288,17 +288,19 @@ impl Shading {
             if let Some(bsp) = &self.bsp {
                 bsp.query_rings(f, &mut rings).unwrap();
                 sil += rings.vertex_count();
+                direct += usize::from(bsp.direct_reason(f).is_some());
             }
         }
         let n = frames.len() as f64;
         format!(
             "{name}: {} faces ({} triangles); per point {:.1} front faces with {:.1} edges, \
-             silhouettes of {:.1} vertices",
+             silhouettes of {:.1} vertices; {direct} of {} points answered directly by the tree",
             self.faces.len(),
             self.mesh.triangle_count(),
             front as f64 / n,
             edges as f64 / n,
-            sil as f64 / n
+            sil as f64 / n,
+            frames.len()
         )
     }
 
@@ -361,13 +363,14 @@ fn build(c: &mut Criterion) {
         let bsp = SilhouetteBsp::build(&solid).unwrap();
         eprintln!(
             "{name}: {} nodes, {} leaves ({} answered directly), {} silhouette elements, {} \
-             planes and triple tests, {} bytes",
+             planes and triple tests, {} bytes ({} counted against the build's budget)",
             bsp.node_count(),
             bsp.leaf_count(),
             bsp.direct_leaf_count(),
             bsp.silhouette_elements(),
             bsp.plane_count(),
-            bsp.byte_size()
+            bsp.byte_size(),
+            bsp.build_bytes()
         );
         g.bench_with_input(BenchmarkId::from_parameter(name), &solid, |b, s| {
             b.iter(|| SilhouetteBsp::build(black_box(s)).unwrap())
@@ -383,10 +386,11 @@ fn build(c: &mut Criterion) {
         let (stored, rings) = bsp.triangulated_leaf_count();
         eprintln!(
             "{name} triangulated: {} nodes, {stored} of {rings} leaves with rings store a \
-             triangulation, {} triangles, {} bytes",
+             triangulation, {} triangles, {} bytes ({} counted against the build's budget)",
             bsp.node_count(),
             bsp.stored_triangle_count(),
-            bsp.byte_size()
+            bsp.byte_size(),
+            bsp.build_bytes()
         );
         g.bench_with_input(BenchmarkId::from_parameter(name), &solid, |b, s| {
             b.iter(|| SilhouetteBsp::build_triangulated(black_box(s)).unwrap())

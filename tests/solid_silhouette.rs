@@ -330,13 +330,14 @@ fn check(
         "{name} x {x}: only {checked} directions checked"
     );
     // Symmetric difference with the union of the front triangles.
-    let (xor, u) = match front_union(mesh, frame).and_then(|u| Ok((sil.boolean(&u, BoolOp::Xor)?, u))) {
-        Ok(r) => r,
-        Err(e) => {
-            assert!(e.is_undecidable(), "{name} x {x}: reference failed: {e}");
-            return Reference::GaveUp;
-        }
-    };
+    let (xor, u) =
+        match front_union(mesh, frame).and_then(|u| Ok((sil.boolean(&u, BoolOp::Xor)?, u))) {
+            Ok(r) => r,
+            Err(e) => {
+                assert!(e.is_undecidable(), "{name} x {x}: reference failed: {e}");
+                return Reference::GaveUp;
+            }
+        };
     let area = xor.solid_angle();
     if area <= 1e-10 * 4.0 * PI {
         return Reference::Agreed;

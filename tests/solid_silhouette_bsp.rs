@@ -20,8 +20,8 @@ use arealight::internals::{
 use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::solid::{
-    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, SilhouetteRings, SilhouetteSampler,
-    TriangleMesh, TriangleSource, nonconvex_silhouette,
+    ClosedMesh, ConvexPolyhedron, DEFAULT_BUILD_BUDGET, ShadingFrame, SilhouetteBsp,
+    SilhouetteRings, SilhouetteSampler, TriangleMesh, TriangleSource, nonconvex_silhouette,
 };
 use arealight::sphere::{SphericalPolygon, SphericalTriangle};
 use robust::orient3d;
@@ -43,7 +43,7 @@ fn direct(solid: &ClosedMesh, frame: &ShadingFrame) -> Result<SphericalPolygon, 
 
 /// Random points for one solid: a third uniform in the box, a third near the solid, a third
 /// near a random splitting plane.
-fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> DVec3 {
+fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> (DVec3, &'static str) {
     let (lo, hi) = bsp.region();
     let b = mesh.bounding_sphere();
     let in_box = |rng: &mut Rng, lo: DVec3, hi: DVec3| {
@@ -54,11 +54,14 @@ fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> DVec3 {
         )
     };
     match (rng.f64() * 3.0) as u32 {
-        0 => in_box(rng, lo, hi),
-        1 => in_box(
-            rng,
-            b.center - DVec3::splat(1.5 * b.radius),
-            b.center + DVec3::splat(1.5 * b.radius),
+        0 => (in_box(rng, lo, hi), "box"),
+        1 => (
+            in_box(
+                rng,
+                b.center - DVec3::splat(1.5 * b.radius),
+                b.center + DVec3::splat(1.5 * b.radius),
+            ),
+            "near the solid",
         ),
         _ => {
             let planes = bsp.plane_equations();
@@ -67,7 +70,10 @@ fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> DVec3 {
             let p = b.center + rng.dir() * b.radius * rng.range(0.0, 3.0);
             let on = p - n * (n.dot(p) - d);
             let off = b.radius * 10f64.powf(rng.range(-11.0, -5.0));
-            on + n * if rng.f64() < 0.5 { off } else { -off }
+            (
+                on + n * if rng.f64() < 0.5 { off } else { -off },
+                "near a plane",
+            )
         }
     }
 }
@@ -164,11 +170,22 @@ fn check_solid(name: &str, solid: &ClosedMesh, rng: &mut Rng, n: usize) -> (usiz
     let (mut checked, mut gave_up) = (0, 0);
     // Give-ups of the query only, of the direct algorithm only, of both.
     let mut kinds = [0usize; 3];
+    // Points the query answers with the direct algorithm, by reason.
+    let mut reasons: std::collections::BTreeMap<String, usize> = Default::default();
     let mut rings = SilhouetteRings::new();
     for _ in 0..n {
-        let x = sample(&bsp, mesh, rng);
+        let (x, kind) = sample(&bsp, mesh, rng);
         let frame = ShadingFrame::new(x, DVec3::Z, DVec3::new(0.2, 0.1, 1.0)).unwrap();
         check_rings(&bsp, solid, &frame, &mut rings);
+        if let Some(r) = bsp.direct_reason(&frame) {
+            // Answered by the direct algorithm: the very same result.
+            assert_eq!(
+                bsp.query(&frame),
+                direct(solid, &frame),
+                "{name} x {x}: {r:?}"
+            );
+            *reasons.entry(format!("{r:?} ({kind})")).or_insert(0) += 1;
+        }
         match (bsp.query(&frame), direct(solid, &frame)) {
             (Ok(q), Ok(d)) => {
                 let same = same_set(&q, &d, rng);
@@ -206,13 +223,16 @@ fn check_solid(name: &str, solid: &ClosedMesh, rng: &mut Rng, n: usize) -> (usiz
     }
     eprintln!(
         "{name}: {} nodes, {} planes, {} bytes; {checked} points equal, {gave_up} give-ups \
-         ({} of the query alone, {} of the direct algorithm alone, {} of both)",
+         ({} of the query alone, {} of the direct algorithm alone, {} of both); {} of {} \
+         leaves direct; points answered directly: {reasons:?}",
         bsp.node_count(),
         bsp.plane_count(),
         bsp.byte_size(),
         kinds[0],
         kinds[1],
-        kinds[2]
+        kinds[2],
+        bsp.direct_leaf_count(),
+        bsp.leaf_count()
     );
     (checked, gave_up)
 }
@@ -266,6 +286,70 @@ fn queries_equal_direct_silhouettes_on_random_solids() {
             "solid {k}: {gave_up} give-ups"
         );
     }
+}
+
+#[test]
+fn builds_stop_at_their_budget() {
+    // The build counts the bytes it holds (`build_bytes`, deterministic): within a budget of
+    // exactly that it succeeds with the same tree, one byte less stops it with `OutOfRange`,
+    // as does a small budget for a tree that would be large (a torus of 16 x 8 segments, whose
+    // tree would take hundreds of megabytes; stopped early, so this test stays fast). The
+    // default budget holds the largest trees of these tests.
+    let (_, bowl) = thesis_polyhedra().unwrap().pop().unwrap();
+    let tori = [
+        ClosedMesh::new(torus(1.0, 0.4, 8, 4).unwrap()).unwrap(),
+        ClosedMesh::new(torus(1.0, 0.4, 16, 8).unwrap()).unwrap(),
+    ];
+    for (solid, triangulated) in [
+        (ClosedMesh::new(bowl).unwrap(), false),
+        (ClosedMesh::new(bowl_like()).unwrap(), true),
+        (
+            ClosedMesh::new(thesis_polyhedra().unwrap()[4].1.clone()).unwrap(),
+            false,
+        ),
+    ] {
+        let (lo, hi) = SilhouetteBsp::build(&solid).unwrap().region();
+        let full =
+            SilhouetteBsp::build_with_budget(&solid, lo, hi, triangulated, usize::MAX).unwrap();
+        let need = full.build_bytes();
+        assert!(need > full.byte_size(), "{need} vs {}", full.byte_size());
+        let exact = SilhouetteBsp::build_with_budget(&solid, lo, hi, triangulated, need).unwrap();
+        assert_eq!(exact, full);
+        match SilhouetteBsp::build_with_budget(&solid, lo, hi, triangulated, need - 1) {
+            Err(GeomError::OutOfRange { value, limit, .. }) => {
+                assert!(
+                    value > limit && limit == (need - 1) as f64,
+                    "{value} {limit}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    let small = tori[0].clone();
+    let need = SilhouetteBsp::build(&small).unwrap().build_bytes();
+    assert!(need <= DEFAULT_BUILD_BUDGET / 4, "{need}");
+    let (lo, hi) = SilhouetteBsp::build(&small).unwrap().region();
+    let start = std::time::Instant::now();
+    let big = SilhouetteBsp::build_with_budget(&tori[1], lo, hi, false, 4 << 20);
+    assert!(matches!(big, Err(GeomError::OutOfRange { .. })), "{big:?}");
+    eprintln!(
+        "torus 8 x 4: {need} bytes counted; torus 16 x 8 stopped at 4 MiB after {:?}",
+        start.elapsed()
+    );
+}
+
+/// The thesis's bowl moved and rotated, for a triangulated build.
+fn bowl_like() -> TriangleMesh {
+    let (_, bowl) = thesis_polyhedra().unwrap().pop().unwrap();
+    let r = DMat3::from_rotation_y(0.4) * DMat3::from_rotation_z(0.3);
+    TriangleMesh::new(
+        bowl.vertices()
+            .iter()
+            .map(|&v| r * v + DVec3::new(0.2, -0.1, 0.3))
+            .collect(),
+        bowl.triangles().to_vec(),
+    )
+    .unwrap()
 }
 
 #[test]
@@ -629,7 +713,7 @@ fn convex_fans_are_valid_triangulations() {
         let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(m).unwrap()).unwrap();
         let mut checked = 0;
         for _ in 0..400 {
-            let x = sample(&bsp, &mesh, &mut rng);
+            let (x, _) = sample(&bsp, &mesh, &mut rng);
             let frame = ShadingFrame::new(x, DVec3::Z, DVec3::Y).unwrap();
             let (Ok(poly), Some(tris)) = (bsp.query(&frame), bsp.stored_triangulation(&frame))
             else {

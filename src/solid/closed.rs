@@ -73,7 +73,9 @@ impl ClosedMesh {
                 .edges()
                 .iter()
                 .find(|e| e.twin().is_none())
-                .map_or((0, [0, 0]), |e| (e.f0 as usize, [e.a as usize, e.b as usize]));
+                .map_or((0, [0, 0]), |e| {
+                    (e.f0 as usize, [e.a as usize, e.b as usize])
+                });
             return Err(GeomError::OpenMesh { triangle, edge });
         }
         check_fans(&mesh)?;

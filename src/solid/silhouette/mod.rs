@@ -10,7 +10,7 @@ mod rings;
 mod triangle;
 mod triangulated;
 
-pub use bsp::{DEFAULT_REGION_RADII, SilhouetteBsp};
+pub use bsp::{DEFAULT_BUILD_BUDGET, DEFAULT_REGION_RADII, DirectReason, SilhouetteBsp};
 pub(crate) use convex::chain_by_index;
 pub use convex::{convex_silhouette, convex_silhouette_rings};
 pub use nonconvex::nonconvex_silhouette;
