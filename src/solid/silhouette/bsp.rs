@@ -86,7 +86,8 @@ pub const DEFAULT_REGION_RADII: f64 = 8.0;
 /// The default budget of a build ([`SilhouetteBsp::build`] and the other constructors without a
 /// budget of their own): 256 MiB of the storage the build counts (see
 /// [`SilhouetteBsp::build_with_budget`]). The largest trees of the tests stay far below it
-/// (sphere-42: about 18 MiB counted; a torus of 8 x 4 segments, 23 MiB; BENCHMARKS.md); a mesh
+/// (sphere-42: 39 MiB counted, mostly the cells of the first pass, for a tree of 1.3 MiB; a
+/// torus of 8 x 4 segments: 10 MiB; BENCHMARKS.md); a mesh
 /// whose tree would need more gets [`GeomError::OutOfRange`] instead of exhausting memory.
 pub const DEFAULT_BUILD_BUDGET: usize = 256 << 20;
 
