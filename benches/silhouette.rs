@@ -477,7 +477,49 @@ fn time_rows(rounds: usize, filter: &str) {
     }
 }
 
+/// Build mode: `SIL_BUILD_CASE='<polyhedron>[/triangulated]' SIL_BUILD_REPS=n` builds that tree
+/// `n` times without criterion and prints the minimum wall time per build; under `perf stat -e
+/// task-clock`, the difference of the CPU times with `n` and with `0` builds over `n` is the CPU
+/// time per build, which a loaded machine does not inflate.
+fn build_case(case: &str, reps: usize) {
+    let (poly, triangulated) = match case.split_once('/') {
+        Some((p, "triangulated")) => (p, true),
+        _ => (case, false),
+    };
+    let (_, mesh) = thesis_polyhedra()
+        .unwrap()
+        .into_iter()
+        .find(|(n, _)| *n == poly)
+        .expect("a polyhedron of table 7.1");
+    let solid = ClosedMesh::new(mesh).unwrap();
+    let mut best = f64::INFINITY;
+    let mut bytes = 0;
+    for _ in 0..reps {
+        let start = std::time::Instant::now();
+        let bsp = if triangulated {
+            SilhouetteBsp::build_triangulated(black_box(&solid))
+        } else {
+            SilhouetteBsp::build(black_box(&solid))
+        }
+        .unwrap();
+        best = best.min(start.elapsed().as_secs_f64());
+        bytes = bsp.byte_size();
+    }
+    println!(
+        "{case} x {reps}: min {:.2} ms per build, {bytes} bytes",
+        best * 1e3
+    );
+}
+
 fn main() {
+    if let Ok(case) = std::env::var("SIL_BUILD_CASE") {
+        let reps = std::env::var("SIL_BUILD_REPS")
+            .ok()
+            .and_then(|r| r.parse().ok())
+            .unwrap_or(1);
+        build_case(&case, reps);
+        return;
+    }
     if let Ok(rounds) = std::env::var("SIL_TIME_ROUNDS") {
         let filter = std::env::var("SIL_TIME_FILTER").unwrap_or_default();
         time_rows(rounds.parse().expect("a round count"), &filter);
