@@ -161,6 +161,9 @@ pub enum GeomError {
     OpenMesh {
         /// Index of a triangle at the offending edge.
         triangle: usize,
+        /// The offending edge as the vertex indices of its ends, in the order that triangle
+        /// runs it.
+        edge: [usize; 2],
     },
     /// (shade) A mesh that must be convex has a vertex in front of a face's plane (or faces
     /// pointing inwards).
@@ -291,11 +294,12 @@ impl fmt::Display for GeomError {
                 f,
                 "triangle {triangle} has (nearly) zero area; remove it or merge its vertices"
             ),
-            GeomError::OpenMesh { triangle } => write!(
+            GeomError::OpenMesh { triangle, edge } => write!(
                 f,
-                "triangle {triangle} has an edge not shared by exactly one other triangle running \
-                 the opposite way; a convex polyhedron or a solid must be a closed, consistently \
-                 oriented mesh"
+                "the edge from vertex {} to vertex {} of triangle {triangle} is not shared by \
+                 exactly one other triangle running the opposite way; a convex polyhedron or a \
+                 solid must be a closed, consistently oriented mesh",
+                edge[0], edge[1]
             ),
             GeomError::OverlappingLightTriangles { triangle, other } => write!(
                 f,

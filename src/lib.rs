@@ -145,7 +145,9 @@ pub mod internals {
     };
     pub use crate::shade::demo::{Demo, DemoConfig, demo_scene};
     pub use crate::solid::fixtures::{bumpy_sphere, extruded_star, thesis_polyhedra, torus};
-    pub use crate::solid::silhouette::{TriangleRole, convex_silhouette, triangle_polygon};
+    pub use crate::solid::silhouette::{
+        DirectReason, TriangleRole, convex_silhouette, convex_silhouette_rings, triangle_polygon,
+    };
     pub use crate::visibility::cull::{SHAFT_MARGIN, Shaft, above_horizon, may_occlude};
 }
 

@@ -323,6 +323,83 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: support::cases(512), ..ProptestConfig::default() })]
+
+    /// The integrals over bare rings of directions of any length (`clamped_cosine_integral_rings`,
+    /// `ltc_integral_rings`: no polygon, no normalization) agree with the exact clip of the
+    /// polygon they bound, every vertex scaled by its own factor from 1e-3 to 1e3: under the
+    /// identity, a map of the tables' form and a general map (mirroring ones go to the exact
+    /// path).
+    #[test]
+    fn ring_integrals_agree_with_the_exact_clip(seed in any::<u64>()) {
+        use arealight::glam::DMat3;
+        use arealight::ltc::{clamped_cosine_integral_rings, ltc_integral, ltc_integral_rings};
+        let Some((p, table_map, exact_table, _)) = ltc_form_case(seed, 0x21A6) else {
+            return Ok(());
+        };
+        let mut rng = Rng::new(seed ^ 0x5CA1);
+        let rings: Vec<Vec<DVec3>> = p
+            .rings()
+            .map(|r| r.iter().map(|&v| v * 10f64.powf(rng.range(-3.0, 3.0))).collect())
+            .collect();
+        let rings = || rings.iter().map(Vec::as_slice);
+        let exact = clamped_cosine_integral(&p);
+        let got = clamped_cosine_integral_rings(rings()).unwrap();
+        prop_assert!((exact - got).abs() <= 1e-12, "{} vs {}", exact, got);
+        let got = ltc_integral_rings(rings(), table_map).unwrap();
+        prop_assert!((exact_table - got).abs() <= 1e-12, "{} vs {}", exact_table, got);
+        let general = DMat3::from_cols(rng.dir() * rng.range(0.2, 3.0), rng.dir(), rng.dir() * rng.range(0.2, 3.0));
+        if let Ok(t) = p.transformed(general) {
+            let exact = clamped_cosine_integral(&t);
+            let got = ltc_integral_rings(rings(), general).unwrap();
+            prop_assert!((exact - got).abs() <= 1e-12, "{} vs {}", exact, got);
+            prop_assert!((ltc_integral(&p, general).unwrap() - got).abs() <= 1e-12);
+        }
+    }
+}
+
+/// Where the clip-free path hands over (a vertex on the horizon), the ring integrals take the
+/// exact path on the validated polygon; no ring is zero, a ring that is not a polygon is an error
+/// there; no rings is the empty region.
+#[test]
+fn ring_integrals_hand_over_on_the_horizon() {
+    use arealight::glam::DMat3;
+    use arealight::ltc::{clamped_cosine_integral_rings, ltc_integral, ltc_integral_rings};
+    // A triangle with a vertex exactly on the horizon, lengths 2, 3 and 0.5.
+    let ring = [
+        DVec3::new(2.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.5, 1.5 * 3f64.sqrt()),
+        DVec3::new(-0.2, -0.3, 0.3),
+    ];
+    let p = SphericalPolygon::new(vec![ring.iter().map(|v| v.normalize()).collect()]).unwrap();
+    let got = clamped_cosine_integral_rings([&ring[..]]).unwrap();
+    assert!((got - clamped_cosine_integral(&p)).abs() <= 1e-15, "{got}");
+    let m = DMat3::from_cols(
+        DVec3::new(1.3, 0.0, -0.4),
+        DVec3::Y,
+        DVec3::new(0.2, 0.0, 0.9),
+    );
+    let got = ltc_integral_rings([&ring[..]], m).unwrap();
+    assert!((got - ltc_integral(&p, m).unwrap()).abs() <= 1e-15, "{got}");
+    // On the exact path, a zero vertex and a self-crossing ring are errors.
+    let zero = [ring[0], ring[1], DVec3::ZERO];
+    assert!(clamped_cosine_integral_rings([&zero[..]]).is_err());
+    // A bow tie with a vertex on the horizon: its edges 0-1 and 2-3 cross at the zenith.
+    let bow = [
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(-1.0, -1.0, 1.0),
+        DVec3::new(1.0, -1.0, 1.0),
+        DVec3::new(-1.0, 1.0, 1.0),
+    ];
+    assert!(clamped_cosine_integral_rings([&bow[..]]).is_err());
+    assert_eq!(
+        clamped_cosine_integral_rings(std::iter::empty()).unwrap(),
+        0.0
+    );
+    assert_eq!(ltc_integral_rings(std::iter::empty(), m).unwrap(), 0.0);
+}
+
 /// Quads take a kernel of their own in the clip-free path. Every pattern of vertices above and
 /// below the horizon (a run of one, two or three vertices above in every position, two runs, none,
 /// all) under the identity, two table maps and a general map, against the exact clip.

@@ -14,13 +14,14 @@ mod support;
 use arealight::GeomError;
 use arealight::glam::{DMat3, DQuat, DVec3};
 use arealight::internals::{
-    bumpy_sphere, convex_silhouette, extruded_star, thesis_polyhedra, torus,
+    bumpy_sphere, convex_silhouette, convex_silhouette_rings, extruded_star, thesis_polyhedra,
+    torus,
 };
 use arealight::ltc::clamped_cosine_integral;
 use arealight::planar::BoolOp;
 use arealight::solid::{
-    ClosedMesh, ConvexPolyhedron, ShadingFrame, SilhouetteBsp, SilhouetteSampler, TriangleMesh,
-    TriangleSource, nonconvex_silhouette,
+    ClosedMesh, ConvexPolyhedron, DEFAULT_BUILD_BUDGET, ShadingFrame, SilhouetteBsp,
+    SilhouetteRings, SilhouetteSampler, TriangleMesh, TriangleSource, nonconvex_silhouette,
 };
 use arealight::sphere::{SphericalPolygon, SphericalTriangle};
 use robust::orient3d;
@@ -42,7 +43,7 @@ fn direct(solid: &ClosedMesh, frame: &ShadingFrame) -> Result<SphericalPolygon, 
 
 /// Random points for one solid: a third uniform in the box, a third near the solid, a third
 /// near a random splitting plane.
-fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> DVec3 {
+fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> (DVec3, &'static str) {
     let (lo, hi) = bsp.region();
     let b = mesh.bounding_sphere();
     let in_box = |rng: &mut Rng, lo: DVec3, hi: DVec3| {
@@ -53,11 +54,14 @@ fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> DVec3 {
         )
     };
     match (rng.f64() * 3.0) as u32 {
-        0 => in_box(rng, lo, hi),
-        1 => in_box(
-            rng,
-            b.center - DVec3::splat(1.5 * b.radius),
-            b.center + DVec3::splat(1.5 * b.radius),
+        0 => (in_box(rng, lo, hi), "box"),
+        1 => (
+            in_box(
+                rng,
+                b.center - DVec3::splat(1.5 * b.radius),
+                b.center + DVec3::splat(1.5 * b.radius),
+            ),
+            "near the solid",
         ),
         _ => {
             let planes = bsp.plane_equations();
@@ -66,7 +70,10 @@ fn sample(bsp: &SilhouetteBsp, mesh: &TriangleMesh, rng: &mut Rng) -> DVec3 {
             let p = b.center + rng.dir() * b.radius * rng.range(0.0, 3.0);
             let on = p - n * (n.dot(p) - d);
             let off = b.radius * 10f64.powf(rng.range(-11.0, -5.0));
-            on + n * if rng.f64() < 0.5 { off } else { -off }
+            (
+                on + n * if rng.f64() < 0.5 { off } else { -off },
+                "near a plane",
+            )
         }
     }
 }
@@ -116,14 +123,69 @@ fn same_set(a: &SphericalPolygon, b: &SphericalPolygon, rng: &mut Rng) -> bool {
     }
 }
 
+/// Whether `r` and `p` have the same rings and their vertices, once normalized, the same
+/// directions within rounding (`1e-15`: a vertex of `p` may be normalized twice).
+fn same_vertices(r: &SilhouetteRings, p: &SphericalPolygon) -> bool {
+    r.is_full() == p.is_full()
+        && r.ring_count() == p.ring_count()
+        && r.rings().zip(p.rings()).all(|(a, b)| {
+            a.len() == b.len()
+                && a.iter()
+                    .zip(b)
+                    .all(|(u, v)| (u.normalize() - *v).length() <= 1e-15)
+        })
+}
+
+/// The ring forms of the query and of the convex silhouette (vertices not normalized, for the
+/// clip-free integrals) give the same rings as the polygon forms, vertex for vertex once
+/// normalized, and fail where they fail.
+fn check_rings(
+    bsp: &SilhouetteBsp,
+    solid: &ClosedMesh,
+    frame: &ShadingFrame,
+    rings: &mut SilhouetteRings,
+) {
+    let x = frame.origin();
+    match (bsp.query(frame), bsp.query_rings(frame, rings)) {
+        (Ok(q), Ok(())) => assert!(same_vertices(rings, &q), "x {x}: {rings:?} vs {q:?}"),
+        (Err(a), Err(b)) => assert_eq!(a, b, "x {x}"),
+        (q, r) => panic!("x {x}: query {q:?}, query_rings {r:?}"),
+    }
+    if let Ok(p) = ConvexPolyhedron::from_mesh(solid.mesh()) {
+        match (
+            convex_silhouette(&p, frame),
+            convex_silhouette_rings(&p, frame, rings),
+        ) {
+            (Ok(q), Ok(())) => assert!(same_vertices(rings, &q), "x {x}: {rings:?} vs {q:?}"),
+            (Err(a), Err(b)) => assert_eq!(a, b, "x {x}"),
+            (q, r) => panic!("x {x}: convex {q:?}, rings {r:?}"),
+        }
+    }
+}
+
 fn check_solid(name: &str, solid: &ClosedMesh, rng: &mut Rng, n: usize) -> (usize, usize) {
     let mesh = solid.mesh();
     let bsp = SilhouetteBsp::build(solid).unwrap();
     assert!(bsp.leaf_count() > 1 && bsp.node_count() == 2 * bsp.leaf_count() - 1);
     let (mut checked, mut gave_up) = (0, 0);
+    // Give-ups of the query only, of the direct algorithm only, of both.
+    let mut kinds = [0usize; 3];
+    // Points the query answers with the direct algorithm, by reason.
+    let mut reasons: std::collections::BTreeMap<String, usize> = Default::default();
+    let mut rings = SilhouetteRings::new();
     for _ in 0..n {
-        let x = sample(&bsp, mesh, rng);
+        let (x, kind) = sample(&bsp, mesh, rng);
         let frame = ShadingFrame::new(x, DVec3::Z, DVec3::new(0.2, 0.1, 1.0)).unwrap();
+        check_rings(&bsp, solid, &frame, &mut rings);
+        if let Some(r) = bsp.direct_reason(&frame) {
+            // Answered by the direct algorithm: the very same result.
+            assert_eq!(
+                bsp.query(&frame),
+                direct(solid, &frame),
+                "{name} x {x}: {r:?}"
+            );
+            *reasons.entry(format!("{r:?} ({kind})")).or_insert(0) += 1;
+        }
         match (bsp.query(&frame), direct(solid, &frame)) {
             (Ok(q), Ok(d)) => {
                 let same = same_set(&q, &d, rng);
@@ -138,12 +200,16 @@ fn check_solid(name: &str, solid: &ClosedMesh, rng: &mut Rng, n: usize) -> (usiz
                 checked += 1;
             }
             (q, d) => {
-                // Only give-ups, and only together or at points within rounding of a plane.
+                // Only give-ups: of the query alone (a point within rounding of a cell
+                // boundary, where the stored structure's vertices nearly coincide), of the
+                // direct algorithm alone (a decision within rounding that the stored structure
+                // does not need), or of both.
                 for r in [&q, &d] {
                     if let Err(e) = r {
                         assert!(e.is_undecidable(), "{name} x {x}: {e}");
                     }
                 }
+                kinds[usize::from(q.is_err()) + 2 * usize::from(d.is_err()) - 1] += 1;
                 gave_up += 1;
             }
         }
@@ -156,10 +222,17 @@ fn check_solid(name: &str, solid: &ClosedMesh, rng: &mut Rng, n: usize) -> (usiz
         assert_eq!(bsp.query(&frame), direct(solid, &frame), "{name} outside");
     }
     eprintln!(
-        "{name}: {} nodes, {} planes, {} bytes; {checked} points equal, {gave_up} give-ups",
+        "{name}: {} nodes, {} planes, {} bytes; {checked} points equal, {gave_up} give-ups \
+         ({} of the query alone, {} of the direct algorithm alone, {} of both); {} of {} \
+         leaves direct; points answered directly: {reasons:?}",
         bsp.node_count(),
         bsp.plane_count(),
-        bsp.byte_size()
+        bsp.byte_size(),
+        kinds[0],
+        kinds[1],
+        kinds[2],
+        bsp.direct_leaf_count(),
+        bsp.leaf_count()
     );
     (checked, gave_up)
 }
@@ -213,6 +286,70 @@ fn queries_equal_direct_silhouettes_on_random_solids() {
             "solid {k}: {gave_up} give-ups"
         );
     }
+}
+
+#[test]
+fn builds_stop_at_their_budget() {
+    // The build counts the bytes it holds (`build_bytes`, deterministic): within a budget of
+    // exactly that it succeeds with the same tree, one byte less stops it with `OutOfRange`,
+    // as does a small budget for a tree that would be large (a torus of 16 x 8 segments, whose
+    // tree would take hundreds of megabytes; stopped early, so this test stays fast). The
+    // default budget holds the largest trees of these tests.
+    let (_, bowl) = thesis_polyhedra().unwrap().pop().unwrap();
+    let tori = [
+        ClosedMesh::new(torus(1.0, 0.4, 8, 4).unwrap()).unwrap(),
+        ClosedMesh::new(torus(1.0, 0.4, 16, 8).unwrap()).unwrap(),
+    ];
+    for (solid, triangulated) in [
+        (ClosedMesh::new(bowl).unwrap(), false),
+        (ClosedMesh::new(bowl_like()).unwrap(), true),
+        (
+            ClosedMesh::new(thesis_polyhedra().unwrap()[4].1.clone()).unwrap(),
+            false,
+        ),
+    ] {
+        let (lo, hi) = SilhouetteBsp::build(&solid).unwrap().region();
+        let full =
+            SilhouetteBsp::build_with_budget(&solid, lo, hi, triangulated, usize::MAX).unwrap();
+        let need = full.build_bytes();
+        assert!(need > full.byte_size(), "{need} vs {}", full.byte_size());
+        let exact = SilhouetteBsp::build_with_budget(&solid, lo, hi, triangulated, need).unwrap();
+        assert_eq!(exact, full);
+        match SilhouetteBsp::build_with_budget(&solid, lo, hi, triangulated, need - 1) {
+            Err(GeomError::OutOfRange { value, limit, .. }) => {
+                assert!(
+                    value > limit && limit == (need - 1) as f64,
+                    "{value} {limit}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    let small = tori[0].clone();
+    let need = SilhouetteBsp::build(&small).unwrap().build_bytes();
+    assert!(need <= DEFAULT_BUILD_BUDGET / 4, "{need}");
+    let (lo, hi) = SilhouetteBsp::build(&small).unwrap().region();
+    let start = std::time::Instant::now();
+    let big = SilhouetteBsp::build_with_budget(&tori[1], lo, hi, false, 4 << 20);
+    assert!(matches!(big, Err(GeomError::OutOfRange { .. })), "{big:?}");
+    eprintln!(
+        "torus 8 x 4: {need} bytes counted; torus 16 x 8 stopped at 4 MiB after {:?}",
+        start.elapsed()
+    );
+}
+
+/// The thesis's bowl moved and rotated, for a triangulated build.
+fn bowl_like() -> TriangleMesh {
+    let (_, bowl) = thesis_polyhedra().unwrap().pop().unwrap();
+    let r = DMat3::from_rotation_y(0.4) * DMat3::from_rotation_z(0.3);
+    TriangleMesh::new(
+        bowl.vertices()
+            .iter()
+            .map(|&v| r * v + DVec3::new(0.2, -0.1, 0.3))
+            .collect(),
+        bowl.triangles().to_vec(),
+    )
+    .unwrap()
 }
 
 #[test]
@@ -576,7 +713,7 @@ fn convex_fans_are_valid_triangulations() {
         let bsp = SilhouetteBsp::build_triangulated(&ClosedMesh::new(m).unwrap()).unwrap();
         let mut checked = 0;
         for _ in 0..400 {
-            let x = sample(&bsp, &mesh, &mut rng);
+            let (x, _) = sample(&bsp, &mesh, &mut rng);
             let frame = ShadingFrame::new(x, DVec3::Z, DVec3::Y).unwrap();
             let (Ok(poly), Some(tris)) = (bsp.query(&frame), bsp.stored_triangulation(&frame))
             else {

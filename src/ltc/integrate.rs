@@ -627,6 +627,87 @@ pub fn clamped_cosine_integral_clip_free(poly: &SphericalPolygon) -> f64 {
     clip_free_sum(poly, |v| v, Exact).unwrap_or_else(|| clamped_cosine_integral(poly))
 }
 
+/// [`clamped_cosine_integral_clip_free`] of the region bounded by `rings`, given as directions of
+/// any positive length that are trusted to bound a valid region (as [`SphericalPolygon::new`]
+/// would accept them once normalized: simple, disjoint, interior on the left): a front-facing
+/// mesh face seen from a point, a silhouette valid by construction. No polygon is built and no
+/// vertex is normalized (every quantity of the clip-free sum is invariant under positive scaling
+/// of a vertex), so a renderer integrating many small rings pays only for the edge terms.
+///
+/// Where the clip-free path hands over to the exact one (a vertex within rounding of the
+/// horizon; see [`clamped_cosine_integral_clip_free`]), the rings are normalized and validated
+/// as a [`SphericalPolygon`] and integrated exactly; the two paths agree to rounding.
+///
+/// # Errors
+///
+/// Those of [`SphericalPolygon::new`] for rings that are not a valid polygon, raised only on the
+/// rare exact path: the validity of the rings is the caller's to guarantee, and on the fast
+/// path rings that are not valid give the integral of their boundary chain (each part of the
+/// sphere weighted by its winding number where that is defined), not an error.
+pub fn clamped_cosine_integral_rings<'a, I>(rings: I) -> Result<f64, crate::GeomError>
+where
+    I: IntoIterator<Item = &'a [DVec3]>,
+    I::IntoIter: Clone,
+{
+    let rings = rings.into_iter();
+    let mut one = rings.clone();
+    let fast = match (one.next(), one.next()) {
+        (None, _) => return Ok(0.0),
+        (Some(ring), None) => ring_clip_free_sum(ring, |v| v, Exact),
+        _ => ring_sum(rings.clone(), |v| v, Exact),
+    };
+    match fast {
+        Some(v) => Ok(v),
+        None => Ok(clamped_cosine_integral(&polygon_of_rings(rings)?)),
+    }
+}
+
+/// [`ltc_integral`] of the region bounded by `rings` (directions of any positive length trusted
+/// to bound a valid region, as for [`clamped_cosine_integral_rings`]): the clip-free path on the
+/// vertices' images under `m_inv`, the exact path on the validated polygon where it hands over.
+///
+/// # Errors
+///
+/// As [`ltc_integral`]; and those of [`SphericalPolygon::new`] for rings that are not a valid
+/// polygon, on the exact path only (see [`clamped_cosine_integral_rings`]).
+pub fn ltc_integral_rings<'a, I>(rings: I, m_inv: glam::DMat3) -> Result<f64, crate::GeomError>
+where
+    I: IntoIterator<Item = &'a [DVec3]>,
+    I::IntoIter: Clone,
+{
+    let rings = rings.into_iter();
+    let mut one = rings.clone();
+    let fast = match (one.next(), one.next()) {
+        (None, _) => return Ok(0.0),
+        (Some(ring), None) => transformed_clip_free(ring, &m_inv, Exact),
+        _ => transformed_clip_free(&RingChain(rings.clone()), &m_inv, Exact),
+    };
+    match fast {
+        Some(v) => Ok(v),
+        None => ltc_integral(&polygon_of_rings(rings)?, m_inv),
+    }
+}
+
+/// The validated polygon of rings of directions of any positive length: the exact paths of
+/// [`clamped_cosine_integral_rings`] and [`ltc_integral_rings`], out of line.
+#[cold]
+#[inline(never)]
+fn polygon_of_rings<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]>,
+) -> Result<SphericalPolygon, crate::GeomError> {
+    let mut out = alloc::vec::Vec::new();
+    for ring in rings {
+        let mut r = alloc::vec::Vec::with_capacity(ring.len());
+        for &v in ring {
+            r.push(v.try_normalize().ok_or(crate::GeomError::Degenerate(
+                "a ring vertex is zero or not finite",
+            ))?);
+        }
+        out.push(r);
+    }
+    SphericalPolygon::new(out)
+}
+
 /// The clip-free sum of [`clamped_cosine_integral_clip_free`] over the images of the polygon's
 /// vertices under `map`, with the edge term given: a single ring through [`single_ring_sum`],
 /// several through [`ring_sum`]. `None` where the exact path must decide (a vertex on the

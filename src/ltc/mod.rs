@@ -62,8 +62,8 @@ pub use ggx::{
 };
 pub use integrate::{
     EDGE_FACTOR_RATIONAL_MAX_ERROR, clamped_cosine_integral, clamped_cosine_integral_clip_free,
-    clamped_cosine_integral_rational, edge_factor_rational, ggx_polygon_integral, ltc_integral,
-    ltc_integral_rational,
+    clamped_cosine_integral_rational, clamped_cosine_integral_rings, edge_factor_rational,
+    ggx_polygon_integral, ltc_integral, ltc_integral_rational, ltc_integral_rings,
 };
 pub(crate) use integrate::{
     clamped_cosine_integral_upper, ltc_rings_integral, upper_rings_integral,

@@ -61,20 +61,22 @@ impl ClosedMesh {
     ///
     /// # Errors
     ///
-    /// - [`GeomError::OpenMesh`] naming a triangle at an edge that is not shared by exactly two
-    ///   triangles running opposite ways (a border, a non-manifold edge or an inconsistent
-    ///   orientation);
+    /// - [`GeomError::OpenMesh`] naming an edge (its two vertices) and a triangle at it that is
+    ///   not shared by exactly two triangles running opposite ways (a border, a non-manifold edge
+    ///   or an inconsistent orientation);
     /// - [`GeomError::NonManifoldVertex`] for a vertex whose triangles form several fans;
     /// - [`GeomError::SelfIntersectingMesh`] naming two triangles that cross, overlap or touch
     ///   away from a shared edge or vertex (two copies of one triangle included).
     pub fn new(mesh: TriangleMesh) -> Result<Self, GeomError> {
         if !mesh.is_closed() {
-            let triangle = mesh
+            let (triangle, edge) = mesh
                 .edges()
                 .iter()
                 .find(|e| e.twin().is_none())
-                .map_or(0, |e| e.f0 as usize);
-            return Err(GeomError::OpenMesh { triangle });
+                .map_or((0, [0, 0]), |e| {
+                    (e.f0 as usize, [e.a as usize, e.b as usize])
+                });
+            return Err(GeomError::OpenMesh { triangle, edge });
         }
         check_fans(&mesh)?;
         check_self_intersections(&mesh)?;
@@ -524,9 +526,15 @@ mod tests {
         let gone = tris.pop().unwrap();
         let open = TriangleMesh::new(c.vertices().to_vec(), tris).unwrap();
         match ClosedMesh::new(open) {
-            Err(GeomError::OpenMesh { triangle }) => {
+            Err(GeomError::OpenMesh { triangle, edge }) => {
+                // The edge is one of the missing triangle's, run as the named triangle runs it.
                 let t = c.triangles()[triangle];
-                assert!(t.iter().filter(|v| gone.contains(v)).count() >= 2, "{t:?}");
+                let [a, b] = edge.map(|v| v as u32);
+                assert!(gone.contains(&a) && gone.contains(&b) && a != b, "{edge:?}");
+                assert!(
+                    (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b),
+                    "{t:?} {edge:?}"
+                );
             }
             other => panic!("{other:?}"),
         }

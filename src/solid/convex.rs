@@ -90,6 +90,7 @@ impl ConvexPolyhedron {
         if let Some(e) = mesh.edges().iter().find(|e| e.twin().is_none()) {
             return Err(GeomError::OpenMesh {
                 triangle: e.f0 as usize,
+                edge: [e.a as usize, e.b as usize],
             });
         }
         Ok(ConvexPolyhedron { mesh: mesh.clone() })

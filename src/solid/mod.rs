@@ -39,7 +39,8 @@ pub(crate) mod separation;
 pub(crate) mod silhouette;
 
 pub use silhouette::{
-    DEFAULT_REGION_RADII, SilhouetteBsp, SilhouetteSampler, TriangleSource, nonconvex_silhouette,
+    DEFAULT_BUILD_BUDGET, DEFAULT_REGION_RADII, SilhouetteBsp, SilhouetteRings, SilhouetteSampler,
+    TriangleSource, nonconvex_silhouette,
 };
 
 pub use bezier::{

@@ -62,8 +62,9 @@ use smallvec::SmallVec;
 
 use super::convex::chain_by_index;
 use super::nonconvex::{
-    Arc, ORDER_ERROR, Outline, collinear, evaluate_rings, outline, outline_with,
+    Arc, ORDER_ERROR, Outline, collinear, evaluate_rings_into, outline, outline_with,
 };
+use super::rings::{SilhouetteRings, spaced};
 use super::triangulated::{
     CellCorners, Extra, OnFace, SNAP_REL, TriangleSource, certified_triangulation, evaluate_stored,
     fan_or_list, raw_stored,
@@ -82,6 +83,14 @@ use crate::sphere::{
 /// silhouette algorithms.
 pub const DEFAULT_REGION_RADII: f64 = 8.0;
 
+/// The default budget of a build ([`SilhouetteBsp::build`] and the other constructors without a
+/// budget of their own): 256 MiB of the storage the build counts (see
+/// [`SilhouetteBsp::build_with_budget`]). The largest trees of the tests stay far below it
+/// (sphere-42: 39 MiB counted, mostly the cells of the first pass, for a tree of 1.3 MiB; a
+/// torus of 8 x 4 segments: 10 MiB; BENCHMARKS.md); a mesh
+/// whose tree would need more gets [`GeomError::OutOfRange`] instead of exhausting memory.
+pub const DEFAULT_BUILD_BUDGET: usize = 256 << 20;
+
 /// Cells thinner than this fraction of the box's half-size are not split: a plane cuts a cell
 /// only when cell vertices lie farther than that on both sides (it keeps the first pass from
 /// creating slivers out of rounding).
@@ -96,6 +105,25 @@ const DIRECT: u32 = 2;
 const RINGS: u32 = 3;
 
 const GIVE_UP_QUERY: &str = "the stored silhouette evaluated at the point has coincident or antipodal vertices (the point is within rounding of a cell boundary)";
+
+/// Why a query is answered by the direct algorithm ([`SilhouetteBsp::direct_reason`]).
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DirectReason {
+    /// The point is outside the tree's box.
+    OutsideBox,
+    /// The point is within the facing predicate's tolerance of a face plane on its path (for
+    /// non-convex solids).
+    FaceBand,
+    /// A triple test on its path is within its rounding bound.
+    TripleBand,
+    /// Its leaf stores no silhouette: a convex polyhedron's inside or a loop that is not one
+    /// chain, a non-convex solid's cell where the direct algorithm gave up at every trial point
+    /// or a combination of triple signs no sample met.
+    DirectLeaf,
+    /// A convex polyhedron's stored loop whose vertices are too close to chain at the point.
+    Spacing,
+}
 
 /// A node test: the front side of a face by the facing predicate, the positive side of
 /// `orient3d` of three mesh vertices and the point, or the sign of `det(n_a, n_b, n_c)` for three
@@ -152,6 +180,9 @@ impl Source {
 pub struct SilhouetteBsp {
     source: Source,
     planes: Vec<SplitPlane>,
+    /// The leading face planes of `planes` as unit normal and offset from the bounding sphere's
+    /// center (the facing predicate's form), read by the descent without a dispatch.
+    face_eqs: Vec<(DVec3, f64)>,
     nodes: Vec<u32>,
     /// Bits of an inner node word that hold the right child's index; the plane index is above.
     child_bits: u32,
@@ -164,6 +195,8 @@ pub struct SilhouetteBsp {
     direct_leaves: u32,
     /// Whether leaves with rings carry a triangulation section (built with triangulations).
     triangulated: bool,
+    /// The bytes the build counted against its budget.
+    build_bytes: usize,
 }
 
 /// The rings of a leaf as arcs and ring ends, read from the leaf data.
@@ -188,15 +221,33 @@ impl SilhouetteBsp {
     ///
     /// [`GeomError::NonFiniteArgument`] or [`GeomError::Degenerate`] for a box that is not
     /// finite or has no volume; [`GeomError::OutOfRange`] when the tree does not fit the
-    /// compact node format (planes times nodes beyond `2^31`).
+    /// compact node format (planes times nodes beyond `2^31`) or the build exceeds
+    /// [`DEFAULT_BUILD_BUDGET`] (see [`SilhouetteBsp::build_with_budget`]).
     pub fn build_in(solid: &ClosedMesh, lo: DVec3, hi: DVec3) -> Result<Self, GeomError> {
-        if let Ok(p) = ConvexPolyhedron::from_mesh(solid.mesh()) {
-            return SilhouetteBsp::build_convex_in(&p, lo, hi);
-        }
-        check_region(lo, hi)?;
-        let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi);
-        b.build_nonconvex();
-        b.finish(Source::Solid(solid.clone()), lo, hi)
+        SilhouetteBsp::build_with_budget(solid, lo, hi, false, DEFAULT_BUILD_BUDGET)
+    }
+
+    /// [`SilhouetteBsp::build_in`] (or, with `triangulated`,
+    /// [`SilhouetteBsp::build_triangulated_in`]) with a budget of `budget` bytes: the build counts
+    /// the storage it holds (the cells of its first pass, with their vertices and the planes
+    /// through each; the nodes, leaf data and planes of the tree as it grows, at their sizes
+    /// while building, which exceed the final [`SilhouetteBsp::byte_size`]) and stops with an
+    /// error as soon as the count exceeds the budget. Freed storage is not subtracted, so the
+    /// count bounds the build's peak memory from above (allocator overhead aside). The default
+    /// budget is [`DEFAULT_BUILD_BUDGET`].
+    ///
+    /// # Errors
+    ///
+    /// [`GeomError::OutOfRange`] (its value the bytes counted when the build stopped, its limit
+    /// the budget) when the build would need more; otherwise as [`SilhouetteBsp::build_in`].
+    pub fn build_with_budget(
+        solid: &ClosedMesh,
+        lo: DVec3,
+        hi: DVec3,
+        triangulated: bool,
+        budget: usize,
+    ) -> Result<Self, GeomError> {
+        Ok(SilhouetteBsp::build_recording(solid, lo, hi, triangulated, false, budget)?.0)
     }
 
     /// As [`SilhouetteBsp::build`], also storing per leaf a triangulation of its silhouette
@@ -229,7 +280,7 @@ impl SilhouetteBsp {
         lo: DVec3,
         hi: DVec3,
     ) -> Result<Self, GeomError> {
-        Ok(SilhouetteBsp::build_triangulated_recording(solid, lo, hi, false)?.0)
+        SilhouetteBsp::build_with_budget(solid, lo, hi, true, DEFAULT_BUILD_BUDGET)
     }
 
     /// As [`SilhouetteBsp::build_triangulated`], also returning the vertices of the cell of
@@ -244,22 +295,31 @@ impl SilhouetteBsp {
         solid: &ClosedMesh,
     ) -> Result<(Self, Vec<Vec<DVec3>>), GeomError> {
         let (lo, hi) = default_region(solid.mesh());
-        SilhouetteBsp::build_triangulated_recording(solid, lo, hi, true)
+        SilhouetteBsp::build_recording(solid, lo, hi, true, true, DEFAULT_BUILD_BUDGET)
     }
 
-    fn build_triangulated_recording(
+    /// The builds of a closed mesh: convex or not, with triangulations or not, recording the
+    /// cells of the leaves that store one, within `budget` bytes.
+    fn build_recording(
         solid: &ClosedMesh,
         lo: DVec3,
         hi: DVec3,
+        triangulated: bool,
         record: bool,
+        budget: usize,
     ) -> Result<(Self, Vec<Vec<DVec3>>), GeomError> {
         if let Ok(p) = ConvexPolyhedron::from_mesh(solid.mesh()) {
-            return Ok((SilhouetteBsp::build_convex_in(&p, lo, hi)?, Vec::new()));
+            return Ok((
+                SilhouetteBsp::build_convex_budget(&p, lo, hi, budget)?,
+                Vec::new(),
+            ));
         }
         check_region(lo, hi)?;
-        let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi);
-        b.triangulate = Some(OnFace::new(solid.mesh()));
-        b.cells = record.then(Vec::new);
+        let mut b = Builder::new(solid.mesh(), Some(solid), lo, hi, budget);
+        if triangulated {
+            b.triangulate = Some(OnFace::new(solid.mesh()));
+            b.cells = record.then(Vec::new);
+        }
         b.build_nonconvex();
         let cells = b.cells.take().unwrap_or_default();
         Ok((b.finish(Source::Solid(solid.clone()), lo, hi)?, cells))
@@ -286,8 +346,19 @@ impl SilhouetteBsp {
         lo: DVec3,
         hi: DVec3,
     ) -> Result<Self, GeomError> {
+        SilhouetteBsp::build_convex_budget(poly, lo, hi, DEFAULT_BUILD_BUDGET)
+    }
+
+    /// [`SilhouetteBsp::build_convex_in`] within `budget` bytes (see
+    /// [`SilhouetteBsp::build_with_budget`]).
+    fn build_convex_budget(
+        poly: &ConvexPolyhedron,
+        lo: DVec3,
+        hi: DVec3,
+        budget: usize,
+    ) -> Result<Self, GeomError> {
         check_region(lo, hi)?;
-        let mut b = Builder::new(poly.mesh(), None, lo, hi);
+        let mut b = Builder::new(poly.mesh(), None, lo, hi, budget);
         b.build_convex();
         b.finish(Source::Convex(poly.clone()), lo, hi)
     }
@@ -309,7 +380,7 @@ impl SilhouetteBsp {
         let Some(leaf) = self.leaf_of(x, matches!(self.source, Source::Solid(_))) else {
             return self.direct(frame);
         };
-        let mut at = leaf as usize;
+        let at = leaf as usize;
         match &self.source {
             Source::Convex(poly) => match self.convex_loop(poly, at, frame) {
                 Some(out) => {
@@ -320,34 +391,149 @@ impl SilhouetteBsp {
             },
             Source::Solid(solid) => {
                 let header = self.read(at);
-                at += 1;
                 match header {
                     EMPTY => Ok(SphericalPolygon::empty()),
                     FULL => Ok(SphericalPolygon::full()),
                     DIRECT => nonconvex_silhouette(solid, frame),
                     _ => {
-                        let (arcs, ends) = self.read_rings(header, &mut at);
-                        let rings = evaluate_rings(solid.mesh(), &arcs, &ends, frame)?;
-                        let mut verts: SmallVec<[DVec3; 12]> = SmallVec::new();
-                        let mut ring_ends: SmallVec<[u32; 2]> = SmallVec::new();
-                        for r in &rings {
-                            let n = r.len();
-                            let ok = n >= 3
-                                && (0..n).all(|k| {
-                                    let (a, b) = (r[k], r[(k + 1) % n]);
-                                    (a - b).length() > COINCIDENT_TOLERANCE
-                                        && (a + b).length() > ANTIPODAL_TOLERANCE
-                                });
-                            if !ok {
-                                return Err(GeomError::Undecidable(GIVE_UP_QUERY));
-                            }
-                            verts.extend_from_slice(r);
-                            ring_ends.push(verts.len() as u32);
-                        }
-                        Ok(SphericalPolygon::from_parts(verts, ring_ends))
+                        let mut out = SilhouetteRings::new();
+                        self.solid_rings(solid, at, frame, &mut out)?;
+                        // Unit vectors, and the checks `solid_rings` made.
+                        Ok(out.into_polygon_unchecked())
                     }
                 }
             }
+        }
+    }
+
+    /// [`SilhouetteBsp::query`] written to `out` as rings of directions that need not be unit
+    /// vectors ([`SilhouetteRings`]), for the clip-free integrals
+    /// ([`clamped_cosine_integral_rings`](crate::ltc::clamped_cosine_integral_rings),
+    /// [`ltc_integral_rings`](crate::ltc::ltc_integral_rings)), which need none: for a convex
+    /// polyhedron the stored loop's vertices in the local frame as they are (no normalization;
+    /// the spacing test decided as the query decides it), for a closed non-convex mesh the
+    /// query's rings; where the query answers with the direct algorithm, a copy of its polygon's
+    /// rings. The same region as [`SilhouetteBsp::query`].
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use arealight::glam::DVec3;
+    /// use arealight::internals::thesis_polyhedra;
+    /// use arealight::ltc::{clamped_cosine_integral, clamped_cosine_integral_rings};
+    /// use arealight::solid::{ClosedMesh, ShadingFrame, SilhouetteBsp, SilhouetteRings};
+    /// let (_, bowl) = thesis_polyhedra()?.pop().unwrap();
+    /// let bsp = SilhouetteBsp::build(&ClosedMesh::new(bowl)?)?;
+    /// let frame = ShadingFrame::new(DVec3::new(0.3, -0.2, 3.0), DVec3::Z, DVec3::Z)?;
+    /// let mut rings = SilhouetteRings::new();
+    /// bsp.query_rings(&frame, &mut rings)?;
+    /// let fast = clamped_cosine_integral_rings(rings.rings())?;
+    /// assert!((fast - clamped_cosine_integral(&bsp.query(&frame)?)).abs() < 1e-14);
+    /// # Ok::<(), arealight::GeomError>(())
+    /// ```
+    ///
+    /// # Errors
+    ///
+    /// As [`SilhouetteBsp::query`].
+    pub fn query_rings(
+        &self,
+        frame: &ShadingFrame,
+        out: &mut SilhouetteRings,
+    ) -> Result<(), GeomError> {
+        out.clear();
+        let x = frame.origin();
+        let leaf = if x.cmpge(self.lo).all() && x.cmple(self.hi).all() {
+            self.leaf_of(x, matches!(self.source, Source::Solid(_)))
+        } else {
+            None
+        };
+        let Some(leaf) = leaf else {
+            out.set_polygon(&self.direct(frame)?);
+            return Ok(());
+        };
+        let at = leaf as usize;
+        match &self.source {
+            Source::Convex(poly) => {
+                if !self.convex_loop_raw(poly, at, frame, out) {
+                    out.set_polygon(&convex_silhouette(poly, frame)?);
+                }
+                Ok(())
+            }
+            Source::Solid(solid) => match self.read(at) {
+                EMPTY => Ok(()),
+                FULL => {
+                    out.set_full();
+                    Ok(())
+                }
+                DIRECT => {
+                    out.set_polygon(&nonconvex_silhouette(solid, frame)?);
+                    Ok(())
+                }
+                _ => self.solid_rings(solid, at, frame, out),
+            },
+        }
+    }
+
+    /// The rings of a non-convex solid's leaf with rings at `at` evaluated at the point
+    /// ([`evaluate_rings_into`]: unit vectors) into `out`, checked as the query checks them: at
+    /// least three vertices per ring, consecutive ones neither coincident nor antipodal.
+    fn solid_rings(
+        &self,
+        solid: &ClosedMesh,
+        mut at: usize,
+        frame: &ShadingFrame,
+        out: &mut SilhouetteRings,
+    ) -> Result<(), GeomError> {
+        let header = self.read(at);
+        at += 1;
+        let (arcs, ends) = self.read_rings(header, &mut at);
+        evaluate_rings_into(solid.mesh(), &arcs, &ends, frame, out)?;
+        for r in out.rings() {
+            let n = r.len();
+            let ok = n >= 3
+                && (0..n).all(|k| {
+                    let (a, b) = (r[k], r[(k + 1) % n]);
+                    (a - b).length() > COINCIDENT_TOLERANCE
+                        && (a + b).length() > ANTIPODAL_TOLERANCE
+                });
+            if !ok {
+                return Err(GeomError::Undecidable(GIVE_UP_QUERY));
+            }
+        }
+        Ok(())
+    }
+
+    /// The stored loop of a convex polyhedron's leaf at `at` written to `out` as the vertices in
+    /// the local frame, not normalized, where [`SilhouetteBsp::convex_loop`] returns it (the same
+    /// spacing decisions, [`spaced`]); `false` where it returns `None`.
+    fn convex_loop_raw(
+        &self,
+        poly: &ConvexPolyhedron,
+        at: usize,
+        frame: &ShadingFrame,
+        out: &mut SilhouetteRings,
+    ) -> bool {
+        let len = self.read(at) as usize;
+        if len == 0 {
+            return false;
+        }
+        let verts = poly.vertices();
+        let first = frame.to_local(verts[self.read(at + 1) as usize]);
+        out.push(first);
+        let mut prev = first;
+        let mut ok = true;
+        for k in 1..len {
+            let cur = frame.to_local(verts[self.read(at + 1 + k) as usize]);
+            ok &= spaced(prev, cur, MATCH_TOLERANCE, ANTIPODAL_TOLERANCE);
+            out.push(cur);
+            prev = cur;
+        }
+        if ok && spaced(prev, first, MATCH_TOLERANCE, ANTIPODAL_TOLERANCE) {
+            out.close_ring();
+            true
+        } else {
+            out.clear();
+            false
         }
     }
 
@@ -534,6 +720,34 @@ impl SilhouetteBsp {
         }
     }
 
+    /// Why [`SilhouetteBsp::query`] answers the point with the direct algorithm rather than from
+    /// a stored leaf; `None` where it evaluates a stored leaf. For the tests and benchmarks that
+    /// report how often that happens.
+    #[doc(hidden)]
+    #[must_use]
+    pub fn direct_reason(&self, frame: &ShadingFrame) -> Option<DirectReason> {
+        let x = frame.origin();
+        if !(x.cmpge(self.lo).all() && x.cmple(self.hi).all()) {
+            return Some(DirectReason::OutsideBox);
+        }
+        let at = match self.descend(x, matches!(self.source, Source::Solid(_))) {
+            Ok(at) => at as usize,
+            Err(r) => return Some(r),
+        };
+        match &self.source {
+            Source::Convex(poly) => {
+                if self.read(at) == 0 {
+                    Some(DirectReason::DirectLeaf)
+                } else {
+                    self.convex_loop(poly, at, frame)
+                        .is_none()
+                        .then_some(DirectReason::Spacing)
+                }
+            }
+            Source::Solid(_) => (self.read(at) == DIRECT).then_some(DirectReason::DirectLeaf),
+        }
+    }
+
     /// The data offset of the leaf holding `x`; `None` when a triple test is within rounding,
     /// or, with `band`, when `x` lies within the facing predicate's tolerance of a face plane
     /// on the path. A non-convex solid's query always sets it: there the face counts as
@@ -542,7 +756,14 @@ impl SilhouetteBsp {
     /// up, itself). The stored triangulations set it for convex polyhedra too: within the band
     /// a face counted edge-on may in fact be seen from its front, and the loop is then convex
     /// only up to the tolerance.
+    #[inline]
     fn leaf_of(&self, x: DVec3, band: bool) -> Option<u32> {
+        self.descend(x, band).ok()
+    }
+
+    /// [`SilhouetteBsp::leaf_of`], saying why where there is no leaf.
+    #[inline(always)]
+    fn descend(&self, x: DVec3, band: bool) -> Result<u32, DirectReason> {
         let mesh = self.source.mesh();
         // The facing predicate (`face_side`) at x, its tolerance computed once.
         let at = FacingAt::new(mesh, x);
@@ -552,13 +773,28 @@ impl SilhouetteBsp {
         loop {
             let w = self.nodes[i];
             if w & LEAF != 0 {
-                return Some(w & !LEAF);
+                return Ok(w & !LEAF);
             }
-            let positive = match self.planes[(w >> self.child_bits) as usize] {
+            let p = (w >> self.child_bits) as usize;
+            // Face planes (interned first) from their own table: one load of the plane, no
+            // dispatch; the distance is the facing predicate's, bit for bit.
+            if let Some(&(n, d)) = self.face_eqs.get(p) {
+                let s = at.distance(n, d);
+                if band && s.abs() <= at.tol() {
+                    return Err(DirectReason::FaceBand);
+                }
+                i = if in_front(s, at.tol()) {
+                    (w & mask) as usize
+                } else {
+                    i + 1
+                };
+                continue;
+            }
+            let positive = match self.planes[p] {
                 SplitPlane::Face(f) => {
                     let s = at.distance(normals[f as usize], offsets[f as usize]);
                     if band && s.abs() <= at.tol() {
-                        return None;
+                        return Err(DirectReason::FaceBand);
                     }
                     in_front(s, at.tol())
                 }
@@ -570,7 +806,7 @@ impl SilhouetteBsp {
                         c3(x),
                     ) > 0.0
                 }
-                SplitPlane::Triple(t) => triple_sign(mesh, t, x)?,
+                SplitPlane::Triple(t) => triple_sign(mesh, t, x).ok_or(DirectReason::TripleBand)?,
             };
             i = if positive { (w & mask) as usize } else { i + 1 };
         }
@@ -700,6 +936,14 @@ impl SilhouetteBsp {
         4 * self.nodes.len()
             + self.data.len()
             + core::mem::size_of::<SplitPlane>() * self.planes.len()
+            + core::mem::size_of::<(DVec3, f64)>() * self.face_eqs.len()
+    }
+
+    /// The bytes the build counted against its budget ([`SilhouetteBsp::build_with_budget`]):
+    /// an upper bound on its peak storage.
+    #[must_use]
+    pub fn build_bytes(&self) -> usize {
+        self.build_bytes
     }
 
     /// The box of points answered by the tree.
@@ -1027,10 +1271,20 @@ struct Builder<'a> {
     /// The last triangulation certified per leaf structure (encoded outline), tried first in
     /// the next cell with that structure (neighbouring cells often share it).
     last_triangulation: BTreeMap<Vec<u32>, Vec<[u32; 3]>>,
+    /// Bytes the build may hold ([`SilhouetteBsp::build_with_budget`]) and bytes counted so
+    /// far; once over, every step returns at once and [`Builder::finish`] fails.
+    budget: usize,
+    used: usize,
 }
 
 impl<'a> Builder<'a> {
-    fn new(mesh: &'a TriangleMesh, solid: Option<&'a ClosedMesh>, lo: DVec3, hi: DVec3) -> Self {
+    fn new(
+        mesh: &'a TriangleMesh,
+        solid: Option<&'a ClosedMesh>,
+        lo: DVec3,
+        hi: DVec3,
+        budget: usize,
+    ) -> Self {
         Builder {
             mesh,
             solid,
@@ -1052,7 +1306,29 @@ impl<'a> Builder<'a> {
             triangulate: None,
             cells: None,
             last_triangulation: BTreeMap::new(),
+            budget,
+            used: 0,
         }
+    }
+
+    /// Counts `bytes` more held by the build; `false` once the count exceeds the budget.
+    #[inline]
+    fn charge(&mut self, bytes: usize) -> bool {
+        self.used = self.used.saturating_add(bytes);
+        self.used <= self.budget
+    }
+
+    /// Whether the build is over its budget (and stopping).
+    #[inline]
+    fn over(&self) -> bool {
+        self.used > self.budget
+    }
+
+    /// Appends a node, counting it.
+    #[inline]
+    fn push_node(&mut self, node: BuildNode) {
+        self.charge(core::mem::size_of::<BuildNode>());
+        self.nodes.push(node);
     }
 
     fn plane(&mut self, p: SplitPlane) -> u32 {
@@ -1060,6 +1336,13 @@ impl<'a> Builder<'a> {
             return i;
         }
         let i = self.planes.len() as u32;
+        // The plane, its equation, its index entry and its memo slots.
+        self.charge(
+            core::mem::size_of::<SplitPlane>() * 2
+                + core::mem::size_of::<(DVec3, f64)>()
+                + core::mem::size_of::<u32>() * 2
+                + core::mem::size_of::<Option<bool>>(),
+        );
         self.planes.push(p);
         self.geo.push(plane_equation(self.mesh, p));
         self.index.insert(p, i);
@@ -1087,10 +1370,13 @@ impl<'a> Builder<'a> {
 
     /// First pass: the cells of the arrangement of `cands` in `cell` (explicit splitting, the
     /// first cutting plane each time).
-    fn enumerate(&self, cell: Cell, cands: Vec<u32>) -> Vec<Cell> {
+    fn enumerate(&mut self, cell: Cell, cands: Vec<u32>) -> Vec<Cell> {
         let mut out = Vec::new();
         let mut stack = vec![(cell, cands)];
         while let Some((cell, cands)) = stack.pop() {
+            if self.over() {
+                break;
+            }
             let cutting: Vec<u32> = cands
                 .into_iter()
                 .filter(|&i| {
@@ -1099,6 +1385,15 @@ impl<'a> Builder<'a> {
                 })
                 .collect();
             let Some((&first, rest)) = cutting.split_first() else {
+                // The cell is kept (its vertices and their planes) and gets a representative
+                // point and a word of sides per 64 face planes in the second pass.
+                self.charge(
+                    core::mem::size_of::<Cell>()
+                        + cell.p.capacity() * core::mem::size_of::<DVec3>()
+                        + cell.tag.capacity() * core::mem::size_of::<SmallVec<[u32; 6]>>()
+                        + core::mem::size_of::<DVec3>()
+                        + 8 * self.geo.len().div_ceil(64),
+                );
                 out.push(cell);
                 continue;
             };
@@ -1121,6 +1416,9 @@ impl<'a> Builder<'a> {
         cands: &[u32],
         leaf: &mut dyn FnMut(&mut Self, u32),
     ) {
+        if self.over() {
+            return;
+        }
         let bit = |item: u32, c: u32| {
             sides[item as usize * words + (c >> 6) as usize] >> (c & 63) & 1 == 1
         };
@@ -1156,7 +1454,7 @@ impl<'a> Builder<'a> {
             }
         }
         let node = self.nodes.len();
-        self.nodes.push(BuildNode::Inner { plane: c, right: 0 });
+        self.push_node(BuildNode::Inner { plane: c, right: 0 });
         let (neg, pos) = items.split_at_mut(k);
         self.balanced(sides, words, neg, &keep, leaf);
         let right = self.nodes.len() as u32;
@@ -1166,7 +1464,8 @@ impl<'a> Builder<'a> {
 
     fn leaf_word(&mut self, payload: &[u32]) {
         self.leaves += 1;
-        self.nodes.push(BuildNode::Leaf(self.data.len() as u32));
+        self.charge(core::mem::size_of_val(payload));
+        self.push_node(BuildNode::Leaf(self.data.len() as u32));
         self.data.extend_from_slice(payload);
     }
 
@@ -1327,6 +1626,9 @@ impl<'a> Builder<'a> {
 
     /// Splits `cell` by the planes of `pairs` whose crossing (or fold) can change inside it.
     fn split_pairs(&mut self, cell: Cell, pairs: Vec<Pair>) {
+        if self.over() {
+            return;
+        }
         // Side of the cell on each plane the pairs use (None: cut), computed once per plane.
         self.now += 1;
         let now = self.now;
@@ -1397,7 +1699,7 @@ impl<'a> Builder<'a> {
         let (n, d) = self.geo[c as usize];
         let (neg, pos) = cell.split(n, d, c + 6, self.eps);
         let node = self.nodes.len();
-        self.nodes.push(BuildNode::Inner { plane: c, right: 0 });
+        self.push_node(BuildNode::Inner { plane: c, right: 0 });
         self.split_pairs(neg, live.clone());
         let right = self.nodes.len() as u32;
         self.nodes[node] = BuildNode::Inner { plane: c, right };
@@ -1412,6 +1714,9 @@ impl<'a> Builder<'a> {
     /// triple test, and each combination of their signs met at sample points of the cell gets
     /// the outline at such a sample; combinations no sample met are answered directly.
     fn outline_leaf(&mut self, cell: &Cell) {
+        if self.over() {
+            return;
+        }
         let Some(solid) = self.solid else {
             self.direct_leaves += 1;
             self.leaf_word(&[DIRECT]);
@@ -1526,6 +1831,9 @@ impl<'a> Builder<'a> {
         mut samples: Vec<(DVec3, u32)>,
         cell: Option<&CellCorners>,
     ) {
+        if self.over() {
+            return;
+        }
         if samples.is_empty() {
             self.direct_leaves += 1;
             self.leaf_word(&[DIRECT]);
@@ -1555,7 +1863,7 @@ impl<'a> Builder<'a> {
             .collect();
         samples.retain(|s| s.1 >> k & 1 == 0);
         let node = self.nodes.len();
-        self.nodes.push(BuildNode::Inner {
+        self.push_node(BuildNode::Inner {
             plane: id,
             right: 0,
         });
@@ -1689,6 +1997,14 @@ impl<'a> Builder<'a> {
     }
 
     fn finish(mut self, source: Source, lo: DVec3, hi: DVec3) -> Result<SilhouetteBsp, GeomError> {
+        if self.over() {
+            return Err(GeomError::OutOfRange {
+                what: "bytes held by the BSP build (its budget; see \
+                       SilhouetteBsp::build_with_budget)",
+                value: self.used as f64,
+                limit: self.budget as f64,
+            });
+        }
         let n = self.nodes.len() as u64;
         let child_bits = (64 - n.max(2).leading_zeros()).max(1);
         let plane_bits = 64 - (self.planes.len() as u64).max(1).leading_zeros();
@@ -1714,8 +2030,20 @@ impl<'a> Builder<'a> {
         for &x in &self.data {
             data.extend_from_slice(&x.to_le_bytes()[..width as usize]);
         }
+        let face_eqs = self
+            .planes
+            .iter()
+            .map_while(|p| match *p {
+                SplitPlane::Face(f) => Some((
+                    self.mesh.normals()[f as usize],
+                    self.mesh.offsets()[f as usize],
+                )),
+                _ => None,
+            })
+            .collect();
         Ok(SilhouetteBsp {
             source,
+            face_eqs,
             planes: self.planes,
             nodes,
             child_bits,
@@ -1726,6 +2054,7 @@ impl<'a> Builder<'a> {
             leaves: self.leaves,
             direct_leaves: self.direct_leaves,
             triangulated: self.triangulate.is_some(),
+            build_bytes: self.used,
         })
     }
 }

@@ -6,8 +6,9 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use smallvec::SmallVec;
 
+use super::rings::{SilhouetteRings, spaced};
 use crate::GeomError;
-use crate::solid::facing::Side;
+use crate::solid::facing::{FacingAt, Side};
 use crate::solid::{ConvexPolyhedron, ShadingFrame};
 use crate::sphere::{
     ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, MATCH_TOLERANCE, SphericalPolygon,
@@ -42,84 +43,172 @@ pub fn convex_silhouette(
     poly: &ConvexPolyhedron,
     frame: &ShadingFrame,
 ) -> Result<SphericalPolygon, GeomError> {
-    let mut s = Vec::new();
-    let tol = poly.facing(frame.origin(), &mut s);
-    let front = |d: f64| Side::of(d, tol) == Side::Front;
-    if !s.iter().any(|&d| front(d)) {
-        // No front face: the point is inside or on the surface. The polyhedron then covers, seen
-        // from the point, the intersection of the closed half-spaces behind the faces the point
-        // lies on: the full sphere inside, a hemisphere on a face (a cube standing on the
-        // ground covers the ground point's whole upper hemisphere), a lune on an edge.
-        let mut region = SphericalPolygon::full();
-        for (f, &d) in s.iter().enumerate() {
-            if Side::of(d, tol) == Side::On {
-                let n = frame.dir_to_local(poly.mesh().triangle_normal(f));
-                region = region.try_clip_to_hemisphere(-n).map_err(|e| {
-                    e.give_up("a face normal of a convex polyhedron is not a direction")
-                })?;
-            }
+    let (ring, contour) = match convex_contour(poly, frame.origin()) {
+        ConvexContour::NoFront => return inside_region(poly, frame),
+        ConvexContour::Loop(ring, contour) => (ring, contour),
+        ConvexContour::Edges(contour) => {
+            return order_edges_of(&contour, poly.vertices(), frame);
         }
-        return Ok(region);
+    };
+    let verts = poly.vertices();
+    // The silhouette of a convex polyhedron seen from outside is one simple loop through
+    // distinct vertices, which are at least about FACE_TOLERANCE apart in direction (they span
+    // front faces, whose planes miss the point by more than the tolerance). So when the
+    // combinatorial walk closes one loop, only consecutive-vertex spacing needs checking, not
+    // the quadratic simplicity test of `SphericalPolygon::new`.
+    let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(ring.len());
+    for &i in &ring {
+        let Some(u) = frame.to_local(verts[i as usize]).try_normalize() else {
+            return order_edges_of(&contour, verts, frame);
+        };
+        out.push(u);
     }
-    // Contour edges as directed pairs of vertex indices.
+    let n = out.len();
+    let spaced = n >= 3
+        && (0..n).all(|k| {
+            let (a, b) = (out[k], out[(k + 1) % n]);
+            (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
+        });
+    if spaced {
+        let ends: SmallVec<[u32; 2]> = smallvec::smallvec![n as u32];
+        return Ok(SphericalPolygon::from_parts(out, ends));
+    }
+    // Vertices closer than the general path's merge tolerance: a polyhedron seen from far away
+    // (1e-9 rad across at 1e9 of its sizes) or an edge seen nearly end-on. Merging would
+    // collapse the ring, but the walk's order is exact, so the ring stands whenever it is a
+    // valid polygon (the sphere layer's validation resolves such tiny polygons exactly), once
+    // the ends of edges seen end-on, the same direction within rounding, are one vertex (which
+    // moves the boundary by less than COINCIDENT_TOLERANCE).
+    let mut ring: Vec<DVec3> = Vec::with_capacity(n);
+    for &u in &out {
+        if ring
+            .last()
+            .is_none_or(|&l| (u - l).length() > COINCIDENT_TOLERANCE)
+        {
+            ring.push(u);
+        }
+    }
+    while ring.len() > 1 && (ring[0] - ring[ring.len() - 1]).length() <= COINCIDENT_TOLERANCE {
+        ring.pop();
+    }
+    if ring.len() >= 3
+        && let Ok(p) = SphericalPolygon::new(alloc::vec![ring])
+    {
+        return Ok(p);
+    }
+    order_edges_of(&contour, verts, frame)
+}
+
+/// [`convex_silhouette`] written to `out` as rings of directions that are not normalized
+/// ([`SilhouetteRings`]), for the clip-free integrals, which need no unit vectors: where
+/// [`convex_silhouette`] returns the chained loop as it is, the same vertices before
+/// normalization (the spacing test decided the same way, on the unit vectors where it is
+/// close); elsewhere (no face in front, a loop that needs merging or the general ordering) a
+/// copy of its polygon's rings.
+///
+/// # Errors
+///
+/// As [`convex_silhouette`].
+pub fn convex_silhouette_rings(
+    poly: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+    out: &mut SilhouetteRings,
+) -> Result<(), GeomError> {
+    out.clear();
+    if let ConvexContour::Loop(ring, _) = convex_contour(poly, frame.origin()) {
+        let verts = poly.vertices();
+        let n = ring.len();
+        let first = frame.to_local(verts[ring[0] as usize]);
+        let mut prev = first;
+        out.push(first);
+        let mut ok = n >= 3;
+        for &i in &ring[1..] {
+            let cur = frame.to_local(verts[i as usize]);
+            ok &= spaced(prev, cur, MATCH_TOLERANCE, ANTIPODAL_TOLERANCE);
+            out.push(cur);
+            prev = cur;
+        }
+        if ok && spaced(prev, first, MATCH_TOLERANCE, ANTIPODAL_TOLERANCE) {
+            out.close_ring();
+            return Ok(());
+        }
+    }
+    out.set_polygon(&convex_silhouette(poly, frame)?);
+    Ok(())
+}
+
+/// The contour of a convex polyhedron seen from a point.
+enum ConvexContour {
+    /// No face in front by the facing predicate: the point is inside or on the surface.
+    NoFront,
+    /// The contour edges chained into one loop by vertex index ([`chain_by_index`]), with the
+    /// directed edges themselves.
+    Loop(SmallVec<[u32; 24]>, SmallVec<[(u32, u32); 24]>),
+    /// Directed contour edges that do not chain into one loop by index.
+    Edges(SmallVec<[(u32, u32); 24]>),
+}
+
+/// The contour edges of `poly` seen from `x` (thesis 003 eq. 4.1/4.2), each directed so that its
+/// front face lies on its left on the sphere (see [`convex_silhouette`]), chained where they make
+/// one loop by index. Front faces by the facing predicate, the same distances and tolerance as
+/// [`face_distances`](crate::solid::facing::face_distances), kept as flags on the stack.
+fn convex_contour(poly: &ConvexPolyhedron, x: DVec3) -> ConvexContour {
+    let mesh = poly.mesh();
+    let at = FacingAt::new(mesh, x);
+    // Front faces as flags on the stack for up to 256 faces.
+    let faces = mesh.normals().len();
+    let mut inline = [false; 256];
+    let mut heap = Vec::new();
+    let front: &mut [bool] = if faces <= inline.len() {
+        &mut inline[..faces]
+    } else {
+        heap.resize(faces, false);
+        &mut heap
+    };
+    let mut any = false;
+    for ((is, n), &d) in front.iter_mut().zip(mesh.normals()).zip(mesh.offsets()) {
+        *is = at.front(*n, d);
+        any |= *is;
+    }
+    if !any {
+        return ConvexContour::NoFront;
+    }
     let mut contour: SmallVec<[(u32, u32); 24]> = SmallVec::new();
     for e in poly.edges() {
         // Every edge of a convex polyhedron has both faces (checked by `from_mesh`).
-        match (front(s[e.f0 as usize]), front(s[e.f1 as usize])) {
+        match (front[e.f0 as usize], front[e.f1 as usize]) {
             (true, false) => contour.push((e.b, e.a)),
             (false, true) => contour.push((e.a, e.b)),
             _ => {}
         }
     }
-    let verts = poly.vertices();
-    if let Some(ring) = chain_by_index(&contour, verts.len()) {
-        // The silhouette of a convex polyhedron seen from outside is one simple loop through
-        // distinct vertices, which are at least about FACE_TOLERANCE apart in direction (they
-        // span front faces, whose planes miss the point by more than the tolerance). So when the
-        // combinatorial walk closes one loop, only consecutive-vertex spacing needs checking,
-        // not the quadratic simplicity test of `SphericalPolygon::new`.
-        let mut out: SmallVec<[DVec3; 12]> = SmallVec::with_capacity(ring.len());
-        for &i in &ring {
-            let Some(u) = frame.to_local(verts[i as usize]).try_normalize() else {
-                return order_edges_of(&contour, verts, frame);
-            };
-            out.push(u);
-        }
-        let n = out.len();
-        let spaced = n >= 3
-            && (0..n).all(|k| {
-                let (a, b) = (out[k], out[(k + 1) % n]);
-                (a - b).length() > MATCH_TOLERANCE && (a + b).length() > ANTIPODAL_TOLERANCE
-            });
-        if spaced {
-            let ends: SmallVec<[u32; 2]> = smallvec::smallvec![n as u32];
-            return Ok(SphericalPolygon::from_parts(out, ends));
-        }
-        // Vertices closer than the general path's merge tolerance: a polyhedron seen from far
-        // away (1e-9 rad across at 1e9 of its sizes) or an edge seen nearly end-on. Merging would
-        // collapse the ring, but the walk's order is exact, so the ring stands whenever it is a
-        // valid polygon (the sphere layer's validation resolves such tiny polygons exactly),
-        // once the ends of edges seen end-on, the same direction within rounding, are one
-        // vertex (which moves the boundary by less than COINCIDENT_TOLERANCE).
-        let mut ring: Vec<DVec3> = Vec::with_capacity(n);
-        for &u in &out {
-            if ring
-                .last()
-                .is_none_or(|&l| (u - l).length() > COINCIDENT_TOLERANCE)
-            {
-                ring.push(u);
-            }
-        }
-        while ring.len() > 1 && (ring[0] - ring[ring.len() - 1]).length() <= COINCIDENT_TOLERANCE {
-            ring.pop();
-        }
-        if ring.len() >= 3
-            && let Ok(p) = SphericalPolygon::new(alloc::vec![ring])
-        {
-            return Ok(p);
+    match chain_by_index(&contour, poly.vertices().len()) {
+        Some(ring) => ConvexContour::Loop(ring, contour),
+        None => ConvexContour::Edges(contour),
+    }
+}
+
+/// What a convex polyhedron covers seen from a point with no face in front (inside or on the
+/// surface): the intersection of the closed half-spaces behind the faces the point lies on:
+/// the full sphere inside, a hemisphere on a face (a cube standing on the ground covers the
+/// ground point's whole upper hemisphere), a lune on an edge.
+#[cold]
+fn inside_region(
+    poly: &ConvexPolyhedron,
+    frame: &ShadingFrame,
+) -> Result<SphericalPolygon, GeomError> {
+    let mut s = Vec::new();
+    let tol = poly.facing(frame.origin(), &mut s);
+    let mut region = SphericalPolygon::full();
+    for (f, &d) in s.iter().enumerate() {
+        if Side::of(d, tol) == Side::On {
+            let n = frame.dir_to_local(poly.mesh().triangle_normal(f));
+            region = region.try_clip_to_hemisphere(-n).map_err(|e| {
+                e.give_up("a face normal of a convex polyhedron is not a direction")
+            })?;
         }
     }
-    order_edges_of(&contour, verts, frame)
+    Ok(region)
 }
 
 /// The general path: the contour's directed edges ordered with [`order_directed_edges`], which

@@ -6,15 +6,17 @@
 mod bsp;
 mod convex;
 mod nonconvex;
+mod rings;
 mod triangle;
 mod triangulated;
 
-pub use bsp::{DEFAULT_REGION_RADII, SilhouetteBsp};
+pub use bsp::{DEFAULT_BUILD_BUDGET, DEFAULT_REGION_RADII, DirectReason, SilhouetteBsp};
 pub(crate) use convex::chain_by_index;
-pub use convex::convex_silhouette;
+pub use convex::{convex_silhouette, convex_silhouette_rings};
 pub use nonconvex::nonconvex_silhouette;
 #[allow(unused_imports)]
 pub(crate) use nonconvex::{Arc, Outline, evaluate_rings, outline};
+pub use rings::SilhouetteRings;
 pub(crate) use triangle::clipped_triangle_polygon;
 pub use triangle::{TriangleRole, triangle_polygon};
 pub use triangulated::{SilhouetteSampler, TriangleSource};

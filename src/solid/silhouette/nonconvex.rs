@@ -24,7 +24,9 @@ use alloc::vec::Vec;
 
 use glam::DVec3;
 use robust::orient3d;
+use smallvec::SmallVec;
 
+use super::rings::SilhouetteRings;
 use crate::GeomError;
 use crate::math::atan2;
 use crate::solid::facing::{Side, face_distances};
@@ -723,23 +725,38 @@ pub(crate) fn arc_start(
     }
 }
 
-/// The rings of directions (local frame) of an outline's arcs seen from the frame's point. Arcs
-/// that subtend more than 120 degrees get an extra vertex at the foot of the perpendicular from
-/// the point to their edge, so that no ring edge comes near half a great circle.
+/// The rings of directions (local frame) of an outline's arcs seen from the frame's point, as
+/// [`evaluate_rings_into`] writes them.
 pub(crate) fn evaluate_rings(
     mesh: &TriangleMesh,
     arcs: &[Arc],
     ends: &[u32],
     frame: &ShadingFrame,
 ) -> Result<Vec<Vec<DVec3>>, GeomError> {
-    let mut rings = Vec::with_capacity(ends.len());
+    let mut out = SilhouetteRings::new();
+    evaluate_rings_into(mesh, arcs, ends, frame, &mut out)?;
+    Ok(out.rings().map(<[DVec3]>::to_vec).collect())
+}
+
+/// Appends to `out` the rings of unit directions (local frame) of an outline's arcs seen from
+/// the frame's point. Arcs that subtend more than 120 degrees get an extra vertex at the foot of
+/// the perpendicular from the point to their edge, so that no ring edge comes near half a great
+/// circle.
+pub(crate) fn evaluate_rings_into(
+    mesh: &TriangleMesh,
+    arcs: &[Arc],
+    ends: &[u32],
+    frame: &ShadingFrame,
+    out: &mut SilhouetteRings,
+) -> Result<(), GeomError> {
     let mut start = 0usize;
+    let mut starts: SmallVec<[DVec3; 24]> = SmallVec::new();
     for &end in ends {
         let ring = &arcs[start..end as usize];
         let n = ring.len();
         // Start point of each arc (vectors from the point, local frame).
-        let starts: Vec<DVec3> = (0..n).map(|k| arc_start(mesh, ring, k, frame)).collect();
-        let mut out = Vec::with_capacity(n + 2);
+        starts.clear();
+        starts.extend((0..n).map(|k| arc_start(mesh, ring, k, frame)));
         for k in 0..n {
             let u = starts[k]
                 .try_normalize()
@@ -755,10 +772,10 @@ pub(crate) fn evaluate_rings(
                 }
             }
         }
-        rings.push(out);
+        out.close_ring();
         start = end as usize;
     }
-    Ok(rings)
+    Ok(())
 }
 
 #[cfg(test)]
