@@ -280,6 +280,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         self.faces[self.slot(b)].as_ref()
     }
 
+    /// [`ClipVisibility::separation`] (by reference) and [`ClipVisibility::touches`] together.
+    pub(super) fn pair(&self, light: usize, b: Blocker) -> (Option<&Separation>, bool) {
+        let k = light * self.blocker_count() + self.slot(b);
+        (self.separations[k].as_ref(), self.touching[k])
+    }
+
     /// Whether blocker `b` has a vertex in the plane of a triangle of light `light`.
     pub(super) fn touches(&self, light: usize, b: Blocker) -> bool {
         self.touching[light * self.blocker_count() + self.slot(b)]

@@ -352,7 +352,9 @@ impl Pieces {
     }
 
     /// `R - (R n K)`: for each ring `L` that `K` meets, `L n K` appended reversed, or `L`
-    /// removed where `K` covers it (see the module documentation).
+    /// removed where `K` covers it (see the module documentation). Out of line (as the other
+    /// rarer steps of a subtraction): the boundary tracing's common path stays small.
+    #[inline(never)]
     fn subtract_by_cuts(&mut self) -> bool {
         let Pieces {
             bufs,
@@ -619,9 +621,8 @@ impl Pieces {
         if steps == 0 && entry.t <= exit.t {
             steps = len;
         }
-        // Element by element after one reservation: the slices are a few vertices long, shorter
-        // than a copy's setup.
-        to.pts.reserve(2 + steps + steps_k);
+        // Element by element: the pieces are a few vertices long, shorter than a copy's setup
+        // (or a reservation's, for the inline storage that holds them).
         to.pts.push(exit.x);
         // The ring's vertices after the exit's edge, up to the entry's edge's last one.
         let ring = &from.pts[r0..r1];
@@ -789,6 +790,7 @@ impl Pieces {
     /// new hole where it lies inside the region (decided by the parity of the region's
     /// crossings with the meridian arc from a vertex of `K` down through the horizon). `false`
     /// where that parity is within rounding.
+    #[inline(never)]
     fn difference_without_crossings(&mut self) -> bool {
         let k0 = self.kv[0];
         // The region lies in the upper hemisphere.
@@ -835,10 +837,14 @@ impl Pieces {
 /// [`Pieces::trace_difference`]).
 #[inline(always)]
 fn first_plane_out(v: DVec3, planes: &[DVec3]) -> Option<u32> {
-    let v1 = norm1(v);
+    let bound = MARGIN * norm1(v);
     for (j, &n) in planes.iter().enumerate() {
         let s = n.dot(v);
-        if s.abs() <= MARGIN * v1 {
+        // Clearly positive (the common case, one comparison), else the checks in order.
+        if s > bound {
+            continue;
+        }
+        if s.abs() <= bound {
             return None;
         }
         if s < 0.0 {
@@ -867,10 +873,15 @@ fn edge_crossings(
     // Entry and exit: parameter, error bound, plane; and the runners-up's nearest bound.
     let (mut t_in, mut e_in, mut j_in, mut second_in) = (0.0, 0.0, usize::MAX, f64::NEG_INFINITY);
     let (mut t_out, mut e_out, mut j_out, mut second_out) = (1.0, 0.0, usize::MAX, f64::INFINITY);
+    let bound = MARGIN;
+    let (ba, bb) = (bound * a1, bound * b1);
     for (j, &n) in planes.iter().enumerate().skip(from) {
         let (sa, sb) = (n.dot(pa), n.dot(pb));
-        let bound = MARGIN;
-        if sa.abs() <= bound * a1 || sb.abs() <= bound * b1 {
+        // Both clearly positive (the plane changes nothing), else the checks in order.
+        if sa > ba && sb > bb {
+            continue;
+        }
+        if sa.abs() <= ba || sb.abs() <= bb {
             return false;
         }
         if sa < 0.0 && sb < 0.0 {
@@ -1022,7 +1033,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             .map(Blocker::Occluder)
             .chain((0..nl).filter(|&k| k != light).map(Blocker::Light));
         for b in blockers {
-            let separation = self.separation(light, b);
+            let (separation, touches) = self.pair(light, b);
             if let Some(sep) = separation
                 && !sep.blocker_side(x)
             {
@@ -1041,7 +1052,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             // the one-pass union, which culls their triangles by shafts. A Bezier-bounded
             // light blocks others by its triangulated flattening, as on the spherical path.
             let fits = separation.is_some()
-                && !self.touches(light, b)
+                && !touches
                 && match body {
                     Body::Convex(p) => {
                         let planes = match self.convex_faces(b) {
@@ -1623,7 +1634,6 @@ fn convex_blocker(
     // `small_silhouette_dirs` (on the same pairs of directions, the same decisions).
     let kv: &[DVec3] = kv;
     planes.clear();
-    planes.reserve(count);
     let mut cur = kv[0];
     let mut cur1 = norm1(cur);
     let mut d_in = cur - kv[count - 1];
