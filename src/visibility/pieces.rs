@@ -27,14 +27,17 @@
 //! The region a blocker covers is convex whenever the blocker is: a convex polyhedron seen from
 //! outside covers the cone bounded by the planes through the point and its contour edges (seed
 //! 000 Alg. 2, thesis 003 section 4.2), `K = n_j H_j`, one half-space `H_j` per contour edge; a
-//! mesh triangle covers the cone of its three edges. `R - K` is computed in one of two ways:
+//! mesh triangle covers the cone of its three edges. The contour of a small polyhedron comes
+//! from a [`ConvexFaces`] table built once per scene (facing tests per plane, and for a box-like
+//! body the contour of every set of front planes), the same loop the per-point chaining finds. `R - K` is computed in one of two ways:
 //!
 //! - **Boundary tracing** (Greiner and Hormann 1998, the difference), while the rings are simple
 //!   and disjoint (an outer boundary and its holes, or the light's one ring): the crossings of
 //!   the rings with `K`'s edges by parametric clipping of each ring edge against the half-spaces
 //!   (Cyrus and Beck 1978), then the rings followed outside `K` and `K`'s edges followed
-//!   backwards inside the region. The result is the region's boundary itself, the fewest edges
-//!   to integrate. Every decision it takes (a vertex's side of a plane, the order of two
+//!   backwards inside the region (with exactly two crossings, one bite out of one ring, the
+//!   loop is written out directly). The result is the region's boundary itself, the fewest
+//!   edges to integrate. Every decision it takes (a vertex's side of a plane, the order of two
 //!   crossings on one edge, which plane an edge enters `K` by) must clear its rounding bound by a
 //!   margin, and the traversal must close consistently; otherwise it does nothing and the
 //!   subtraction below runs instead, for this blocker and every later one.
