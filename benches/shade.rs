@@ -9,6 +9,8 @@
 //! eight points `n` times (default 1) with no criterion (cases: see `count_case`), so that
 //! `valgrind --tool=callgrind` counts exactly that; run it with `n = 0` too and divide the
 //! difference by `8 n` for the instructions per shading point (scene construction cancels).
+//! `SHADE_POINT_ONLY=k` (0 to 7) shades only the `k`-th point (divide by `n`), to see what each
+//! point costs.
 
 use arealight::glam::DVec3;
 use arealight::internals::{DemoConfig, demo_scene};
@@ -252,7 +254,11 @@ fn quad_light_points(c: &mut Criterion) {
 /// times. Returns the sum of the values, which the caller prints so that nothing is optimized
 /// out.
 fn count_case(case: &str, reps: usize) -> f64 {
-    let points = issue15_points();
+    let mut points = issue15_points();
+    if let Ok(k) = std::env::var("SHADE_POINT_ONLY") {
+        let k: usize = k.parse().unwrap();
+        points = vec![points[k]];
+    }
     let diffuse = Material::diffuse(DVec3::splat(0.8)).unwrap();
     let glossy = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
     let parts: Vec<&str> = case.split('-').collect();

@@ -106,6 +106,7 @@ pub fn face_side(mesh: &TriangleMesh, f: usize, x: DVec3) -> Side {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct FacingAt {
     rel: DVec3,
+    dist: f64,
     tol: f64,
 }
 
@@ -116,9 +117,11 @@ impl FacingAt {
     pub(crate) fn new(mesh: &TriangleMesh, x: DVec3) -> FacingAt {
         let b = mesh.bounding_sphere();
         let rel = x - b.center;
+        let dist = rel.length();
         FacingAt {
             rel,
-            tol: FACE_TOLERANCE * (b.radius + rel.length()),
+            dist,
+            tol: FACE_TOLERANCE * (b.radius + dist),
         }
     }
 
@@ -156,6 +159,13 @@ impl FacingAt {
     #[must_use]
     pub(crate) fn rel(self) -> DVec3 {
         self.rel
+    }
+
+    /// The point's distance from the mesh's bounding center (`rel().length()`, computed once).
+    #[inline]
+    #[must_use]
+    pub(crate) fn dist(self) -> f64 {
+        self.dist
     }
 }
 

@@ -6,7 +6,8 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::cull::{Shaft, above_horizon, may_occlude, shaft_triangles};
+use super::cull::{LightCone, Shaft, above_horizon, may_occlude, shaft_triangles};
+use super::pieces::ConvexFaces;
 use super::union::{BlockerAccel, BlockerGeometry, LightRegion, one_pass};
 use super::{Blocker, Visibility};
 use crate::GeomError;
@@ -88,6 +89,9 @@ pub struct ClipVisibility<L> {
     /// plane of one of the light's triangles (by [`face_side`]). Such a blocker is never
     /// subtracted whole (see [`ClipVisibility::visible_region`], step 2).
     touching: Vec<bool>,
+    /// Per blocker slot: a small convex body's facing planes and contour candidates, for the
+    /// fast path's silhouettes ([`ConvexFaces`]).
+    faces: Vec<Option<ConvexFaces>>,
 }
 
 /// Bodies with at least this many triangles get a [`Bvh`]; for fewer, testing every triangle
@@ -156,6 +160,14 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             .chain(lights.iter().map(AsRef::as_ref))
             .map(|b| BlockerAccel::new(b, BVH_MIN_TRIANGLES))
             .collect();
+        let faces = occluders
+            .iter()
+            .chain(lights.iter().map(AsRef::as_ref))
+            .map(|b| match b {
+                Body::Convex(p) => ConvexFaces::of(p),
+                _ => None,
+            })
+            .collect();
         let solids = lights
             .iter()
             .map(|l| match l.as_ref() {
@@ -181,6 +193,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             outlines,
             accels,
             touching,
+            faces,
         }
     }
 
@@ -262,6 +275,17 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             })
     }
 
+    /// The precomputed facing planes and edges of blocker `b`, if it is a small convex body.
+    pub(super) fn convex_faces(&self, b: Blocker) -> Option<&ConvexFaces> {
+        self.faces[self.slot(b)].as_ref()
+    }
+
+    /// [`ClipVisibility::separation`] (by reference) and [`ClipVisibility::touches`] together.
+    pub(super) fn pair(&self, light: usize, b: Blocker) -> (Option<&Separation>, bool) {
+        let k = light * self.blocker_count() + self.slot(b);
+        (self.separations[k].as_ref(), self.touching[k])
+    }
+
     /// Whether blocker `b` has a vertex in the plane of a triangle of light `light`.
     pub(super) fn touches(&self, light: usize, b: Blocker) -> bool {
         self.touching[light * self.blocker_count() + self.slot(b)]
@@ -296,6 +320,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             center: DVec3::ZERO,
             radius: 0.0,
         });
+        let cone = LightCone::new(x, n, lb);
         (0..no)
             .map(Blocker::Occluder)
             .chain((0..nl).filter(move |&k| k != light).map(Blocker::Light))
@@ -305,7 +330,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 {
                     return false;
                 }
-                may_occlude(x, n, lb, self.blocker(b).1)
+                cone.may_occlude(self.blocker(b).1)
             })
     }
 

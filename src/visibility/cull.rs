@@ -43,36 +43,71 @@ const MARGIN: f64 = 1e-9;
 /// ```
 #[must_use]
 pub fn may_occlude(x: DVec3, n: DVec3, light: BoundingSphere, occ: BoundingSphere) -> bool {
-    let to_occ = occ.center - x;
-    // (1) Entirely below the horizon plane.
-    if to_occ.dot(n) < -occ.radius {
-        return false;
+    LightCone::new(x, n, light).may_occlude(occ)
+}
+
+/// [`may_occlude`] for one point and light and many occluders: the light's cone, computed once.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct LightCone {
+    x: DVec3,
+    n: DVec3,
+    to_light: DVec3,
+    d_light: f64,
+    /// The light's farthest distance from `x`.
+    far: f64,
+    /// `x` inside the light's sphere (its cone is every direction).
+    inside: bool,
+    sin_l: f64,
+    cos_l: f64,
+}
+
+impl LightCone {
+    /// The cone from `x` (surface normal `n`, unit) around the sphere `light`.
+    #[inline]
+    pub(crate) fn new(x: DVec3, n: DVec3, light: BoundingSphere) -> Self {
+        let to_light = light.center - x;
+        let d_light = to_light.length();
+        let sin_l = (light.radius / d_light).min(1.0);
+        LightCone {
+            x,
+            n,
+            to_light,
+            d_light,
+            far: d_light + light.radius,
+            inside: d_light <= light.radius,
+            sin_l,
+            cos_l: sqrt((1.0 - sin_l * sin_l).max(0.0)),
+        }
     }
-    let d_occ = to_occ.length();
-    let to_light = light.center - x;
-    let d_light = to_light.length();
-    // (2) Entirely behind the light: its nearest point is farther than the light's farthest.
-    if d_occ - occ.radius > d_light + light.radius {
-        return false;
+
+    /// [`may_occlude`] of the occluder bounded by `occ`.
+    #[inline]
+    pub(crate) fn may_occlude(&self, occ: BoundingSphere) -> bool {
+        let to_occ = occ.center - self.x;
+        // (1) Entirely below the horizon plane.
+        if to_occ.dot(self.n) < -occ.radius {
+            return false;
+        }
+        let d_occ = to_occ.length();
+        // (2) Entirely behind the light: its nearest point is farther than the light's farthest.
+        if d_occ - occ.radius > self.far {
+            return false;
+        }
+        // (3) Disjoint cones. Inside a sphere its cone is everything.
+        if d_occ <= occ.radius || self.inside {
+            return true;
+        }
+        // The cones meet where the angle between their axes is at most the sum of their
+        // half-angles `a + b` (`sin a = r / d` for each): compared through cosines, `cos(a + b)
+        // = cos a cos b - sin a sin b`, with two roots and no inverse trigonometric function.
+        // The margin moves to the cosine side as `cos(a + b + MARGIN) >= cos(a + b) - MARGIN`,
+        // which keeps every pair the angles' test keeps (and a few more where the cones are tiny
+        // and the cosine flat), far above the rounding of either side.
+        let sin_o = (occ.radius / d_occ).min(1.0);
+        let cos_o = sqrt((1.0 - sin_o * sin_o).max(0.0));
+        let cos_between = to_occ.dot(self.to_light) / (d_occ * self.d_light);
+        cos_between >= cos_o * self.cos_l - sin_o * self.sin_l - MARGIN
     }
-    // (3) Disjoint cones. Inside a sphere its cone is everything.
-    if d_occ <= occ.radius || d_light <= light.radius {
-        return true;
-    }
-    // The cones meet where the angle between their axes is at most the sum of their half-angles
-    // `a + b` (`sin a = r / d` for each): compared through cosines, `cos(a + b) = cos a cos b -
-    // sin a sin b`, with two roots and no inverse trigonometric function. The margin moves to the
-    // cosine side as `cos(a + b + MARGIN) >= cos(a + b) - MARGIN`, which keeps every pair the
-    // angles' test keeps (and a few more where the cones are tiny and the cosine flat), far above
-    // the rounding of either side.
-    let (sin_o, sin_l) = (
-        (occ.radius / d_occ).min(1.0),
-        (light.radius / d_light).min(1.0),
-    );
-    let cos_o = sqrt((1.0 - sin_o * sin_o).max(0.0));
-    let cos_l = sqrt((1.0 - sin_l * sin_l).max(0.0));
-    let cos_between = to_occ.dot(to_light) / (d_occ * d_light);
-    cos_between >= cos_o * cos_l - sin_o * sin_l - MARGIN
 }
 
 /// Whether a light bounded by `light` may be above the horizon of `x` (normal `n`, unit).

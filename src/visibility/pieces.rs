@@ -27,14 +27,17 @@
 //! The region a blocker covers is convex whenever the blocker is: a convex polyhedron seen from
 //! outside covers the cone bounded by the planes through the point and its contour edges (seed
 //! 000 Alg. 2, thesis 003 section 4.2), `K = n_j H_j`, one half-space `H_j` per contour edge; a
-//! mesh triangle covers the cone of its three edges. `R - K` is computed in one of two ways:
+//! mesh triangle covers the cone of its three edges. The contour of a small polyhedron comes
+//! from a [`ConvexFaces`] table built once per scene (facing tests per plane, and for a box-like
+//! body the contour of every set of front planes), the same loop the per-point chaining finds. `R - K` is computed in one of two ways:
 //!
 //! - **Boundary tracing** (Greiner and Hormann 1998, the difference), while the rings are simple
 //!   and disjoint (an outer boundary and its holes, or the light's one ring): the crossings of
 //!   the rings with `K`'s edges by parametric clipping of each ring edge against the half-spaces
 //!   (Cyrus and Beck 1978), then the rings followed outside `K` and `K`'s edges followed
-//!   backwards inside the region. The result is the region's boundary itself, the fewest edges
-//!   to integrate. Every decision it takes (a vertex's side of a plane, the order of two
+//!   backwards inside the region (with exactly two crossings, one bite out of one ring, the
+//!   loop is written out directly). The result is the region's boundary itself, the fewest
+//!   edges to integrate. Every decision it takes (a vertex's side of a plane, the order of two
 //!   crossings on one edge, which plane an edge enters `K` by) must clear its rounding bound by a
 //!   margin, and the traversal must close consistently; otherwise it does nothing and the
 //!   subtraction below runs instead, for this blocker and every later one.
@@ -77,11 +80,13 @@
 //! right somewhere (a face within the facing tolerance of edge-on left out): there the
 //! spherical path decides, or gives up, exactly as without this path.
 
+use alloc::vec::Vec;
+
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::cull::{above_horizon, may_occlude};
-use super::{ClipVisibility, Method};
+use super::cull::{LightCone, above_horizon, may_occlude};
+use super::{Blocker, ClipVisibility, Method};
 use crate::GeomError;
 use crate::solid::facing::{FacingAt, Side, face_side};
 use crate::solid::silhouette::chain_by_index;
@@ -190,6 +195,12 @@ pub struct Pieces {
     /// Subtractions so far by boundary tracing and by inclusion–exclusion (diagnostics).
     traced: u64,
     cut: u64,
+    /// Tests: take the general traversal for two crossings too, and count the subtractions
+    /// that [`Pieces::traverse_two`] answered.
+    #[cfg(test)]
+    general_only: bool,
+    #[cfg(test)]
+    two_crossings: u64,
 }
 
 /// Where a ring of the region crosses the boundary of a blocker's region `K`.
@@ -245,6 +256,10 @@ impl Pieces {
             order: SmallVec::new(),
             traced: 0,
             cut: 0,
+            #[cfg(test)]
+            general_only: false,
+            #[cfg(test)]
+            two_crossings: 0,
         }
     }
 
@@ -340,7 +355,9 @@ impl Pieces {
     }
 
     /// `R - (R n K)`: for each ring `L` that `K` meets, `L n K` appended reversed, or `L`
-    /// removed where `K` covers it (see the module documentation).
+    /// removed where `K` covers it (see the module documentation). Out of line (as the other
+    /// rarer steps of a subtraction): the boundary tracing's common path stays small.
+    #[inline(never)]
     fn subtract_by_cuts(&mut self) -> bool {
         let Pieces {
             bufs,
@@ -480,72 +497,156 @@ impl Pieces {
         if pts.len() > 64 {
             return false;
         }
-        // Which vertices lie inside `K` (bit `i`): outside at the first plane with a negative
-        // side. Each side that decides is checked against its rounding bound; sides are
-        // recomputed where the crossings need them, which is cheaper than storing them.
-        // Also the first plane each vertex outside `K` is outside of: an edge whose ends share
-        // it misses `K`, which the crossings' pass would find at that plane after the same
-        // checks on the same sides.
+        // Ring by ring: which vertices lie inside `K` (bit `i`), and the crossings of each edge
+        // in order along the ring. A vertex is classified by the first plane with a negative
+        // side ([`first_plane_out`]); an edge whose ends are outside `K` first by the same plane
+        // (or both inside it) misses `K`'s boundary, which the crossings' pass would find at
+        // that plane after the same checks on the same sides. Sides are recomputed where the
+        // crossings need them, which is cheaper than storing them.
         let mut inside = 0u64;
-        let mut first_out = [u32::MAX; 64];
-        for (i, &v) in pts.iter().enumerate() {
-            let v1 = norm1(v);
-            let mut all = true;
-            for (j, &n) in planes.iter().enumerate() {
-                let s = n.dot(v);
-                if s.abs() <= MARGIN * v1 {
-                    return false;
-                }
-                if s < 0.0 {
-                    all = false;
-                    first_out[i] = j as u32;
-                    break;
-                }
-            }
-            inside |= u64::from(all) << i;
-        }
-        self.inside_bits = inside;
-        // The crossings, ring by ring, in order along each ring.
         self.crossings.clear();
         let mut start = 0usize;
         for &end in &region.ends {
             let end = end as usize;
-            let first = self.crossings.len();
-            for a in start..end {
-                let b = if a + 1 == end { start } else { a + 1 };
-                // Both ends inside `K`, or both outside it first by the same plane (both
-                // inside is the one way to share `u32::MAX`).
-                if (inside >> a) & (inside >> b) & 1 == 1 || first_out[a] == first_out[b] {
-                    continue;
-                }
-                if !edge_crossings(
-                    pts,
-                    planes,
-                    (a, b),
-                    (start as u32, end as u32),
-                    &mut self.crossings,
-                ) {
+            let ring = (start as u32, end as u32);
+            let Some(first) = first_plane_out(pts[start], planes) else {
+                return false;
+            };
+            inside |= u64::from(first == u32::MAX) << start;
+            let mut prev = first;
+            for b in start + 1..=end {
+                let (b, out) = if b == end {
+                    (start, first)
+                } else {
+                    let Some(out) = first_plane_out(pts[b], planes) else {
+                        return false;
+                    };
+                    inside |= u64::from(out == u32::MAX) << b;
+                    (b, out)
+                };
+                let a = if b == start { end - 1 } else { b - 1 };
+                // Every side of both ends before the first plane either end is outside of is
+                // positive, and was checked against its bound: the crossings' pass starts there.
+                if prev != out
+                    && !edge_crossings(
+                        pts,
+                        planes,
+                        (a, b),
+                        ring,
+                        prev.min(out) as usize,
+                        &mut self.crossings,
+                    )
+                {
                     return false;
                 }
-            }
-            // Link the ring's crossings in a cycle.
-            let cs = &mut self.crossings[first..];
-            let last = cs.len();
-            for (c, x) in cs.iter_mut().enumerate() {
-                x.next = (first + if c + 1 == last { 0 } else { c + 1 }) as u16;
+                prev = out;
             }
             start = end;
         }
-        if self.crossings.len() > u16::MAX as usize / 2 {
+        self.inside_bits = inside;
+        #[cfg(test)]
+        let general_only = self.general_only;
+        #[cfg(not(test))]
+        let general_only = false;
+        match self.crossings.len() {
+            0 => self.difference_without_crossings(),
+            2 if !general_only => {
+                #[cfg(test)]
+                {
+                    self.two_crossings += 1;
+                }
+                self.traverse_two()
+            }
+            n if n > u16::MAX as usize / 2 => false,
+            _ => {
+                // Link each ring's crossings in a cycle (they are consecutive, in ring order).
+                let cs = &mut self.crossings[..];
+                let mut first = 0;
+                for c in 0..cs.len() {
+                    let last = c + 1 == cs.len() || cs[c + 1].ring != cs[c].ring;
+                    cs[c].next = if last { first } else { c + 1 } as u16;
+                    if last {
+                        first = c + 1;
+                    }
+                }
+                self.order_along_k() && self.traverse()
+            }
+        }
+    }
+
+    /// [`Pieces::traverse`] (after [`Pieces::order_along_k`]) for exactly two crossings: the
+    /// same region, vertex for vertex in the same order, and the same decisions, without the
+    /// general bookkeeping. The loop leaves `K` at the exit crossing, runs along the ring to the
+    /// entry crossing, and back along `K` to the exit; where the two crossings are on one edge
+    /// of `K`, their order along it (decided as `order_along_k` decides it) says whether that
+    /// is no vertex of `K` or all of them.
+    fn traverse_two(&mut self) -> bool {
+        let (c0, c1) = (self.crossings[0], self.crossings[1]);
+        // One ring leaving `K` once and entering it once, or the traversal fails.
+        if c0.ring != c1.ring || c0.enter == c1.enter {
             return false;
         }
-        if self.crossings.is_empty() {
-            return self.difference_without_crossings();
+        let m = self.kv.len();
+        let steps_k = if c0.j == c1.j {
+            // `order_along_k`'s comparison of the two: crossing 0 is after crossing 1 along
+            // `K`'s edge where `d > 0`.
+            let d = c1.x.cross(c0.x).dot(self.planes[c0.j as usize]);
+            if d.abs() <= MARGIN * norm1(c0.x) * norm1(c1.x) {
+                return false;
+            }
+            // All of `K`'s vertices where the exit comes after the entry (crossing 1 is the
+            // entry exactly where crossing 0 is the exit).
+            if (d > 0.0) == c1.enter { m } else { 0 }
+        } else {
+            let (je, jp) = if c0.enter { (c0.j, c1.j) } else { (c1.j, c0.j) };
+            (je as usize + m - jp as usize) % m
+        };
+        let (exit, entry) = if c0.enter { (c1, c0) } else { (c0, c1) };
+        let Pieces {
+            bufs,
+            cur,
+            kv,
+            inside_bits,
+            ..
+        } = self;
+        let inside = *inside_bits;
+        let (a, b) = bufs.split_at_mut(1);
+        let (from, to) = if *cur == 0 {
+            (&a[0], &mut b[0])
+        } else {
+            (&b[0], &mut a[0])
+        };
+        to.clear();
+        let (r0, r1) = (exit.ring.0 as usize, exit.ring.1 as usize);
+        let len = r1 - r0;
+        let (ia, ib) = (exit.edge as usize - r0, entry.edge as usize - r0);
+        let mut steps = (ib + len - ia) % len;
+        if steps == 0 && entry.t <= exit.t {
+            steps = len;
         }
-        if !self.order_along_k() {
-            return false;
+        // Element by element: the pieces are a few vertices long, shorter than a copy's setup
+        // (or a reservation's, for the inline storage that holds them).
+        to.pts.push(exit.x);
+        // The ring's vertices after the exit's edge, up to the entry's edge's last one.
+        let ring = &from.pts[r0..r1];
+        for k in ia + 1..=ia + steps {
+            to.pts.push(ring[if k >= len { k - len } else { k }]);
         }
-        self.traverse()
+        to.pts.push(entry.x);
+        // `K`'s vertices backwards from the entry's edge's first one.
+        let je = entry.j as usize;
+        for k in 0..steps_k {
+            to.pts.push(kv[if k <= je { je - k } else { je + m - k }]);
+        }
+        to.close(0);
+        // Rings without crossings: kept outside `K`, dropped inside.
+        for range in from.ranges() {
+            if range.start != r0 && (inside >> range.start) & 1 == 0 {
+                to.push_ring(&from.pts[range]);
+            }
+        }
+        self.flip();
+        true
     }
 
     /// Ranks the crossings in order along `K`'s boundary (by edge, then along it); `false` where
@@ -692,6 +793,7 @@ impl Pieces {
     /// new hole where it lies inside the region (decided by the parity of the region's
     /// crossings with the meridian arc from a vertex of `K` down through the horizon). `false`
     /// where that parity is within rounding.
+    #[inline(never)]
     fn difference_without_crossings(&mut self) -> bool {
         let k0 = self.kv[0];
         // The region lies in the upper hemisphere.
@@ -733,16 +835,40 @@ impl Pieces {
     }
 }
 
+/// The first of `planes` on whose negative side `v` lies, `u32::MAX` if none (`v` inside `K`);
+/// `None` where a side up to that plane is within its rounding bound (see
+/// [`Pieces::trace_difference`]).
+#[inline(always)]
+fn first_plane_out(v: DVec3, planes: &[DVec3]) -> Option<u32> {
+    let bound = MARGIN * norm1(v);
+    for (j, &n) in planes.iter().enumerate() {
+        let s = n.dot(v);
+        // Clearly positive (the common case, one comparison), else the checks in order.
+        if s > bound {
+            continue;
+        }
+        if s.abs() <= bound {
+            return None;
+        }
+        if s < 0.0 {
+            return Some(j as u32);
+        }
+    }
+    Some(u32::MAX)
+}
+
 /// Adds to `out` the crossings of the ring edge `a -> b` (indices into `pts`, the ring's range
 /// `ring`) with `K`'s boundary, by Cyrus–Beck: the edge's part inside `K` is `[t_in, t_out]`,
 /// `t_in` the largest parameter at which it enters a half-space and `t_out` the smallest at which
 /// it leaves one. `false` where a side, the plane of the entry or exit, or whether the part is
-/// empty, is within rounding.
+/// empty, is within rounding. The planes before `from` are skipped: the caller knows both ends
+/// clearly inside them (a plane with both sides positive changes nothing here).
 fn edge_crossings(
     pts: &[DVec3],
     planes: &[DVec3],
     (a, b): (usize, usize),
     ring: (u32, u32),
+    from: usize,
     out: &mut SmallVec<[Crossing; 16]>,
 ) -> bool {
     let (pa, pb) = (pts[a], pts[b]);
@@ -750,10 +876,15 @@ fn edge_crossings(
     // Entry and exit: parameter, error bound, plane; and the runners-up's nearest bound.
     let (mut t_in, mut e_in, mut j_in, mut second_in) = (0.0, 0.0, usize::MAX, f64::NEG_INFINITY);
     let (mut t_out, mut e_out, mut j_out, mut second_out) = (1.0, 0.0, usize::MAX, f64::INFINITY);
-    for (j, &n) in planes.iter().enumerate() {
+    let bound = MARGIN;
+    let (ba, bb) = (bound * a1, bound * b1);
+    for (j, &n) in planes.iter().enumerate().skip(from) {
         let (sa, sb) = (n.dot(pa), n.dot(pb));
-        let bound = MARGIN;
-        if sa.abs() <= bound * a1 || sb.abs() <= bound * b1 {
+        // Both clearly positive (the plane changes nothing), else the checks in order.
+        if sa > ba && sb > bb {
+            continue;
+        }
+        if sa.abs() <= ba || sb.abs() <= bb {
             return false;
         }
         if sa < 0.0 && sb < 0.0 {
@@ -886,7 +1017,35 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         if !blocked || self.blocker_count() == 1 {
             return Ok(true);
         }
-        for b in self.blockers_between(light, frame) {
+        if !self.subtract_blockers(light, frame, out) {
+            out.clear();
+            return Ok(false);
+        }
+        Ok(true)
+    }
+
+    /// Subtracts from `out` every blocker of [`ClipVisibility::blockers_between`] (the same
+    /// culling, the light's cone computed once); `false` where one is the spherical path's.
+    /// Out of line: the unoccluded light's path stays short.
+    #[inline(never)]
+    fn subtract_blockers(&self, light: usize, frame: &ShadingFrame, out: &mut Pieces) -> bool {
+        let (x, n) = (frame.origin(), frame.normal());
+        let cone = LightCone::new(x, n, self.light_bounds[light]);
+        let (no, nl) = (self.occluders().len(), self.lights().len());
+        let blockers = (0..no)
+            .map(Blocker::Occluder)
+            .chain((0..nl).filter(|&k| k != light).map(Blocker::Light));
+        for b in blockers {
+            let (separation, touches) = self.pair(light, b);
+            if let Some(sep) = separation
+                && !sep.blocker_side(x)
+            {
+                continue;
+            }
+            let (body, bound) = self.blocker(b);
+            if !cone.may_occlude(bound) {
+                continue;
+            }
             if out.is_empty() {
                 break;
             }
@@ -895,21 +1054,26 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             // face: the spherical path's business. Meshes large enough for a hierarchy go to
             // the one-pass union, which culls their triangles by shafts. A Bezier-bounded
             // light blocks others by its triangulated flattening, as on the spherical path.
-            let fits = self.separation(light, b).is_some()
-                && !self.touches(light, b)
-                && match self.blocker(b).0 {
-                    Body::Convex(p) => convex_planes(p, frame, out) && out.subtract(),
+            let fits = separation.is_some()
+                && !touches
+                && match body {
+                    Body::Convex(p) => {
+                        let planes = match self.convex_faces(b) {
+                            Some(faces) => convex_blocker(p, faces, frame, out),
+                            None => convex_planes(p, frame, out),
+                        };
+                        planes && out.subtract()
+                    }
                     other => {
                         self.bvh(b).is_none()
                             && self.subtract_triangles(light, other.mesh(), frame, out)
                     }
                 };
             if !fits {
-                out.clear();
-                return Ok(false);
+                return false;
             }
         }
-        Ok(true)
+        true
     }
 
     /// The light's own region as the first rings of `out`, clipped to the upper hemisphere;
@@ -997,7 +1161,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// Subtracts from `out` every triangle of the mesh blocker `m` (seen from either side, each
     /// with its three half-spaces), after the per-triangle cull of the spherical path; `false`
     /// where a triangle's projection is turned over by rounding or the rings would exceed
-    /// [`MAX_RINGS`].
+    /// [`MAX_RINGS`]. Out of line, so that its setup stays out of the loop over convex blockers.
+    #[inline(never)]
     fn subtract_triangles(
         &self,
         light: usize,
@@ -1320,6 +1485,251 @@ fn chain_contour(
     dirs.iter().all(|v| v.length_squared() > 0.0)
 }
 
+/// A small convex polyhedron's faces and edges as the fast path's silhouette walks them
+/// ([`convex_blocker`]), built once per scene: its triangles grouped by plane, and the edges
+/// between triangles of different planes.
+///
+/// Triangles with the same normal and offset (equal as numbers; a zero's sign cannot change a
+/// facing test, whose tolerance is positive) get the same answer from the facing predicate, so
+/// one test serves them all, and the edges between them (the diagonals of a box's faces) are
+/// never on a contour. The edges kept are in the polyhedron's order, so the contour is chained
+/// from the same first edge as by [`small_silhouette_dirs`].
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct ConvexFaces {
+    /// Per plane: the triangles' unit normal and offset from the bounding sphere's center.
+    normals: Vec<DVec3>,
+    offsets: Vec<f64>,
+    /// `[a, b, g0, g1]`: the edge from vertex `a` to `b`, counter-clockwise around the triangle
+    /// of plane `g0`, and `b -> a` in the triangle of plane `g1`; and the bits of its two planes.
+    edges: Vec<[u8; 4]>,
+    masks: Vec<u64>,
+    /// For at most [`CONTOUR_TABLE_PLANES`] planes, the contour for every set of front planes
+    /// (bit `g` for plane `g`), as [`contour_loop`] chains it from `edges`: `loops[m]` is the
+    /// range of `vertices` holding the loop's vertex indices in order, empty where it declines.
+    loops: Vec<(u16, u8)>,
+    vertices: Vec<u8>,
+}
+
+/// Polyhedra with at most this many distinct face planes (a box has six; a polyhedron with eight
+/// has at most twelve vertices) get a table of their contours, one per set of front planes.
+const CONTOUR_TABLE_PLANES: usize = 8;
+
+impl ConvexFaces {
+    /// The table of `p`; `None` beyond 64 triangles or [`INLINE_VERTICES`] vertices (the
+    /// general walk of [`convex_silhouette_dirs`] takes those).
+    pub(super) fn of(p: &ConvexPolyhedron) -> Option<ConvexFaces> {
+        let mesh = p.mesh();
+        if mesh.normals().len() > 64 || p.vertices().len() > INLINE_VERTICES {
+            return None;
+        }
+        let (mut normals, mut offsets) = (Vec::new(), Vec::<f64>::new());
+        let mut plane_of = Vec::with_capacity(mesh.normals().len());
+        for (&n, &d) in mesh.normals().iter().zip(mesh.offsets()) {
+            let g = match normals
+                .iter()
+                .zip(&offsets)
+                .position(|(&m, &e)| m == n && e == d)
+            {
+                Some(g) => g,
+                None => {
+                    normals.push(n);
+                    offsets.push(d);
+                    normals.len() - 1
+                }
+            };
+            plane_of.push(g as u8);
+        }
+        let edges = p
+            .edges()
+            .iter()
+            .map(|e| {
+                [
+                    e.a as u8,
+                    e.b as u8,
+                    plane_of[e.f0 as usize],
+                    plane_of[e.f1 as usize],
+                ]
+            })
+            .filter(|e| e[2] != e[3])
+            .collect::<Vec<_>>();
+        let masks = edges
+            .iter()
+            .map(|e| (1u64 << e[2]) | (1u64 << e[3]))
+            .collect::<Vec<_>>();
+        let (mut loops, mut vertices) = (Vec::new(), Vec::new());
+        if normals.len() <= CONTOUR_TABLE_PLANES {
+            let mut order = [0u8; INLINE_VERTICES];
+            for front in 0..1u64 << normals.len() {
+                let n = contour_loop(front, &edges, &masks, &mut order).unwrap_or(0);
+                loops.push((vertices.len() as u16, n as u8));
+                vertices.extend_from_slice(&order[..n]);
+            }
+        }
+        Some(ConvexFaces {
+            normals,
+            offsets,
+            edges,
+            masks,
+            loops,
+            vertices,
+        })
+    }
+}
+
+/// [`convex_planes`] for a polyhedron with a [`ConvexFaces`] table: the same silhouette
+/// (vertices, in the same order and bit for bit) and the same half-spaces, and the same
+/// decisions, in one walk. Front planes as bits; each contour edge written into the successor
+/// table the chaining walks; each vertex's direction, the plane of the edge that reaches it,
+/// the turn at the vertex before, and the spacing test, computed as the walk reaches it.
+///
+/// The spacing test's quick accept is taken from the edge's plane normal `p = (a + b) x (b - a)
+/// = 2 a x b` (see [`spaced_by_plane`]), which the plane needs anyway; where it does not accept,
+/// the test on unit vectors decides, as before.
+fn convex_blocker(
+    p: &ConvexPolyhedron,
+    faces: &ConvexFaces,
+    frame: &ShadingFrame,
+    out: &mut Pieces,
+) -> bool {
+    let at = FacingAt::new(p.mesh(), frame.origin());
+    let dist = at.dist();
+    let mut front = 0u64;
+    for (g, (nf, &d)) in faces.normals.iter().zip(&faces.offsets).enumerate() {
+        front |= u64::from(at.front(*nf, d)) << g;
+    }
+    if front == 0 {
+        return false;
+    }
+    let mut order = [0u8; INLINE_VERTICES];
+    let order: &[u8] = if faces.loops.is_empty() {
+        match contour_loop(front, &faces.edges, &faces.masks, &mut order) {
+            Some(count) => &order[..count],
+            None => return false,
+        }
+    } else {
+        let (at, count) = faces.loops[front as usize];
+        &faces.vertices[at as usize..at as usize + count as usize]
+    };
+    let count = order.len();
+    if count < 3 || !(dist > 0.0) {
+        return false;
+    }
+    // Directions scaled by the inverse distance to the polyhedron's center, as in
+    // `convex_silhouette_dirs`.
+    let inv = 1.0 / dist;
+    let verts = p.vertices();
+    let Pieces { kv, planes, .. } = out;
+    kv.clear();
+    kv.extend(
+        order
+            .iter()
+            .map(|&i| frame.to_local(verts[i as usize]) * inv),
+    );
+    // Planes, turns and spacing, edge by edge: `convex_planes`' loop, with the spacing test of
+    // `small_silhouette_dirs` (on the same pairs of directions, the same decisions).
+    let kv: &[DVec3] = kv;
+    planes.clear();
+    let mut cur = kv[0];
+    let mut cur1 = norm1(cur);
+    let mut d_in = cur - kv[count - 1];
+    for k in 0..count {
+        let k1 = if k + 1 == count { 0 } else { k + 1 };
+        let next = kv[k1];
+        let next1 = norm1(next);
+        let d_out = next - cur;
+        if !turns_left(d_in, d_out, cur) {
+            return false;
+        }
+        // `edge_plane(cur, next)` bit for bit (see `convex_planes`).
+        let n = (cur + next).cross(d_out);
+        let n1 = norm1(n);
+        if !spaced_by_plane(cur, next, cur1, next1, n1)
+            && !spaced_ids(verts, frame, order[k].into(), order[k1].into())
+        {
+            return false;
+        }
+        planes.push(n / n1);
+        (cur, cur1, d_in) = (next, next1, d_out);
+    }
+    true
+}
+
+/// The contour for the front planes `front` (bit `g` for plane `g`) as [`small_silhouette_dirs`]
+/// chains it: the edges between a front and a back plane, oriented by their front face, chained
+/// by vertex index from the first one's tail into one loop in which every vertex has one
+/// outgoing edge; its vertex indices in order into `order`, and their number. `None` where they
+/// do not form one such loop of at least three edges.
+fn contour_loop(
+    front: u64,
+    edges: &[[u8; 4]],
+    masks: &[u64],
+    order: &mut [u8; INLINE_VERTICES],
+) -> Option<usize> {
+    const NONE: u8 = u8::MAX;
+    let mut next = [NONE; INLINE_VERTICES];
+    let (mut count, mut start) = (0usize, NONE);
+    for (&[a, b, g0, _], &m) in edges.iter().zip(masks) {
+        // One of the edge's planes in front and the other not.
+        let f = front & m;
+        if f != 0 && f != m {
+            let (a, b) = if (front >> g0) & 1 == 1 {
+                (b, a)
+            } else {
+                (a, b)
+            };
+            if next[a as usize] != NONE {
+                return None;
+            }
+            next[a as usize] = b;
+            if count == 0 {
+                start = a;
+            }
+            count += 1;
+        }
+    }
+    if count < 3 {
+        return None;
+    }
+    order[0] = start;
+    let mut at = next[start as usize];
+    for slot in order.iter_mut().take(count).skip(1) {
+        if at == NONE || at == start {
+            return None;
+        }
+        *slot = at;
+        at = next[at as usize];
+    }
+    (at == start).then_some(count)
+}
+
+/// The silhouette's turn at `cur` from the edge with difference `d_in` to the one with `d_out`
+/// is to the left or straight within its rounding bound (see [`convex_planes`]): `left_turn`'s
+/// operations.
+#[inline(always)]
+fn turns_left(d_in: DVec3, d_out: DVec3, cur: DVec3) -> bool {
+    let turn = d_in.cross(d_out).dot(cur);
+    turn > 0.0 || turn > -MARGIN * norm1(d_in) * norm1(d_out) * norm1(cur)
+}
+
+/// A quick accept of the spacing test of [`spaced_ids`] for consecutive silhouette directions
+/// `a` and `b` (1-norms `a1`, `b1`), from the 1-norm `n1` of the computed `(a + b) x (b - a)`:
+/// where it holds the unit vectors are further apart than `MATCH_TOLERANCE` and not antipodal.
+///
+/// Exactly `|(a + b) x (b - a)| = 2 |a| |b| sin(theta)`, and `|n|_1 <= sqrt(3) |n|`, `|a| <=
+/// |a|_1`, so `sin(theta) >= |n|_1 / (2 sqrt(3) a1 b1)`; the computed normal is off by at most
+/// `8 eps (a1 + b1)^2` in 1-norm (the rounding of the sum, the difference, the products and the
+/// subtractions). So `n1 > 8 sqrt(3) TOL a1 b1 + 16 eps (a1 + b1)^2` gives `sin(theta) > 4 TOL`
+/// less rounding, more than twice `MATCH_TOLERANCE`: the unit vectors (equal to these directions'
+/// up to a few ulps of angle) are more than `MATCH_TOLERANCE` apart, and with `a . b > 0` the
+/// angle is acute, far from antipodal.
+#[inline(always)]
+fn spaced_by_plane(a: DVec3, b: DVec3, a1: f64, b1: f64, n1: f64) -> bool {
+    const REL: f64 = 8.0 * 1.732_050_807_568_877_3 * MATCH_TOLERANCE;
+    const ABS: f64 = 16.0 * f64::EPSILON;
+    let s = a1 + b1;
+    a.dot(b) > 0.0 && n1 > REL * a1 * b1 + ABS * s * s
+}
+
 /// The half-spaces of the convex blocker `p`'s silhouette into `out.planes`, one per contour
 /// edge (the silhouette is their intersection), and its vertices into `out.kv`; `false` where
 /// [`convex_silhouette_dirs`] declines or the silhouette turns right somewhere.
@@ -1373,4 +1783,191 @@ fn edge_plane(a: DVec3, b: DVec3) -> DVec3 {
 #[inline]
 fn left_turn(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     (b - a).cross(c - b).dot(b)
+}
+
+#[cfg(test)]
+mod tests {
+    //! The fast path's shortcuts against the code they shortcut, bit for bit: the silhouette
+    //! walk over a [`ConvexFaces`] table against [`convex_planes`], and the traversal of two
+    //! crossings against the general one.
+
+    use alloc::vec;
+    use alloc::vec::Vec;
+
+    use glam::DVec3;
+
+    use super::{ConvexFaces, Pieces, convex_blocker, convex_planes};
+    use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
+    use crate::visibility::ClipVisibility;
+
+    /// A light for [`ClipVisibility`]: a body alone.
+    struct Lit(Body);
+
+    impl AsRef<Body> for Lit {
+        fn as_ref(&self) -> &Body {
+            &self.0
+        }
+    }
+
+    /// A small deterministic generator (SplitMix64).
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn range(&mut self, a: f64, b: f64) -> f64 {
+            a + (b - a) * self.next()
+        }
+
+        fn vec(&mut self, a: f64, b: f64) -> DVec3 {
+            DVec3::new(self.range(a, b), self.range(a, b), self.range(a, b))
+        }
+    }
+
+    /// Boxes (axis-aligned, whose coplanar triangles share a plane bit for bit, and turned),
+    /// icospheres (20 and 80 faces), wedges and random hulls.
+    fn polyhedra(rng: &mut Rng) -> Vec<ConvexPolyhedron> {
+        let mut out = Vec::new();
+        for _ in 0..6 {
+            let c = rng.vec(-1.0, 1.0);
+            out.push(ConvexPolyhedron::cuboid(c, rng.vec(0.05, 0.6)).unwrap());
+            let (u, v) = rng.vec(-1.0, 1.0).normalize().any_orthonormal_pair();
+            let w = u.cross(v);
+            let h = rng.vec(0.05, 0.6);
+            let corners: Vec<DVec3> = (0..8)
+                .map(|k| {
+                    let s = |b: usize| if k >> b & 1 == 1 { 1.0 } else { -1.0 };
+                    c + u * (s(0) * h.x) + v * (s(1) * h.y) + w * (s(2) * h.z)
+                })
+                .collect();
+            out.push(ConvexPolyhedron::hull(&corners).unwrap());
+            let wedge = [
+                c,
+                c + DVec3::X * 0.5,
+                c + DVec3::Y * 0.4,
+                c + DVec3::Z * 0.3,
+                c + DVec3::new(0.5, 0.0, 0.3),
+                c + DVec3::new(0.0, 0.4, 0.3),
+            ];
+            out.push(ConvexPolyhedron::hull(&wedge).unwrap());
+            out.push(ConvexPolyhedron::icosphere(c, rng.range(0.1, 0.5), 0).unwrap());
+            out.push(ConvexPolyhedron::icosphere(c, rng.range(0.1, 0.5), 1).unwrap());
+            let pts: Vec<DVec3> = (0..10).map(|_| c + rng.vec(-0.5, 0.5)).collect();
+            if let Ok(p) = ConvexPolyhedron::hull(&pts) {
+                out.push(p);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn table_walk_matches_convex_planes() {
+        let mut rng = Rng(15);
+        let (mut compared, mut tables, mut accepted) = (0, 0, 0);
+        for p in polyhedra(&mut rng) {
+            // Beyond 64 triangles (the subdivided icosphere) the general walk serves.
+            let Some(faces) = ConvexFaces::of(&p) else {
+                assert!(p.mesh().triangle_count() > 64);
+                continue;
+            };
+            tables += usize::from(!faces.loops.is_empty());
+            let verts = p.vertices();
+            for k in 0..300 {
+                // Points all around, some in the plane of a face or through an edge's line.
+                let x = match k % 3 {
+                    0 => p.mesh().bounding_sphere().center + rng.vec(-3.0, 3.0),
+                    1 => {
+                        let (a, b) = (verts[k % verts.len()], verts[(k * 7 + 1) % verts.len()]);
+                        a + (a - b) * rng.range(0.5, 4.0)
+                    }
+                    _ => {
+                        let t = p.mesh().triangle(k % p.mesh().triangle_count());
+                        t[0] + (t[1] - t[0]) * rng.range(-2.0, 3.0)
+                            + (t[2] - t[0]) * rng.range(-2.0, 3.0)
+                    }
+                };
+                let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
+                let Ok(frame) = frame else { continue };
+                let (mut a, mut b) = (Pieces::new(), Pieces::new());
+                let fast = convex_blocker(&p, &faces, &frame, &mut a);
+                let general = convex_planes(&p, &frame, &mut b);
+                assert_eq!(fast, general, "{x}");
+                compared += 1;
+                if fast {
+                    accepted += 1;
+                    let bits = |v: &[DVec3]| -> Vec<u64> {
+                        v.iter()
+                            .flat_map(|d| d.to_array().map(f64::to_bits))
+                            .collect()
+                    };
+                    assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
+                    assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
+                }
+            }
+        }
+        assert!(
+            tables >= 12 && compared > 8_000 && accepted > compared / 2 && accepted < compared,
+            "{tables} tables, {compared} compared, {accepted} accepted"
+        );
+    }
+
+    #[test]
+    fn two_crossings_match_the_general_traversal() {
+        let mut rng = Rng(17);
+        let (mut pairs, mut two) = (0u64, 0u64);
+        for _ in 0..60 {
+            let light = TriangleMesh::quad(
+                DVec3::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), 2.0),
+                DVec3::new(0.0, rng.range(0.2, 0.8), rng.range(-0.2, 0.2)),
+                DVec3::new(rng.range(0.2, 0.8), 0.0, 0.0),
+            )
+            .unwrap();
+            let occluders: Vec<Body> = (0..1 + (rng.next() * 4.0) as usize)
+                .map(|k| {
+                    let c = DVec3::new(rng.range(-0.8, 0.8), rng.range(-0.8, 0.8), 1.0)
+                        + DVec3::Z * rng.range(-0.5, 0.4);
+                    if k % 2 == 0 {
+                        ConvexPolyhedron::cuboid(c, rng.vec(0.05, 0.3))
+                            .unwrap()
+                            .into()
+                    } else {
+                        ConvexPolyhedron::icosphere(c, rng.range(0.05, 0.3), 0)
+                            .unwrap()
+                            .into()
+                    }
+                })
+                .collect();
+            let vis = ClipVisibility::new(vec![Lit(light.into())], occluders);
+            for _ in 0..100 {
+                let x = DVec3::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), 0.0);
+                let n = DVec3::new(rng.range(-0.3, 0.3), rng.range(-0.3, 0.3), 1.0);
+                let frame = ShadingFrame::new(x, n, DVec3::Z).unwrap();
+                let (mut a, mut b) = (Pieces::new(), Pieces::new());
+                b.general_only = true;
+                let fast = vis.visible_pieces(0, &frame, true, &mut a).unwrap();
+                let general = vis.visible_pieces(0, &frame, true, &mut b).unwrap();
+                assert_eq!(fast, general);
+                assert_eq!(a.subtractions(), b.subtractions());
+                let rings = |p: &Pieces| -> Vec<Vec<u64>> {
+                    p.rings()
+                        .map(|r| {
+                            r.iter()
+                                .flat_map(|d| d.to_array().map(f64::to_bits))
+                                .collect()
+                        })
+                        .collect()
+                };
+                assert_eq!(rings(&a), rings(&b), "{x}");
+                pairs += 1;
+                two += a.two_crossings;
+            }
+        }
+        assert!(two > pairs / 4, "{two} of {pairs}");
+    }
 }
