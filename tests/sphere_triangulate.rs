@@ -3,7 +3,8 @@
 //! 1e-12 relative, and exact coverage of a deterministic direction set (a Fibonacci lattice plus
 //! directions around every vertex and across every edge) against `SphericalPolygon::contains`.
 //! Extra-vertex counts are printed per family (`cargo test --test sphere_triangulate --
-//! --nocapture`) and bounded: at most one except for the full sphere, none where none is needed.
+//! --nocapture`) and bounded: at most one except for the full sphere and the families that reach
+//! the coordinate cuts (`octant_cuts`), none where none is needed.
 
 #[path = "sphere_triangulate_check/mod.rs"]
 mod check;
@@ -87,6 +88,12 @@ fn poly(rings: Vec<Vec<DVec3>>) -> SphericalPolygon {
 
 /// Triangulates and checks; prints the family's numbers.
 fn run(name: &str, p: &SphericalPolygon) -> check::Report {
+    run_with(name, p, 1)
+}
+
+/// As [`run`], allowing `max_extra` extra vertices (the coordinate cuts of step 5 add them
+/// where edges cross the planes and along the planes' circles).
+fn run_with(name: &str, p: &SphericalPolygon, max_extra: usize) -> check::Report {
     let tris = p
         .triangulate()
         .unwrap_or_else(|e| panic!("{name}: triangulate failed: {e}\n{p:?}"));
@@ -106,7 +113,7 @@ fn run(name: &str, p: &SphericalPolygon) -> check::Report {
     // hemisphere bounded by vertices on its great circle), except the full sphere (a
     // tetrahedron's four). Families that need none assert 0 where they are built.
     assert!(
-        r.extra_vertices <= 1 || p.is_full(),
+        r.extra_vertices <= max_extra || p.is_full(),
         "{name}: {} extra vertices\n{p:?}",
         r.extra_vertices
     );
@@ -599,4 +606,148 @@ fn regression_fuzz_triangle_with_nearly_antipodal_vertices() {
         .sum();
     assert!((sum - 0.2507261794505107).abs() <= 1e-13, "{sum}");
     assert_eq!(r.extra_vertices, 0);
+}
+
+/// The sphere minus `k` small star-shaped holes of radius `r` in seeded random directions
+/// (`None` where two holes overlap): the complement of several small occluders. No cap narrower
+/// than a hemisphere holds the vertices, and every stereographic pole step 3 tries is inside
+/// the region or within its clearance of a hole, so with six or more holes this reaches the
+/// coordinate cuts of step 5.
+fn sphere_minus_holes(seed: u64, k: usize, r: f64) -> Option<SphericalPolygon> {
+    let mut rng = Rng::new(seed);
+    let rings: Vec<Vec<DVec3>> = (0..k)
+        .map(|_| {
+            let c = rng.dir();
+            reversed(star_ring(&mut rng, c, 5, r, 0.5))
+        })
+        .collect();
+    SphericalPolygon::new(rings).ok()
+}
+
+/// A strip of `n` edges per side between latitudes `-lat` and `lat` (as `z` before
+/// normalizing), wrapped `span` radians round the z axis: one ring wider than a hemisphere,
+/// star-shaped about no candidate of step 4, with long edges whose stereographic images stray
+/// from their arcs.
+fn wrapped_strip(n: usize, lat: f64, span: f64) -> SphericalPolygon {
+    let e = |t: f64, z: f64| DVec3::new(t.cos(), t.sin(), z).normalize();
+    let mut ring: Vec<DVec3> = (0..=n)
+        .map(|i| e(span * i as f64 / n as f64, -lat))
+        .collect();
+    ring.extend((0..=n).rev().map(|i| e(span * i as f64 / n as f64, lat)));
+    poly(vec![ring])
+}
+
+/// The polygons of the step-5 tests, named.
+fn octant_cut_families() -> Vec<(String, SphericalPolygon)> {
+    let mut out = Vec::new();
+    for (seed, k, r) in [
+        (1, 6, 0.01),
+        (1, 6, 1e-3),
+        (8, 6, 0.03),
+        (10, 7, 0.04),
+        (11, 12, 0.03),
+        (3, 10, 0.01),
+        (4, 10, 1e-3),
+        (5, 10, 0.04),
+        (6, 16, 0.02),
+        (7, 8, 1e-6),
+    ] {
+        if let Some(p) = sphere_minus_holes(seed, k, r) {
+            out.push((format!("sphere minus {k} holes of {r:e} (seed {seed})"), p));
+        }
+    }
+    for (n, lat, span) in [(8, 1.0, 1.7 * PI), (7, 1.0, 1.8 * PI), (10, 1.0, 1.8 * PI)] {
+        out.push((
+            format!("strip of {n} edges at latitude {lat} over {span:.2} rad"),
+            wrapped_strip(n, lat, span),
+        ));
+    }
+    out
+}
+
+/// Step 5 of `triangulate` (coordinate cuts) on the families that reach it: the sphere minus
+/// many small holes and a ring wrapped most of the way round the sphere. That the step is
+/// reached shows in the extra vertices: steps 2 and 4 add at most one and step 3 none, so two or
+/// more come from the cuts. The halves tile the region: the checker's coverage and areas within
+/// 1e-12 relative.
+#[test]
+fn octant_cuts() {
+    for (name, p) in octant_cut_families() {
+        let r = run_with(&name, &p, 24);
+        assert!(r.area_error <= 1e-13, "{name}: {:e}", r.area_error);
+        // A change that handles a family earlier (a better pole in step 3) should replace it
+        // here by one that still reaches the cuts.
+        assert!(
+            r.extra_vertices >= 2,
+            "{name} no longer reaches the coordinate cuts"
+        );
+    }
+}
+
+/// What makes step 5's halves tile the region: for every coordinate cut, every vertex the clip
+/// makes lies exactly on the plane (axis coordinate `0.0`), and the two halves end their chains
+/// at the same vectors, bit for bit up to the sign of zeros (a half's vertex on the plane next to one off it is an
+/// edge's crossing, which the other half must have too). Checked for the cuts of every family
+/// of [`octant_cuts`], on the halves as `triangulate` makes them (each half cut again by the
+/// next plane).
+#[test]
+fn octant_cut_halves_share_their_vertices() {
+    // Bits, with -0.0 as 0.0: the projection onto the plane may give a zero either sign.
+    fn bits(p: DVec3) -> [u64; 3] {
+        p.to_array().map(|x| (x + 0.0).to_bits())
+    }
+    // The vertices of `half` on plane `k` next to one off it that are not (projections of)
+    // vertices of the polygon cut: the edges' crossings.
+    fn crossings(half: &SphericalPolygon, k: usize, cut: &SphericalPolygon) -> Vec<[u64; 3]> {
+        let mut out = Vec::new();
+        let snapped = |v: DVec3| cut.rings().flatten().any(|&w| (v - w).length() <= 1e-11);
+        for ring in half.rings() {
+            let m = ring.len();
+            for i in 0..m {
+                let (p, q, v) = (ring[(i + m - 1) % m], ring[(i + 1) % m], ring[i]);
+                let on = |x: DVec3| x.to_array()[k] == 0.0;
+                if on(v) && (!on(p) || !on(q)) && !snapped(v) {
+                    out.push(bits(v));
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+    let axes = [DVec3::X, DVec3::Y, DVec3::Z];
+    let mut cuts = 0;
+    for (name, p) in octant_cut_families() {
+        let mut level = vec![p];
+        for (k, &n) in axes.iter().enumerate() {
+            let mut next = Vec::new();
+            for q in &level {
+                let own: Vec<[u64; 3]> = q.rings().flatten().map(|&v| bits(v)).collect();
+                let (up, down) = (q.clip_to_hemisphere(n), q.clip_to_hemisphere(-n));
+                for half in [&up, &down] {
+                    for &v in half.rings().flatten() {
+                        assert!(
+                            own.contains(&bits(v)) || v.to_array()[k] == 0.0,
+                            "{name}: cut {k} made the vertex {v:?} off the plane"
+                        );
+                    }
+                }
+                // Vertices on or within the clip's tolerance of the plane (polygon vertices, and
+                // circle points an earlier cut placed by sin and cos, 1e-16 off the next plane)
+                // are projected onto it; where the ring passes through the plane both halves do
+                // so alike, where it only touches the plane or runs along it the region lies on
+                // one side (up to what `cut_allowance` bounds). Only the crossings of edges are
+                // compared.
+                assert_eq!(
+                    crossings(&up, k, q),
+                    crossings(&down, k, q),
+                    "{name}: the halves of cut {k} end at different crossings"
+                );
+                cuts += 1;
+                next.extend([up, down].into_iter().filter(|h| !h.is_empty()));
+            }
+            level = next;
+        }
+    }
+    assert!(cuts > 50, "{cuts}");
 }

@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 use super::gnomonic::enclosing_cap;
 use super::polygon::SphericalPolygon;
 use super::predicates::{AXES, normalize_any, orient, tangent_frame};
-use super::sample::{SphericalTriangle, signed_solid_angle, signed_solid_angle_with_error};
+use super::sample::{SphericalTriangle, signed_solid_angle_with_error};
 use crate::GeomError;
 use crate::planar::{Cdt, constrained_delaunay};
 
@@ -56,7 +56,12 @@ impl SphericalPolygon {
     /// 5. otherwise the region is cut in two by the coordinate plane `x = 0` (exact hemisphere
     ///    clipping, [`SphericalPolygon::clip_to_hemisphere`]), each half solved the same way, then
     ///    `y = 0`, then `z = 0`; an octant always fits a chart. The cuts add vertices where edges
-    ///    cross the planes. No test family reaches this step.
+    ///    cross the planes and along the planes' circles, and the two halves share every vertex
+    ///    on a cut bit for bit. Regions reach this step when no cap narrower than a hemisphere
+    ///    holds their vertices, no stereographic pole of step 3 is both outside them and clear of
+    ///    their vertices (the sphere minus six or more small holes, a complement of many small
+    ///    occluders) or its chart cannot be repaired, and they are not one ring star-shaped about
+    ///    a candidate point (a ring wrapped most of the way round the sphere with long edges).
     ///
     /// Thesis 003 section 6.2 adds extra vertices where a triangulation would need arcs longer
     /// than `pi`; here steps 1-3 use none, and an extra vertex is added (steps 2 and 4) only
@@ -74,8 +79,10 @@ impl SphericalPolygon {
     /// reverse, and the areas add up to the region's within `2 pi`. The first two make the
     /// number of triangles over any direction off the edges equal to the region's indicator
     /// plus a constant `k`, and the third makes `k = 0`: the triangles tile the region exactly
-    /// (for step 5, each half exactly; the halves tile the region up to the rounding of the
-    /// crossing points the clipping computes). Deterministic; no sampling.
+    /// (for step 5, each half exactly, and the halves meet exactly along the cut; they tile the
+    /// region up to what the clipping moves: the crossing points rounded off their edges, and
+    /// vertices within the clip's tolerances of a cut plane snapped onto it). Deterministic; no
+    /// sampling.
     ///
     /// Triangles certified positive whose area rounds to zero (slivers below rounding between
     /// nearly collinear vertices) are left out: they cover nothing beyond rounding of an edge.
@@ -102,8 +109,9 @@ impl SphericalPolygon {
     ///
     /// [`GeomError::Undecidable`] when no candidate passes the certificate (rounding in every
     /// chart made the planar triangulation disagree with the sphere at a near-degeneracy), or
-    /// when the triangles' areas miss the region's by more than `1e-9` relative (which would
-    /// mean a clipping fault). Never a wrong triangulation.
+    /// when the triangles' areas miss the region's by more than `1e-12` relative plus the
+    /// rounding bounds of both sums and what step 5's clipping may move (which would mean a
+    /// fault). Never a wrong triangulation.
     pub fn triangulate(&self) -> Result<Vec<SphericalTriangle>, GeomError> {
         if let Some(ring) = self.single_ring()
             && let Some(fan) = fan_from_first(ring)
@@ -111,13 +119,17 @@ impl SphericalPolygon {
             return Ok(fan);
         }
         let mut tris: Vec<[DVec3; 3]> = Vec::new();
-        solve(self, 0, &mut tris)?;
+        let mut moved = 0.0;
+        solve(self, 0, &mut tris, &mut moved)?;
         let mut out = Vec::with_capacity(tris.len());
-        let mut sum = 0.0;
+        let (mut sum, mut rounding) = (0.0, 0.0);
         for [a, b, c] in tris {
             match SphericalTriangle::from_unit(a, b, c) {
                 Ok(t) => {
                     sum += t.solid_angle();
+                    // The triangles are certified positive, so `(a, b, c)` is the
+                    // counter-clockwise order whose area `from_unit` took.
+                    rounding += signed_solid_angle_with_error(a, b, c).1;
                     out.push(t);
                 }
                 // Certified positive, area below rounding.
@@ -125,8 +137,12 @@ impl SphericalPolygon {
                 Err(e) => return Err(e),
             }
         }
-        let area = region_area(self);
-        if !((sum - area).abs() <= 1e-9 * area + 1e-300) {
+        let (area, area_err) = region_area_with_error(self);
+        // The certificate makes the triangles tile the polygon (for step 5, the polygon the cuts
+        // leave: see `cut_allowance`), so the sums may differ only by their rounding.
+        let tol =
+            AREA_GUARD * area + rounding + out.len() as f64 * f64::EPSILON * sum + area_err + moved;
+        if !((sum - area).abs() <= tol) {
             return Err(GeomError::Undecidable(
                 "triangle areas do not add up to the polygon's",
             ));
@@ -174,14 +190,20 @@ fn fan_from_first(ring: &[DVec3]) -> Option<Vec<SphericalTriangle>> {
 
 /// The region's solid angle, reduced modulo `4 pi` only after the rings' signed fan sums (from
 /// a vertex or axis far from every antipode of the ring; a triangle's area is defined modulo `4 pi` even where its far edge
-/// passes the apex's antipode, see [`signed_solid_angle`]) are added, so that a tiny outer ring and its tiny hole cancel as small numbers (reducing each
+/// passes the apex's antipode, see [`signed_solid_angle_with_error`]) are added, so that a tiny outer ring and its tiny hole cancel as small numbers (reducing each
 /// ring first, as a ring's own left area must be, leaves the hole at `4 pi - epsilon`, which
 /// cannot hold `epsilon` to relative precision).
 fn region_area(poly: &SphericalPolygon) -> f64 {
+    region_area_with_error(poly).0
+}
+
+/// [`region_area`] and a bound on its rounding error: the fan terms' own bounds
+/// ([`signed_solid_angle_with_error`]) plus the rounding of their sum.
+fn region_area_with_error(poly: &SphericalPolygon) -> (f64, f64) {
     if poly.is_full() {
-        return 4.0 * PI;
+        return (4.0 * PI, 0.0);
     }
-    let mut sum = 0.0;
+    let (mut sum, mut err, mut magnitude) = (0.0, 0.0, 0.0);
     for ring in poly.rings() {
         // The apex: the first vertex, unless a vertex is near its antipode (where the arcs from
         // the apex are undefined); then the vertex or axis farthest from every antipode.
@@ -202,11 +224,22 @@ fn region_area(poly: &SphericalPolygon) -> f64 {
         for i in 0..n {
             let (b, c) = (ring[i], ring[(i + 1) % n]);
             if b != apex && c != apex {
-                sum += signed_solid_angle(apex, b, c);
+                let (w, e) = signed_solid_angle_with_error(apex, b, c);
+                sum += w;
+                err += e;
+                magnitude += w.abs();
             }
         }
     }
-    sum.rem_euclid(4.0 * PI)
+    // Recursive summation rounds by at most (terms - 1) eps times the sum of magnitudes; the
+    // reduction rounds only when it shifts the sum.
+    let terms = poly.vertex_count() as f64;
+    let reduced = sum.rem_euclid(4.0 * PI);
+    let shift = if reduced == sum { 0.0 } else { 4.0 * PI };
+    (
+        reduced,
+        err + terms * f64::EPSILON * magnitude + f64::EPSILON * shift,
+    )
 }
 
 /// A polygon as indexed geometry: its distinct vertices (equal bits are one vertex, so pinches
@@ -248,11 +281,14 @@ impl Indexed {
     }
 }
 
-/// Triangulates `poly` into `out`; `depth` is the number of coordinate cuts already made.
+/// Triangulates `poly` into `out`; `depth` is the number of coordinate cuts already made, and
+/// `moved` collects a bound on the solid angle by which the cuts' halves may miss tiling `poly`
+/// ([`cut_allowance`]).
 fn solve(
     poly: &SphericalPolygon,
     depth: usize,
     out: &mut Vec<[DVec3; 3]>,
+    moved: &mut f64,
 ) -> Result<(), GeomError> {
     if poly.is_empty() {
         return Ok(());
@@ -343,15 +379,56 @@ fn solve(
             ix.verts.pop();
         }
     }
-    // 5. Cut by the next coordinate plane.
+    // 5. Cut by the next coordinate plane. The two halves share every vertex on the plane bit
+    // for bit (see `cut_allowance`), so their triangles meet along the cut without gaps or
+    // overlaps.
     if depth < 3 {
         let n = AXES[depth];
-        solve(&poly.clip_to_hemisphere(n), depth + 1, out)?;
-        return solve(&poly.clip_to_hemisphere(-n), depth + 1, out);
+        *moved += cut_allowance(poly, n);
+        solve(&poly.clip_to_hemisphere(n), depth + 1, out, moved)?;
+        return solve(&poly.clip_to_hemisphere(-n), depth + 1, out, moved);
     }
     Err(GeomError::Undecidable(
         "no chart of an octant triangulates the polygon within rounding",
     ))
+}
+
+/// Relative part of the final guard of [`SphericalPolygon::triangulate`]: the triangles' areas
+/// must add up to the region's within this fraction of it, on top of the rounding bounds of both
+/// sums and the cuts' [`cut_allowance`].
+const AREA_GUARD: f64 = 1e-12;
+
+/// A bound on the solid angle by which the halves `poly.clip_to_hemisphere(n)` and
+/// `poly.clip_to_hemisphere(-n)` of step 5, for a coordinate axis `n`, can fail to tile `poly`.
+///
+/// Where they meet they agree bit for bit: every vertex the clip makes on the plane (an edge's
+/// crossing `w - n (w . n)` with `w = below (above . n) - above (below . n)`, a vertex near the
+/// plane projected as `p - n (p . n)`, a point of the circle `u cos t + v sin t` with `u`, `v`
+/// orthogonal to the axis) has its axis coordinate exactly zero, and an edge's crossing is the
+/// same expression for `n` and `-n` (heights negated exactly, `above` and `below` swapped), so
+/// both halves end their chains at the same vectors and their edges along the cut lie on the
+/// same great circle. What the halves can miss is what the clip moves: a crossing rounded off
+/// its edge (the thin triangle between the edge and its two pieces: the edge's length times the
+/// crossing's error bound, `8e-15` plus `4e-15` over the length of `w`), and vertices or edges
+/// within the clip's tolerances of the plane, snapped onto it (`8e-12` times the length of
+/// their edges, and the slivers dropped, `1e-12` times the squared length).
+fn cut_allowance(poly: &SphericalPolygon, n: DVec3) -> f64 {
+    let mut moved = 0.0;
+    for ring in poly.rings() {
+        let m = ring.len();
+        for i in 0..m {
+            let (a, b) = (ring[i], ring[(i + 1) % m]);
+            let (sa, sb) = (a.dot(n), b.dot(n));
+            let len = (a - b).length();
+            if sa.abs() <= 1e-11 || sb.abs() <= 1e-11 {
+                moved += 8e-12 * len + 1e-12 * len * len;
+            } else if (sa > 0.0) != (sb > 0.0) {
+                let w = (b * sa - a * sb).length();
+                moved += len * (8e-15 + 4e-15 / w);
+            }
+        }
+    }
+    moved
 }
 
 /// The full sphere as the four faces of a regular tetrahedron, positively oriented.
