@@ -751,3 +751,33 @@ fn octant_cut_halves_share_their_vertices() {
     }
     assert!(cuts > 50, "{cuts}");
 }
+
+/// Found by `tests/sphere_triangulate_census.rs`: the complement of a ring 1e-10 rad across.
+/// Its fan from the far side has every apex within 1e-10 of the antipode of both other
+/// vertices, where Van Oosterom-Strackee's denominator is about 1e-21 and the vertices' own
+/// normalization error (their lengths are 1 within 2e-16) moved each area by up to 2e-11: the
+/// sum was 5e-12 (relative) short, and the final guard gave up. The triangles' areas now use
+/// the unit vectors' chords; within 4e-16 of 60-digit values of these triangles.
+#[test]
+fn regression_complement_of_a_ring_1e_10_across() {
+    let v = [
+        [-0.21277109934982402, 0.475264968854496, -0.8537280999599359],
+        [-0.2127710993157535, 0.4752649689184834, -0.853728099932806],
+        [
+            -0.21277109939008726,
+            0.4752649689157283,
+            -0.8537280999158139,
+        ],
+        [-0.2127710994299239, 0.4752649689087198, -0.8537280999097869],
+        [
+            -0.21277109947857786,
+            0.4752649688262925,
+            -0.8537280999435478,
+        ],
+        [-0.2127710994123778, 0.4752649688070814, -0.8537280999707415],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    let r = run("complement of a ring 1e-10 across", &p);
+    assert!(r.area_error <= 1e-15, "{:e}", r.area_error);
+    assert_eq!(r.extra_vertices, 1);
+}
