@@ -781,3 +781,51 @@ fn regression_complement_of_a_ring_1e_10_across() {
     assert!(r.area_error <= 1e-15, "{:e}", r.area_error);
     assert_eq!(r.extra_vertices, 1);
 }
+
+/// Found by the `sphere_triangulate` fuzz target: the complement of a sliver triangle 1e-9 wide
+/// (its vertices within 1e-9 of one great circle). No chart takes it whole (its fan apexes lie
+/// on that circle; no stereographic pole fits in the sliver), so the coordinate cuts do, and
+/// the cut `x = 0` crosses the sliver's two long edges 1e-18 apart near its tip: two distinct
+/// vertices that no chart separates, where `triangulate` gave up. It now merges vertices closer
+/// than `COINCIDENT_TOLERANCE` (the same direction for every purpose of the crate). The half it
+/// gave up on (the hemisphere `x <= 0` less a spike, with those two vertices) is checked too,
+/// with the two vertices 1e-18 to 1e-9 apart.
+#[test]
+fn complement_of_a_sliver_and_vertices_closer_than_rounding() {
+    let (b, c) = (
+        DVec3::new(
+            -0.5773502691896258,
+            -0.5773502691896258,
+            -0.5773502691896258,
+        ),
+        DVec3::new(-0.7071067811865475, -0.7071067811865475, 0.0),
+    );
+    for e in [1e-10, 1e-9, 1e-8, 1e-6, 1e-4] {
+        let a = DVec3::new(e, 0.0, 1.0).normalize();
+        let r = run_with(
+            &format!("complement of a sliver {e:e} wide"),
+            &poly(vec![vec![a, b, c]]),
+            12,
+        );
+        assert!(r.area_error <= 1e-13, "{:e}", r.area_error);
+        run(&format!("sliver {e:e} wide"), &poly(vec![vec![a, c, b]]));
+    }
+    let ring = |sep: f64| {
+        vec![
+            DVec3::new(0.0, -1e-9 - sep, 1.0),
+            b,
+            c,
+            DVec3::new(0.0, -1e-9, 1.0),
+            DVec3::new(-0.0, 1.0, 1.0000002664373908e-9),
+            DVec3::new(0.0, 1.0000003276697308e-9, -1.0),
+            DVec3::new(0.0, -1.0, -1.0000003889020707e-9),
+        ]
+    };
+    for sep in [1e-18, 1e-17, 1e-16, 1e-15, 1e-12, 1e-9] {
+        run_with(
+            &format!("spike with vertices {sep:e} apart"),
+            &poly(vec![ring(sep)]),
+            12,
+        );
+    }
+}

@@ -211,6 +211,46 @@ fn give_ups_on_near_degenerate_inputs() {
                 census.run("vertices just above a great circle", &p);
             }
         }
+        // A sliver triangle 1e-12..1e-6 wide (two long edges 1e-12..1e-6 rad apart at one end)
+        // and its complement, whose coordinate cuts cross the sliver's tip.
+        {
+            let (u, _) = c.any_orthonormal_pair();
+            let (l1, l2) = (rng.range(0.3, 2.5), rng.range(0.3, 2.5));
+            let w = 10f64.powf(rng.range(-12.0, -6.0));
+            let far = polar(c, l1, rng.range(0.0, 2.0 * PI));
+            let tip = (c + u * w).normalize();
+            let other = polar(c, l2, rng.range(0.0, 2.0 * PI));
+            if let Some(p) = poly(vec![vec![tip, far, other]]) {
+                census.run("thin triangle", &p);
+                census.run("complement of a thin triangle", &p.complement());
+            }
+            if let Some(p) = poly(vec![vec![tip, far, c]]) {
+                census.run("sliver", &p);
+                census.run("complement of a sliver", &p.complement());
+            }
+        }
+        // A thin triangle whose tip lies 1e-12..1e-6 across the coordinate plane x = 0 and whose
+        // long edges both cross it (1e-24..1e-12 apart) on their way to the far vertices on a
+        // great circle through the tip's foot, and the complement, which the coordinate cuts
+        // of step 5 triangulate.
+        {
+            let w = 10f64.powf(rng.range(-12.0, -6.0));
+            let foot = DVec3::new(0.0, rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)).normalize();
+            let t = DVec3::new(-1.0, rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+            let d = (t - foot * t.dot(foot)).normalize();
+            let (l1, l2) = (rng.range(0.2, 1.2), rng.range(1.3, 2.8));
+            let far = |l: f64| foot * l.cos() + d * l.sin();
+            let tip = (foot + DVec3::X * w).normalize();
+            for ring in [vec![tip, far(l2), far(l1)], vec![tip, far(l1), far(l2)]] {
+                if let Some(p) = poly(vec![ring]) {
+                    census.run("thin triangle across a cut", &p);
+                    census.run(
+                        "complement of a thin triangle across a cut",
+                        &p.complement(),
+                    );
+                }
+            }
+        }
         // A ring with a vertex 1e-9..1e-3 from the antipode of another.
         {
             let a = rng.dir();
