@@ -321,15 +321,13 @@ fn tiny_polygons() {
                 &format!("{s:e} comb {where_}"),
                 &poly(vec![ring(c, s / 10.0, &comb(4))]),
             );
-            // The complement through `complement()`: `SphericalPolygon::new` rejects a
-            // clockwise ring of 1e-9 rad as of zero area (its left side, 4 pi - 1e-18, rounds
-            // to 4 pi), so tiny holes are built at 1e-7 below.
-            run(
-                &format!("complement of a {s:e} L {where_}"),
-                &poly(vec![ring(c, s, &L)]).complement(),
-            );
+            // The complement through `complement()` and as a clockwise ring given to `new`:
+            // the same region.
+            let complement = poly(vec![ring(c, s, &L)]).complement();
+            assert_eq!(poly(vec![reversed(ring(c, s, &L))]), complement);
+            run(&format!("complement of a {s:e} L {where_}"), &complement);
         }
-        for s in [1e-6, 1e-7] {
+        for s in [1e-6, 1e-7, 1e-9, 1e-10] {
             run(
                 &format!("{s:e} square with a hole {where_}"),
                 &poly(vec![
@@ -827,5 +825,44 @@ fn complement_of_a_sliver_and_vertices_closer_than_rounding() {
             &poly(vec![ring(sep)]),
             12,
         );
+    }
+}
+
+/// `triangulate` is deterministic: the same polygon gives the same triangles, bit for bit, on
+/// every call and on a copy built again from its rings, for every path (the fan, a chart, the
+/// stereographic chart, a fan from an extra vertex, the coordinate cuts).
+#[test]
+fn triangulation_is_deterministic() {
+    let c = generic();
+    let mut rng = Rng::new(9);
+    let mut polys: Vec<SphericalPolygon> = vec![
+        poly(vec![ring(c, 0.2, &L)]),
+        poly(vec![ring(c, 0.1, &spiral())]),
+        poly(vec![reversed(ring(c, 0.3, &ngon(4)))]),
+        poly(vec![star_ring(&mut rng, c, 40, 0.6, 0.3)]),
+        SphericalPolygon::full(),
+    ];
+    polys.extend(octant_cut_families().into_iter().map(|(_, p)| p));
+    let bits = |p: &SphericalPolygon| -> Vec<[u64; 9]> {
+        p.triangulate()
+            .unwrap()
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.vertices();
+                let v = [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z];
+                v.map(f64::to_bits)
+            })
+            .collect()
+    };
+    for p in &polys {
+        let first = bits(p);
+        assert!(!first.is_empty());
+        for _ in 0..3 {
+            assert_eq!(bits(p), first, "{p:?}");
+        }
+        if !p.is_full() {
+            let again = poly(p.rings().map(<[DVec3]>::to_vec).collect());
+            assert_eq!(bits(&again), first, "{p:?}");
+        }
     }
 }
