@@ -734,7 +734,7 @@ fn octant_cut_halves_share_their_vertices() {
                 // circle points an earlier cut placed by sin and cos, 1e-16 off the next plane)
                 // are projected onto it; where the ring passes through the plane both halves do
                 // so alike, where it only touches the plane or runs along it the region lies on
-                // one side (up to what `cut_allowance` bounds). Only the crossings of edges are
+                // one side (up to what the clip moves there). Only the crossings of edges are
                 // compared.
                 assert_eq!(
                     crossings(&up, k, q),
@@ -865,4 +865,35 @@ fn triangulation_is_deterministic() {
             assert_eq!(bits(&again), first, "{p:?}");
         }
     }
+}
+
+/// Found by the `sphere_triangulate` fuzz target: a pinched ring with two pairs of nearly
+/// antipodal vertices, triangulated by the coordinate cuts. The cut `x = 0`, where two edges
+/// cross the plane 3e-12 apart, lost 1.2e-11 sr (3.6e-12 relative) of the polygon, and the final
+/// guard let it through on an a-priori allowance for the clip. Each cut now measures its halves'
+/// areas against the polygon's and takes the first coordinate plane that adds up (here `y = 0`),
+/// and the guard allows no clip move beyond 1e-12 relative.
+#[test]
+fn regression_fuzz_cut_through_nearly_crossing_edges() {
+    let v = [
+        [-0.42759275762122007, 0.6067106269109613, 0.6701243532533263],
+        [0.0, -1.0, 0.0],
+        [
+            0.12574832228809996,
+            -0.5768963064724225,
+            -0.8070799285202208,
+        ],
+        [-0.906984700465906, 0.08958632105541348, -0.4115252655676527],
+        [-0.42759275762122007, 0.6067106269109613, 0.6701243532533263],
+        [
+            -0.8476509425317053,
+            -0.011531065015006448,
+            -0.5304289906903008,
+        ],
+        [0.4275927576212198, -0.6067106269109613, -0.6701243532533263],
+        [0.8476509425317055, 0.011531065015006114, 0.5304289906903004],
+    ];
+    let p = poly(vec![v.iter().map(|&a| DVec3::from_array(a)).collect()]);
+    let r = run_with("pinched ring with antipodal pairs", &p, 12);
+    assert!(r.area_error <= 1e-12, "{:e}", r.area_error);
 }

@@ -114,8 +114,9 @@ impl SphericalPolygon {
     /// [`GeomError::Undecidable`] when no candidate passes the certificate (rounding in every
     /// chart made the planar triangulation disagree with the sphere at a near-degeneracy), or
     /// when the triangles' areas miss the region's by more than `1e-12` relative plus the
-    /// rounding bounds of both sums and what step 5's clipping may move (which would mean a
-    /// fault). Never a wrong triangulation.
+    /// rounding bounds of both sums (and the move of merged vertices): a fault, or step 5's
+    /// clips moving the boundary by more than that at every plane tried. Never a wrong
+    /// triangulation.
     pub fn triangulate(&self) -> Result<Vec<SphericalTriangle>, GeomError> {
         if let Some(ring) = self.single_ring()
             && let Some(fan) = fan_from_first(ring)
@@ -142,8 +143,8 @@ impl SphericalPolygon {
             }
         }
         let (area, area_err) = region_area_with_error(self);
-        // The certificate makes the triangles tile the polygon (for step 5, the polygon the cuts
-        // leave: see `cut_allowance`), so the sums may differ only by their rounding.
+        // The certificate makes the triangles tile the polygon (for step 5, the halves the cuts
+        // leave: see `cut`), so the sums may differ only by their rounding.
         let tol =
             AREA_GUARD * area + rounding + out.len() as f64 * f64::EPSILON * sum + area_err + moved;
         if !((sum - area).abs() <= tol) {
@@ -360,12 +361,12 @@ impl Indexed {
     }
 }
 
-/// Triangulates `poly` into `out`; `depth` is the number of coordinate cuts already made, and
-/// `moved` collects a bound on the solid angle by which the cuts' halves may miss tiling `poly`
-/// ([`cut_allowance`]).
+/// Triangulates `poly` into `out`; `used` has bit `k` set for each coordinate plane `AXES[k]`
+/// already cut by, and `moved` collects a bound on the solid angle that merging unresolved
+/// vertices moves ([`Indexed::merge_unresolved`]).
 fn solve(
     poly: &SphericalPolygon,
-    depth: usize,
+    used: u8,
     out: &mut Vec<[DVec3; 3]>,
     moved: &mut f64,
 ) -> Result<(), GeomError> {
@@ -459,14 +460,11 @@ fn solve(
             ix.verts.pop();
         }
     }
-    // 5. Cut by the next coordinate plane. The two halves share every vertex on the plane bit
-    // for bit (see `cut_allowance`), so their triangles meet along the cut without gaps or
-    // overlaps.
-    if depth < 3 {
-        let n = AXES[depth];
-        *moved += cut_allowance(poly, n);
-        solve(&poly.clip_to_hemisphere(n), depth + 1, out, moved)?;
-        return solve(&poly.clip_to_hemisphere(-n), depth + 1, out, moved);
+    // 5. Cut by a coordinate plane not used yet (see `cut`).
+    if used != 0b111 {
+        let (k, up, down) = cut(poly, used);
+        solve(&up, used | 1 << k, out, moved)?;
+        return solve(&down, used | 1 << k, out, moved);
     }
     Err(GeomError::Undecidable(
         "no chart of an octant triangulates the polygon within rounding",
@@ -475,40 +473,51 @@ fn solve(
 
 /// Relative part of the final guard of [`SphericalPolygon::triangulate`]: the triangles' areas
 /// must add up to the region's within this fraction of it, on top of the rounding bounds of both
-/// sums and the cuts' [`cut_allowance`].
+/// sums and the move of merged vertices. What step 5's clips move ([`cut`]) must fit in it.
 const AREA_GUARD: f64 = 1e-12;
 
-/// A bound on the solid angle by which the halves `poly.clip_to_hemisphere(n)` and
-/// `poly.clip_to_hemisphere(-n)` of step 5, for a coordinate axis `n`, can fail to tile `poly`.
+/// Step 5 of [`SphericalPolygon::triangulate`]: the halves `poly.clip_to_hemisphere(n)` and
+/// `poly.clip_to_hemisphere(-n)` for the first coordinate axis `n = AXES[k]` not in `used` whose
+/// halves' solid angles add up to the polygon's within their rounding bounds, else for the one
+/// that comes closest (the final guard of [`SphericalPolygon::triangulate`] then decides whether
+/// that is close enough); with `k`.
 ///
-/// Where they meet they agree bit for bit: every vertex the clip makes on the plane (an edge's
-/// crossing `w - n (w . n)` with `w = below (above . n) - above (below . n)`, a vertex near the
-/// plane projected as `p - n (p . n)`, a point of the circle `u cos t + v sin t` with `u`, `v`
-/// orthogonal to the axis) has its axis coordinate exactly zero, and an edge's crossing is the
-/// same expression for `n` and `-n` (heights negated exactly, `above` and `below` swapped), so
-/// both halves end their chains at the same vectors and their edges along the cut lie on the
-/// same great circle. What the halves can miss is what the clip moves: a crossing rounded off
-/// its edge (the thin triangle between the edge and its two pieces: the edge's length times the
-/// crossing's error bound, `8e-15` plus `4e-15` over the length of `w`), and vertices or edges
-/// within the clip's tolerances of the plane, snapped onto it (`8e-12` times the length of
-/// their edges, and the slivers dropped, `1e-12` times the squared length).
-fn cut_allowance(poly: &SphericalPolygon, n: DVec3) -> f64 {
-    let mut moved = 0.0;
-    for ring in poly.rings() {
-        let m = ring.len();
-        for i in 0..m {
-            let (a, b) = (ring[i], ring[(i + 1) % m]);
-            let (sa, sb) = (a.dot(n), b.dot(n));
-            let len = (a - b).length();
-            if sa.abs() <= 1e-11 || sb.abs() <= 1e-11 {
-                moved += 8e-12 * len + 1e-12 * len * len;
-            } else if (sa > 0.0) != (sb > 0.0) {
-                let w = (b * sa - a * sb).length();
-                moved += len * (8e-15 + 4e-15 / w);
-            }
+/// Where the halves meet they agree bit for bit: every vertex the clip makes on the plane (an
+/// edge's crossing `w - n (w . n)` with `w = below (above . n) - above (below . n)`, a vertex
+/// near the plane projected as `p - n (p . n)`, a point of the circle `u cos t + v sin t` with
+/// `u`, `v` orthogonal to the axis) has its axis coordinate exactly zero, and an edge's crossing
+/// is the same expression for `n` and `-n` (heights negated exactly, `above` and `below`
+/// swapped), so both halves end their chains at the same vectors and their edges along the cut
+/// lie on the same great circle. What the halves can still miss is what the clip moves: a
+/// crossing rounded off its edge (about `1e-14` of the edge's length), vertices or edges within
+/// the clip's tolerances of the plane snapped onto it, and crossings of two edges that meet
+/// within `1e-11` of the plane, which the clip may take in the wrong order (a pinched polygon
+/// with nearly antipodal vertices lost 1.2e-11 sr to the cut `x = 0`, and none to `y = 0`).
+/// Measuring each candidate avoids the last where another plane is clean.
+fn cut(poly: &SphericalPolygon, used: u8) -> (usize, SphericalPolygon, SphericalPolygon) {
+    let (area, area_err) = region_area_with_error(poly);
+    let mut best: Option<(usize, SphericalPolygon, SphericalPolygon, f64)> = None;
+    for k in (0..3).filter(|k| used & 1 << k == 0) {
+        let (up, down) = (
+            poly.clip_to_hemisphere(AXES[k]),
+            poly.clip_to_hemisphere(-AXES[k]),
+        );
+        let ((a_up, e_up), (a_down, e_down)) =
+            (region_area_with_error(&up), region_area_with_error(&down));
+        let rounding = area_err + e_up + e_down + 4.0 * f64::EPSILON * (a_up + a_down + area);
+        let miss = ((a_up + a_down - area).abs() - rounding).max(0.0);
+        if miss == 0.0 {
+            return (k, up, down);
+        }
+        if best.as_ref().is_none_or(|b| miss < b.3) {
+            best = Some((k, up, down, miss));
         }
     }
-    moved
+    // `used` has a free axis whenever this is called.
+    best.map_or_else(
+        || (0, SphericalPolygon::empty(), SphericalPolygon::empty()),
+        |(k, up, down, _)| (k, up, down),
+    )
 }
 
 /// The full sphere as the four faces of a regular tetrahedron, positively oriented.
