@@ -897,3 +897,29 @@ fn regression_fuzz_cut_through_nearly_crossing_edges() {
     let r = run_with("pinched ring with antipodal pairs", &p, 12);
     assert!(r.area_error <= 1e-12, "{:e}", r.area_error);
 }
+
+/// Found by the `sphere_triangulate` fuzz target (through its checker's reference direction): a
+/// sliver 1e-9 wide along the circle `x = 0`, seen from `q` 0.18 rad away. The feet of `q` on the
+/// sliver's two long edges lie within 1e-18 (relative) of the same distance, on the edges'
+/// opposite sides, so the nearest feature, which `contains` decided by, was chosen by rounding:
+/// `contains(q)` said inside. Such ties now go to the parity of exact crossings.
+#[test]
+fn regression_fuzz_contains_beside_a_sliver() {
+    let p = poly(vec![vec![
+        DVec3::new(0.0, 0.7071067811865475, 0.7071067811865475),
+        DVec3::new(-1e-9, 0.0, 1.0),
+        DVec3::new(0.0, 0.14378924498659834, 0.9896083331430592),
+    ]]);
+    assert!(p.solid_angle() < 4e-10);
+    for q in [
+        DVec3::new(0.17608480733726006, 0.0, 0.984375),
+        DVec3::new(-0.17608480733726006, 0.0, 0.984375),
+        DVec3::new(0.3, 0.2, 0.9).normalize(),
+        DVec3::new(-0.07364465901900703, 0.06746454030062121, 0.995),
+    ] {
+        assert!(!p.contains(q), "{q}");
+        assert!(p.complement().contains(q), "{q}");
+    }
+    run("sliver 1e-9 wide along x = 0", &p);
+    run_with("complement of the sliver", &p.complement(), 12);
+}
