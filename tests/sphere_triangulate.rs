@@ -923,3 +923,39 @@ fn regression_fuzz_contains_beside_a_sliver() {
     run("sliver 1e-9 wide along x = 0", &p);
     run_with("complement of the sliver", &p.complement(), 12);
 }
+
+/// Found by the `sphere_triangulate` fuzz target (fifth run, 27 245 runs): a hemisphere bounded
+/// by four vertices on its great circle (two antipodal pairs, on the coordinate planes) and a
+/// ring along that circle. After the cut `x = 0`, the cut `y = 0` of one half lost 7.5e-12 sr
+/// (1.2e-12 relative) while `z = 0` loses nothing; the cut took the first plane that added up
+/// within its rounding estimate and the final guard gave up. Each cut now takes the plane whose
+/// halves come closest.
+#[test]
+fn regression_fuzz_cut_order_after_the_first_cut() {
+    let v = [
+        [
+            -0.020824296970586242,
+            0.9995662545881396,
+            -0.020824296970586242,
+        ],
+        [0.827958664240161, 0.5602275961131838, 0.025089656492108064],
+        [
+            -0.37031782365373717,
+            0.9288373279326609,
+            -0.01122175223725154,
+        ],
+        [
+            -0.9860628245777514,
+            -0.16366811006392926,
+            -0.029880691656124607,
+        ],
+        [0.9995411791453815, -0.0, 0.03028912664076914],
+        [-0.0, -1.0, 0.0],
+        [-0.9995411791453815, 0.0, -0.03028912664076914],
+        [0.0, 1.0, -0.0],
+    ];
+    let v: Vec<DVec3> = v.iter().map(|&a| DVec3::from_array(a)).collect();
+    let p = poly(vec![v[..4].to_vec(), v[4..].to_vec()]);
+    let r = run_with("hemisphere on its vertices with a ring along it", &p, 12);
+    assert!(r.area_error <= 1e-13, "{:e}", r.area_error);
+}
