@@ -983,9 +983,7 @@ fn parity_contains<'a>(rings: impl Iterator<Item = &'a [DVec3]> + Clone, p: DVec
         if (p + r).length_squared() < 0.25 || p == r {
             continue;
         }
-        let Some((dr, inside_r, ambiguous)) = nearest_feature_checked(rings.clone(), r) else {
-            return None;
-        };
+        let (dr, inside_r, ambiguous) = nearest_feature_checked(rings.clone(), r)?;
         if ambiguous || !(dr > 1e-12) || dr > 2.0 {
             continue;
         }

@@ -562,7 +562,7 @@ mod tests {
         let b = DVec3::new(-0.21277109934982402, 0.475264968854496, -0.8537280999599359);
         let c = DVec3::new(-0.2127710993157535, 0.4752649689184834, -0.853728099932806);
         let (w, err) = signed_solid_angle_with_error(a, b, c);
-        let exact = 1.9620406324349051326;
+        let exact = 1.962_040_632_434_905_1;
         assert!((w - exact).abs() <= err, "{w} vs {exact}, bound {err:e}");
         assert!(err < 1e-14, "{err:e}");
     }
