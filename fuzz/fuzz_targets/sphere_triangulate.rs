@@ -9,9 +9,7 @@
 //!
 //! `GeomError::Undecidable` fails the target: the triangulation census
 //! (`tests/sphere_triangulate_census.rs`) finds no give-up on any of these families, so one here
-//! is a finding (the first run found the complement of a 1e-9 sliver, whose cut made vertices
-//! 1e-18 apart; `triangulate` now merges vertices closer than `COINCIDENT_TOLERANCE`). Any
-//! other error on valid input fails too.
+//! is a finding. Any other error on valid input fails too.
 //!
 //! Run: `RUSTC_BOOTSTRAP=1 cargo fuzz run sphere_triangulate -- -max_total_time=300` (from the
 //! crate root).
