@@ -6,7 +6,9 @@
 //! roughness, uniform subdivision with `N = 6, 18, 30` chords per cubic sets a maximum error over
 //! the points (against `eps = 1e-12`); the adaptive threshold is then lowered by factors of 2
 //! from `1e-2` until its maximum error is no larger, and both are timed on the same points
-//! (adaptive also with its proven error bound, `Subdivision::AdaptiveWithBound`).
+//! (adaptive also with its proven error bound, `Subdivision::AdaptiveWithBound`). Where no
+//! threshold matches (adaptive's coarsest is already more accurate than N = 6), the smallest
+//! uniform N that reaches adaptive's coarsest error is found and timed against it.
 //! The matching table (errors and edges) is printed once; results in BENCHMARKS.md (section
 //! `Bezier lights`). Run with `cargo bench -p arealight-benches --bench bezier`.
 
@@ -169,6 +171,32 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| black_box(shade(&pts, alpha, s)))
             });
         }
+        // Equal error from the other side, for the row where no threshold matches (N = 6):
+        // adaptive cannot be made coarser than `N_div = 4` intervals per cubic, each accepted
+        // with its midpoint (8 chords), so its coarsest threshold is already more accurate than
+        // N = 6; the uniform N that reaches that error is timed against it.
+        let coarsest = Subdivision::Adaptive { eps: 1e-2 };
+        let (a, a_edges) = shade(&pts, alpha, coarsest);
+        let target = max_error(&a, &reference);
+        let mut n = 1;
+        let (mut u, mut u_edges) = shade(&pts, alpha, Subdivision::Uniform { n });
+        while max_error(&u, &reference) > target && n < 1000 {
+            n += 1;
+            (u, u_edges) = shade(&pts, alpha, Subdivision::Uniform { n });
+        }
+        let uniform = Subdivision::Uniform { n };
+        let t = min_times(&pts, alpha, &[uniform, coarsest], 300);
+        println!(
+            "alpha {alpha}: adaptive at its coarsest (eps 1e-2): max error {target:.2e}, {:.1} \
+             edges per point, {:.1} us; the smallest uniform N reaching it: N = {n}, max error \
+             {:.2e}, {:.1} edges per point, {:.1} us (uniform / adaptive time {:.2})",
+            a_edges as f64 / pts.len() as f64,
+            t[1] * 1e6,
+            max_error(&u, &reference),
+            u_edges as f64 / pts.len() as f64,
+            t[0] * 1e6,
+            t[0] / t[1]
+        );
     }
     g.finish();
 }

@@ -214,12 +214,29 @@ fn input_errors_name_the_problem() {
         line,
         Err(GeomError::TooFewVertices { ring: 0, .. })
     ));
-    let huge = Shape::new(vec![vec![
-        DVec2::new(0.0, 0.0),
-        DVec2::new(1e200, 0.0),
-        DVec2::new(1.0, 1.0),
-    ]]);
-    assert!(matches!(huge, Err(GeomError::OutOfRange { .. })));
+    let huge = Shape::new(vec![
+        vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+        ],
+        vec![
+            DVec2::new(5.0, 0.0),
+            DVec2::new(6.0, 0.0),
+            DVec2::new(1e200, 1.0),
+        ],
+    ]);
+    assert_eq!(
+        huge,
+        Err(GeomError::CoordinateOutOfRange {
+            ring: 1,
+            vertex: 2,
+            value: 1e200,
+            limit: arealight::planar::MAX_COORD,
+        })
+    );
+    let msg = format!("{}", huge.unwrap_err());
+    assert!(msg.contains("vertex 2 in ring 1"), "{msg}");
     // Messages are actionable.
     let msg = format!("{}", bowtie.unwrap_err());
     assert!(msg.contains("crosses itself"), "{msg}");

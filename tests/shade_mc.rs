@@ -183,10 +183,10 @@ fn occluded_analytic_matches_monte_carlo_with_ltc_brdf() {
 }
 
 #[test]
-fn silhouette_path_never_fails_on_random_points() {
+fn analytic_shading_never_fails_on_random_points() {
     // Points anywhere in the scene's box (inside occluders and lights too), on occluder
-    // surfaces, edges and vertices, with random normals and views: the silhouette path must
-    // return a finite, non-negative radiance every time.
+    // surfaces, edges and vertices, with random normals and views: `Scene::shade` (the
+    // silhouette method) must return a finite, non-negative radiance every time.
     let demo = demo_scene(DemoConfig::default()).unwrap();
     let scene = &demo.scene;
     let mut rng = Rng::new(9905);
@@ -299,4 +299,78 @@ fn silhouette_sampling_wastes_no_samples() {
             assert!((ratio - 1.0).abs() < 0.2, "{name}: variance ratio {ratio}");
         }
     }
+}
+
+/// `Estimate::fallbacks` and `LightRatio::fell_back` report exactly the lights whose unoccluded
+/// region or its triangulation gave up (recomputed here through the public visibility and
+/// sphere layers), on points anywhere in the scene's box and on mesh vertices and edges, with
+/// random normals. The demo scene's lights are one-sided, so `Scene::visibility` holds them.
+/// Which count is right where a give-up happens is tested inside the crate
+/// (`shade::reference::tests::silhouette_falls_back_to_faces_and_says_so`); here the counts
+/// must agree with the layers below and the Faces sampling must report none.
+#[test]
+fn silhouette_fallbacks_are_reported() {
+    use arealight::shade::{RatioEstimator, ShadingFrame};
+    use arealight::visibility::Visibility;
+    let demo = demo_scene(DemoConfig::default()).unwrap();
+    let scene = &demo.scene;
+    assert!(scene.lights().iter().all(|l| !l.is_two_sided()));
+    let mut rng = Rng::new(1_616);
+    let shapes: Vec<_> = scene
+        .occluders()
+        .iter()
+        .chain(scene.lights().iter().map(|l| l.shape()))
+        .collect();
+    let (mut points, mut total) = (0, 0);
+    for i in 0..400 {
+        let x = if i % 2 == 0 {
+            DVec3::new(
+                6.0 * rng.f64() - 3.0,
+                6.0 * rng.f64() - 3.0,
+                3.5 * rng.f64(),
+            )
+        } else {
+            let mesh = shapes[i % shapes.len()].mesh();
+            let [a, b, _] = mesh.triangle(rng.below(mesh.triangle_count()));
+            if rng.f64() < 0.5 { a } else { (a + b) / 2.0 }
+        };
+        let (n, v) = (rng.dir(), rng.dir());
+        let Ok(frame) = ShadingFrame::new(x, n, v) else {
+            continue;
+        };
+        let expect = (0..scene.lights().len())
+            .filter(|&li| {
+                scene
+                    .visibility()
+                    .unoccluded_region(li, &frame)
+                    .and_then(|pieces| pieces.iter().try_for_each(|p| p.triangulate().map(drop)))
+                    .is_err()
+            })
+            .count() as u32;
+        let mc = MonteCarlo::new(4, ReferenceBrdf::Ltc);
+        let Ok(e) = mc.estimate(scene, x, n, v, &demo.ground, i as u64) else {
+            continue;
+        };
+        assert_eq!(e.fallbacks, expect, "point {i}: x {x} n {n} v {v}");
+        let faces = mc.with_sampling(LightSampling::Faces);
+        let f = faces
+            .estimate(scene, x, n, v, &demo.ground, i as u64)
+            .unwrap();
+        assert_eq!(f.fallbacks, 0);
+        if let Ok(r) = RatioEstimator::new(4, ReferenceBrdf::Ltc).estimate_lights(
+            scene,
+            x,
+            n,
+            v,
+            &demo.ground,
+            i as u64,
+        ) {
+            let fell = r.iter().filter(|l| l.fell_back).count() as u32;
+            assert_eq!(fell, expect, "ratio, point {i}: x {x} n {n} v {v}");
+        }
+        points += 1;
+        total += expect;
+    }
+    println!("{total} fallbacks at {points} points");
+    assert!(points > 300, "{points}");
 }

@@ -508,16 +508,29 @@ fn sample_mean_matches_first_moment() {
     }
 }
 
+/// `inverse(sample(u)) == u` to rounding, per case: `u2` to `4 eps` over the triangle's width
+/// (the rounding of the sample's coordinates, relative to the smallest height `2 area /
+/// longest chord`), `u1` to that over `sqrt(u2)` (the sample's distance from the vertex that
+/// all of `u1` maps to at `u2 = 0`), plus `1e-14`, plus `8 eps` over the triangle's gap to a
+/// hemisphere (the sub-triangle area that `u1` is a ratio of is known only to that near one).
+/// The worst case is printed per triangle (`cargo test --test sphere_sample
+/// inverse_undoes_sample -- --nocapture`); measured: at most 0.41 of this tolerance (the thin
+/// triangle), 0.11 on the octant, medium and clockwise ones (about 1e-15 absolute), 0.3 on the
+/// generic tiny ones (set by the coordinates' rounding), 0.35 near a hemisphere.
 #[test]
 fn inverse_undoes_sample() {
     let mut rng = Rng::new(4);
+    let mut worst_all = 0.0f64;
     for case in cases() {
         let t = SphericalTriangle::new(case.tri[0], case.tri[1], case.tri[2]).unwrap();
         let size = (case.tri[1] - case.tri[0])
             .length()
             .max((case.tri[2] - case.tri[0]).length())
             .max((case.tri[2] - case.tri[1]).length());
-        let mut worst = 0.0f64;
+        let width = 2.0 * t.solid_angle() / size;
+        let round = 4.0 * f64::EPSILON / width;
+        let floor = 1e-14 + 8.0 * f64::EPSILON / (2.0 * PI - t.solid_angle());
+        let (mut worst, mut at) = (0.0f64, DVec2::ZERO);
         for k in 0..20_000 {
             let u = if k < 100 {
                 // Corners and edges of the square.
@@ -529,25 +542,26 @@ fn inverse_undoes_sample() {
             let back = t
                 .inverse(p)
                 .unwrap_or_else(|| panic!("{}: inverse rejects sample({u})", case.name));
-            // u1 is undetermined at u2 = 0 (all of it maps to one vertex) and known to the
-            // rounding of p over its distance from that vertex, sqrt(u2) times the triangle's
-            // width (the smallest height, 2 area / longest chord, for a thin one).
-            let width = 2.0 * t.solid_angle() / size;
-            let round = 4.0 * f64::EPSILON / width;
-            let e1 = (back.x - u.x).abs() / (1e-8 + round / u.y.sqrt());
-            let e2 = (back.y - u.y).abs() / (1e-8 + round);
-            worst = worst.max(e1).max(e2);
+            let e1 = (back.x - u.x).abs() / (floor + round / u.y.sqrt());
+            let e2 = (back.y - u.y).abs() / (floor + round);
+            if e1.max(e2) > worst {
+                (worst, at) = (e1.max(e2), u);
+            }
             assert!(
                 e1 <= 1.0 && e2 <= 1.0,
-                "{}: inverse(sample({u})) = {back}",
-                case.name
+                "{}: inverse(sample({u})) = {back} (off {:e}, {:e}; floor {floor:e}, round {round:e})",
+                case.name,
+                back.x - u.x,
+                back.y - u.y
             );
         }
         println!(
-            "{}: worst round trip {worst:.2e} of the tolerance",
+            "{}: worst round trip {worst:.2e} of the tolerance (floor {floor:.1e}, rounding {round:.1e}) at u = {at}",
             case.name
         );
+        worst_all = worst_all.max(worst);
     }
+    println!("worst of all: {worst_all:.2}");
 }
 
 #[test]

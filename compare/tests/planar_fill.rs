@@ -13,8 +13,11 @@
 //!   verdict on it must equal containment in our result.
 //!
 //! Every result must pass `Shape::validate` and be a valid operand of all four operations (the
-//! area identities hold with a second resolved shape). 64 cases per property by default,
-//! `PLANAR_CASES=N` for more.
+//! area identities hold with a second resolved shape). The GeoJSON-role constructors are checked
+//! against the same reference built from their documented semantics (the exterior's non-zero
+//! region minus the union of the holes', unions of polygons), and the four operations between
+//! two resolved shapes against i_overlay's operations between its own resolutions. 64 cases per
+//! property by default, `PLANAR_CASES=N` for more.
 
 // The crate's shared test helpers (generators, text format), from the package next door.
 #[path = "../../tests/support/mod.rs"]
@@ -487,6 +490,153 @@ proptest! {
         let mut rings = rings;
         rings.extend(grid.into_iter().map(|r| r.into_iter().map(|p| p * 0.25).collect()));
         check_soup(&rings, true)?;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// GeoJSON roles and operations on resolved shapes, against i_overlay
+
+/// i_overlay's region of one ring under the non-zero rule, as paths (outer boundaries
+/// counter-clockwise, holes clockwise, so that the non-zero rule reads them back).
+fn io_ring_region(ring: &[DVec2]) -> IPaths {
+    io_resolve(&[ring.to_vec()], FillRule::NonZero)
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// i_overlay's union of regions given as such paths.
+fn io_union(parts: Vec<IPaths>) -> IPaths {
+    let all: IPaths = parts.into_iter().flatten().collect();
+    all.simplify_shape_as::<i64>(i_overlay::core::fill_rule::FillRule::NonZero)
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// The reference of `Shape::from_polygon_rings`, built with i_overlay from the documented
+/// semantics: the exterior's non-zero region minus the union of the holes' non-zero regions.
+fn io_polygon(rings: &[Vec<DVec2>]) -> IPaths {
+    let Some((exterior, holes)) = rings.split_first() else {
+        return IPaths::new();
+    };
+    let e = io_ring_region(exterior);
+    let h = io_union(holes.iter().map(|r| io_ring_region(r)).collect());
+    e.overlay_as::<i64>(
+        &h,
+        OverlayRule::Difference,
+        i_overlay::core::fill_rule::FillRule::NonZero,
+    )
+    .into_iter()
+    .flatten()
+    .collect()
+}
+
+/// Area of the symmetric difference of our shape and reference paths, measured by i_overlay.
+fn sym_diff_paths(ours: &Shape, reference: &IPaths) -> f64 {
+    let x = to_paths(ours).overlay_as::<i64>(
+        reference,
+        OverlayRule::Xor,
+        i_overlay::core::fill_rule::FillRule::EvenOdd,
+    );
+    ioverlay_area(&x)
+}
+
+/// The tolerance against i_overlay for inputs `rings`: `REF_TOL` of their total ring area plus
+/// 16 snapping distances times their perimeter.
+fn ref_tol(rings: &[Vec<DVec2>]) -> f64 {
+    let (area, per) = size(rings);
+    let (lo, hi) = bbox(rings);
+    let scale = lo.abs().max(hi.abs()).max_element();
+    REF_TOL * area + 16.0 * SNAP_REL * scale * per
+}
+
+/// A GeoJSON polygon as users have it: an exterior (a star, possibly self-intersecting, or a
+/// random ring) and up to three holes of either orientation, inside it, crossing its boundary,
+/// outside it or overlapping each other.
+fn geojson_polygon() -> impl Strategy<Value = Vec<Vec<DVec2>>> {
+    (
+        prop_oneof![
+            star_ring(10, 0.3),
+            float_ring(8),
+            bow_ties().prop_map(|mut v| v.remove(0))
+        ],
+        prop::collection::vec((star_ring(7, 1.2), 0.1f64..0.7, any::<bool>()), 0..=3),
+    )
+        .prop_map(|(exterior, holes)| {
+            let mut rings = vec![exterior];
+            for (h, k, rev) in holes {
+                let c = h.iter().copied().sum::<DVec2>() / h.len() as f64;
+                let mut h: Vec<DVec2> = h.into_iter().map(|p| c + (p - c) * k).collect();
+                if rev {
+                    h.reverse();
+                }
+                rings.push(h);
+            }
+            rings
+        })
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn polygon_rings_match_the_reference(rings in geojson_polygon(), (k, off) in placement()) {
+        let rings = scaled(&rings, k, off);
+        let s = Shape::from_polygon_rings(rings.clone())
+            .map_err(|e| TestCaseError::fail(format!("{e}\nrings = {rings:?}")))?;
+        s.validate().map_err(|e| TestCaseError::fail(format!("invalid: {e}\n{s:?}")))?;
+        let sd = sym_diff_paths(&s, &io_polygon(&rings));
+        let tol = ref_tol(&rings);
+        prop_assert!(sd <= tol, "symmetric difference with i_overlay {sd} > {tol}\nrings = {rings:?}\nours = {s:?}");
+    }
+
+    #[test]
+    fn multipolygons_match_the_reference(polys in prop::collection::vec((geojson_polygon(), -1.5f64..1.5, -1.5f64..1.5), 1..=3)) {
+        let polys: Vec<Vec<Vec<DVec2>>> = polys
+            .into_iter()
+            .map(|(p, x, y)| scaled(&p, 0, DVec2::new(x, y)))
+            .collect();
+        let s = Shape::from_multipolygon(polys.clone())
+            .map_err(|e| TestCaseError::fail(format!("{e}\npolys = {polys:?}")))?;
+        s.validate().map_err(|e| TestCaseError::fail(format!("invalid: {e}\n{s:?}")))?;
+        let reference = io_union(polys.iter().map(|p| io_polygon(p)).collect());
+        let all: Vec<Vec<DVec2>> = polys.iter().flatten().cloned().collect();
+        let sd = sym_diff_paths(&s, &reference);
+        let tol = ref_tol(&all);
+        prop_assert!(sd <= tol, "symmetric difference with i_overlay {sd} > {tol}\npolys = {polys:?}\nours = {s:?}");
+    }
+
+    #[test]
+    fn operations_on_resolved_shapes_match_the_reference(
+        a in prop_oneof![float_soup(), grid_soup(), star_soup(), bow_ties()],
+        b in prop_oneof![float_soup(), grid_soup(), star_soup(), bow_ties()],
+        (ra, rb) in (0usize..4, 0usize..4),
+        shift in (-1.0f64..1.0, -1.0f64..1.0),
+    ) {
+        // Two ring soups resolved under their own rules, then each operation between the two
+        // shapes, against i_overlay's operation between its own resolutions of the soups.
+        let b = scaled(&b, 0, DVec2::new(shift.0, shift.1));
+        let (rule_a, rule_b) = (RULES[ra], RULES[rb]);
+        let sa = Shape::with_fill_rule(a.clone(), rule_a)
+            .map_err(|e| TestCaseError::fail(format!("{e}\na = {a:?}")))?;
+        let sb = Shape::with_fill_rule(b.clone(), rule_b)
+            .map_err(|e| TestCaseError::fail(format!("{e}\nb = {b:?}")))?;
+        let ia: IPaths = io_resolve(&a, rule_a).into_iter().flatten().collect();
+        let ib: IPaths = io_resolve(&b, rule_b).into_iter().flatten().collect();
+        let all: Vec<Vec<DVec2>> = a.iter().chain(&b).cloned().collect();
+        let tol = ref_tol(&all);
+        for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference, BoolOp::Xor] {
+            let r = boolean(&sa, &sb, op)
+                .map_err(|e| TestCaseError::fail(format!("{op:?}: {e}\nA = {sa:?}\nB = {sb:?}")))?;
+            r.validate().map_err(|e| TestCaseError::fail(format!("{op:?} invalid: {e}\n{r:?}")))?;
+            let reference: IPaths = ioverlay(&ia, &ib, op).into_iter().flatten().collect();
+            let sd = sym_diff_paths(&r, &reference);
+            prop_assert!(
+                sd <= tol,
+                "{op:?} ({rule_a:?} a, {rule_b:?} b): symmetric difference with i_overlay {sd} > {tol}\na = {a:?}\nb = {b:?}\nours = {r:?}"
+            );
+        }
     }
 }
 

@@ -201,9 +201,10 @@ impl Shape {
     ///
     /// # Errors
     ///
-    /// - [`GeomError::NonFinite`] for a NaN or infinite coordinate;
-    /// - [`GeomError::OutOfRange`] for a coordinate of magnitude above [`MAX_COORD`] (`1e150`),
-    ///   beyond which the exact orientation predicate could overflow;
+    /// - [`GeomError::NonFinite`] for a NaN or infinite coordinate, and
+    ///   [`GeomError::CoordinateOutOfRange`] for a coordinate of magnitude above [`MAX_COORD`]
+    ///   (`1e150`), beyond which the exact orientation predicate could overflow, both naming the
+    ///   ring and the vertex;
     /// - [`GeomError::TooFewVertices`] for a ring with fewer than three distinct, non-collinear
     ///   points;
     /// - [`GeomError::SelfIntersecting`] when a ring touches or crosses itself, or two rings cross
@@ -220,8 +221,9 @@ impl Shape {
                 }
                 let m = p.x.abs().max(p.y.abs());
                 if m > MAX_COORD {
-                    return Err(GeomError::OutOfRange {
-                        what: "planar coordinate",
+                    return Err(GeomError::CoordinateOutOfRange {
+                        ring: ri,
+                        vertex: vi,
                         value: m,
                         limit: MAX_COORD,
                     });

@@ -104,6 +104,10 @@ pub struct LightRatio {
     pub ratio: DVec3,
     /// The delta-method standard error of `ratio` (0 for a single sample).
     pub ratio_std_error: DVec3,
+    /// Whether [`LightSampling::Silhouette`] gave up for this light at this point (its
+    /// triangulation returned [`GeomError::Undecidable`]) and the ratio was sampled over the
+    /// light's faces instead: still unbiased, only noisier.
+    pub fell_back: bool,
 }
 
 impl LightRatio {
@@ -154,10 +158,12 @@ impl RatioEstimator {
     ) -> Result<Estimate, GeomError> {
         let mut mean = DVec3::ZERO;
         let mut var = DVec3::ZERO;
+        let mut fallbacks = 0;
         for r in self.estimate_lights(scene, point, normal, view, material, seed)? {
             mean += r.radiance();
             let s = r.unshadowed * r.ratio_std_error;
             var += s * s;
+            fallbacks += u32::from(r.fell_back);
         }
         Ok(Estimate {
             mean,
@@ -165,6 +171,7 @@ impl RatioEstimator {
             samples: self.samples_per_light.max(1),
             // A ratio of two means, not a mean of bounded steps: no Bernstein interval.
             sample_bound: DVec3::INFINITY,
+            fallbacks,
         })
     }
 
@@ -206,11 +213,12 @@ impl RatioEstimator {
                 unshadowed,
                 ratio: DVec3::ONE,
                 ratio_std_error: DVec3::ZERO,
+                fell_back: false,
             };
-            if self.sampling == LightSampling::Faces
-                || ps.region_domain(li, &pieces, &mut domain).is_err()
-            {
+            if self.sampling == LightSampling::Faces {
                 ps.faces_domain(li, &mut domain);
+            } else {
+                r.fell_back = ps.silhouette_domain(li, Ok(&pieces), &mut domain);
             }
             if domain.is_empty() || pieces.is_empty() {
                 out.push(r);

@@ -197,6 +197,11 @@ pub struct Estimate {
     /// a specular lobe, whose peak density is not bounded in advance; lights bounded by Bezier
     /// curves).
     pub sample_bound: DVec3,
+    /// How many lights were sampled by their faces because [`LightSampling::Silhouette`] gave
+    /// up at this point (the light's unoccluded region or its triangulation returned
+    /// [`GeomError::Undecidable`]): the estimate is still unbiased, only noisier. Always 0
+    /// with [`LightSampling::Faces`].
+    pub fallbacks: u32,
 }
 
 impl Estimate {
@@ -551,18 +556,41 @@ impl<'a> PointSampler<'a> {
     }
 
     /// Fills `out` with the directions of light `light` to sample by `sampling` (see
-    /// [`LightSampling`]); empty when the light can give nothing.
-    pub(crate) fn domain(&self, light: usize, sampling: LightSampling, out: &mut LightDomain) {
-        if sampling == LightSampling::Silhouette
-            && let Ok(pieces) = self
-                .scene
-                .light_visibility(light, &self.frame)
-                .unoccluded_region(light, &self.frame)
-            && self.region_domain(light, &pieces, out).is_ok()
+    /// [`LightSampling`]); empty when the light can give nothing. `true` when
+    /// [`LightSampling::Silhouette`] gave up and the faces were taken instead.
+    pub(crate) fn domain(
+        &self,
+        light: usize,
+        sampling: LightSampling,
+        out: &mut LightDomain,
+    ) -> bool {
+        if sampling == LightSampling::Faces {
+            self.faces_domain(light, out);
+            return false;
+        }
+        let region = self
+            .scene
+            .light_visibility(light, &self.frame)
+            .unoccluded_region(light, &self.frame);
+        self.silhouette_domain(light, region.as_deref(), out)
+    }
+
+    /// Fills `out` with the triangulation of `region` (light `light`'s unoccluded region, see
+    /// [`PointSampler::region_domain`]), or, where the region or its triangulation is an error,
+    /// with the light's faces ([`PointSampler::faces_domain`]); `true` in the second case.
+    pub(crate) fn silhouette_domain(
+        &self,
+        light: usize,
+        region: Result<&[SphericalPolygon], &GeomError>,
+        out: &mut LightDomain,
+    ) -> bool {
+        if let Ok(pieces) = region
+            && self.region_domain(light, pieces, out).is_ok()
         {
-            return;
+            return false;
         }
         self.faces_domain(light, out);
+        true
     }
 
     /// Fills `out` with the triangulation of `pieces`, a region of light `light` in the shading
@@ -845,6 +873,7 @@ impl MonteCarlo {
         let mut var = DVec3::ZERO;
         let mut domain = LightDomain::default();
         let mut bound = DVec3::ZERO;
+        let mut fallbacks = 0;
         for (li, light) in scene.lights().iter().enumerate() {
             if let Body::Bezier(shape) = light.shape() {
                 let two = light.is_two_sided();
@@ -854,7 +883,9 @@ impl MonteCarlo {
                 bound = DVec3::INFINITY;
                 continue;
             }
-            ps.domain(li, self.sampling, &mut domain);
+            if ps.domain(li, self.sampling, &mut domain) {
+                fallbacks += 1;
+            }
             let mis = self.techniques == Techniques::LightAndBrdf;
             if domain.is_empty() && !mis {
                 continue;
@@ -914,6 +945,57 @@ impl MonteCarlo {
             std_error: DVec3::new(sqrt(var.x), sqrt(var.y), sqrt(var.z)),
             samples: n,
             sample_bound: bound,
+            fallbacks,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shade::{Light, TriangleMesh};
+
+    /// The silhouette sampling falls back to the faces exactly where the region is an error,
+    /// and says so.
+    #[test]
+    fn silhouette_falls_back_to_faces_and_says_so() {
+        let quad =
+            TriangleMesh::quad(DVec3::new(0.0, 0.0, 2.0), DVec3::Y * 0.5, DVec3::X * 0.5).unwrap();
+        let scene = Scene::new(
+            alloc::vec![Light::new(quad, DVec3::ONE).unwrap()],
+            alloc::vec![],
+        )
+        .unwrap();
+        let m = Material::new(DVec3::splat(0.5), DVec3::ZERO, 0.5).unwrap();
+        let ps = PointSampler::new(
+            &scene,
+            DVec3::ZERO,
+            DVec3::Z,
+            DVec3::Z,
+            &m,
+            ReferenceBrdf::Ltc,
+        )
+        .unwrap();
+        let mut faces = LightDomain::default();
+        ps.faces_domain(0, &mut faces);
+        assert!(!faces.is_empty() && !faces.local);
+        let mut out = LightDomain::default();
+        // The light's own region: triangulated, no fallback.
+        assert!(!ps.domain(0, LightSampling::Silhouette, &mut out));
+        assert!(out.local && !out.is_empty());
+        let cap = SphericalPolygon::new(alloc::vec![alloc::vec![
+            DVec3::new(0.1, 0.0, 1.0),
+            DVec3::new(0.0, 0.1, 1.0),
+            DVec3::new(-0.1, -0.1, 1.0),
+        ]])
+        .unwrap();
+        assert!(!ps.silhouette_domain(0, Ok(&[cap]), &mut out));
+        assert!(out.local && out.tris.len() == 1);
+        // The region given up on (as `unoccluded_region` or `triangulate` report it).
+        let region = Err(&GeomError::Undecidable("test"));
+        assert!(ps.silhouette_domain(0, region, &mut out));
+        assert!(!out.local && out.tris == faces.tris);
+        assert!(!ps.domain(0, LightSampling::Faces, &mut out));
+        assert!(!out.local);
     }
 }

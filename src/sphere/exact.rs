@@ -48,6 +48,21 @@ fn two_product(a: f64, b: f64) -> (f64, f64) {
     (p, err)
 }
 
+/// `|p| - 1` for a vector `p` within a few ulps of unit length, to about `1e-31` absolute: the
+/// squares' exact products and their sum's rounding errors are kept (Two-Product, Two-Sum), so
+/// the defect, itself about `1e-16`, keeps its own relative precision. (`|p|^2 - 1 = e` gives
+/// `|p| - 1 = e / 2 - e^2 / 8 + ...`; the square term is below `1e-32`.)
+pub(crate) fn unit_defect(p: DVec3) -> f64 {
+    let (x, ex) = two_product(p.x, p.x);
+    let (y, ey) = two_product(p.y, p.y);
+    let (z, ez) = two_product(p.z, p.z);
+    let (s, f) = two_sum(x, y);
+    let (s, g) = two_sum(s, z);
+    // s is within a few ulps of 1, so s - 1 is exact (Sterbenz).
+    let e = (s - 1.0) + (((f + g) + (ex + ey)) + ez);
+    0.5 * e - 0.125 * e * e
+}
+
 /// `e + b` (Grow-Expansion with zero elimination).
 fn grow(e: &[f64], b: f64) -> Expansion {
     let mut out = Vec::with_capacity(e.len() + 1);

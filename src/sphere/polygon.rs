@@ -946,17 +946,71 @@ fn ring_small_area_with<const ERR: bool>(ring: &[DVec3]) -> (f64, f64) {
 /// sphere) every vertex lies in the open hemisphere about `-p`, whose gnomonic plane holds the
 /// whole boundary with `p` at infinity: `p` is inside iff the outermost rings run clockwise
 /// there ([`far_side_inside`]).
+///
+/// Where another feature with the other verdict is as near within rounding (`p` faces the two
+/// sides of a sliver thinner than the rounding of its distance to them: the geodesic to the
+/// nearer one crosses the other, and rounding picks either), the parity of the exact crossings
+/// of an arc from `p` to a reference direction decides instead ([`parity_contains`]).
 pub(crate) fn rings_contain<'a>(
     rings: impl Iterator<Item = &'a [DVec3]> + Clone,
     p: DVec3,
 ) -> bool {
-    let Some((d, inside)) = nearest_feature(rings.clone(), p) else {
+    let Some((d, inside, ambiguous)) = nearest_feature_checked(rings.clone(), p) else {
         return false;
     };
     if d <= 2.0 {
+        if ambiguous {
+            return parity_contains(rings, p).unwrap_or(inside);
+        }
         return inside;
     }
     far_side_inside(rings, -p).unwrap_or(inside)
+}
+
+/// Whether `p` lies in the region, by the parity of the exact crossings (`orient3d`) of the
+/// minor arc from `p` to a reference direction `r` with the edges, `r`'s own membership decided
+/// by its nearest feature where that is unambiguous and clear of the boundary. References: the
+/// coordinate axes and the cube's diagonals, each skipped when it is near `-p` or when the arc
+/// passes exactly through a vertex or ends on an edge's circle. `None` when none will do.
+fn parity_contains<'a>(rings: impl Iterator<Item = &'a [DVec3]> + Clone, p: DVec3) -> Option<bool> {
+    let s = 1.0 / crate::math::sqrt(3.0);
+    let diagonals = [-1.0, 1.0].into_iter().flat_map(move |x| {
+        [-1.0, 1.0]
+            .into_iter()
+            .flat_map(move |y| [-1.0, 1.0].map(|z| DVec3::new(x, y, z) * s))
+    });
+    'reference: for r in AXES.into_iter().chain(diagonals) {
+        if (p + r).length_squared() < 0.25 || p == r {
+            continue;
+        }
+        let (dr, inside_r, ambiguous) = nearest_feature_checked(rings.clone(), r)?;
+        if ambiguous || !(dr > 1e-12) || dr > 2.0 {
+            continue;
+        }
+        let mut odd = false;
+        for ring in rings.clone() {
+            let n = ring.len();
+            for i in 0..n {
+                let (a, b) = (ring[i], ring[(i + 1) % n]);
+                let (abp, abr) = (orient(a, b, p), orient(a, b, r));
+                let (pra, prb) = (orient(p, r, a), orient(p, r, b));
+                if abr == 0 || pra == 0 || prb == 0 {
+                    continue 'reference;
+                }
+                if abp == 0 {
+                    // p on this edge's circle: on the boundary if within the arc, else the
+                    // crossing is decided by the other edges; either way rounding may decide.
+                    return None;
+                }
+                // The arcs cross (at the point on both minor arcs, not its antipode).
+                if abp != abr && pra != prb && pra == abr {
+                    odd = !odd;
+                }
+            }
+        }
+        return Some(inside_r ^ odd);
+    }
+    None
 }
 
 /// When every vertex of `rings` lies in the open hemisphere about `c` (by more than
@@ -1026,10 +1080,34 @@ pub(crate) fn nearest_feature<'a>(
     rings: impl Iterator<Item = &'a [DVec3]> + Clone,
     p: DVec3,
 ) -> Option<(f64, bool)> {
+    nearest_feature_checked(rings, p).map(|(d, inside, _)| (d, inside))
+}
+
+/// [`nearest_feature`], and whether another feature within `1e-12` (relative, in squared chord)
+/// of the same distance gives the other verdict, which rounding may have put first.
+pub(crate) fn nearest_feature_checked<'a>(
+    rings: impl Iterator<Item = &'a [DVec3]> + Clone,
+    p: DVec3,
+) -> Option<(f64, bool, bool)> {
     // The nearest feature so far: its squared chord distance, and either the side of an edge or
     // the vertex itself (whose side is decided after the scan, from all its visits).
     let mut best: Option<(f64, Result<bool, DVec3>)> = None;
+    // For the ambiguity: the nearest edge of each verdict, the two nearest distinct vertices.
+    let mut edge_min = [f64::INFINITY; 2];
+    let mut vertex_min = [(f64::INFINITY, DVec3::ZERO); 2];
     let mut consider = |d: f64, what: Result<bool, DVec3>| {
+        match what {
+            Ok(inside) => edge_min[inside as usize] = edge_min[inside as usize].min(d),
+            Err(v) => {
+                if v != vertex_min[0].1 && v != vertex_min[1].1 {
+                    if d < vertex_min[0].0 {
+                        vertex_min = [(d, v), vertex_min[0]];
+                    } else if d < vertex_min[1].0 {
+                        vertex_min[1] = (d, v);
+                    }
+                }
+            }
+        }
         if best.is_none_or(|(bd, _)| d < bd) {
             best = Some((d, what));
         }
@@ -1066,7 +1144,13 @@ pub(crate) fn nearest_feature<'a>(
         }
     }
     let (d, what) = best?;
-    Some((d, what.unwrap_or_else(|v| vertex_side(rings, v, p))))
+    let inside = what.unwrap_or_else(|v| vertex_side(rings.clone(), v, p));
+    let near = |x: f64| x <= d + 1e-12 * d;
+    let ambiguous = near(edge_min[!inside as usize])
+        || vertex_min.iter().any(|&(dv, v)| {
+            near(dv) && Err(v) != what && vertex_side(rings.clone(), v, p) != inside
+        });
+    Some((d, inside, ambiguous))
 }
 
 /// Whether the point `p` lies inside the region near the vertex `v`, from every visit of the

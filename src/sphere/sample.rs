@@ -412,28 +412,31 @@ pub(crate) fn signed_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 /// angle `2 atan2(det, den)` moves by `2 (|den| d_det + |det| d_den) / (det^2 + den^2)`. The
 /// bound is large only where both terms vanish together: nearly antipodal vertices nearly on a
 /// great circle, whose area rounding decides at will.
+///
+/// The half-chords are those of the directions, not of the rounded vectors: for vectors
+/// `1 + d` long, `|x -+ y|^2` differs from the unit vectors' by up to about `(d_x - d_y)^2` (the
+/// first order cancels), which is negligible unless the denominator itself is that small (a vertex
+/// within `1e-8` of the antipode of both others, as in a fan from the far side over a tiny
+/// polygon, where it moved the area by `1e-11`). There the chords are taken of
+/// `x -+ y - (d_x x -+ d_y y)` with the defects `d` to their own precision
+/// ([`super::exact::unit_defect`]).
 pub(crate) fn signed_solid_angle_with_error(a: DVec3, b: DVec3, c: DVec3) -> (f64, f64) {
     let (u, v) = (shorter(b - a, b + a), shorter(c - a, c + a));
     let det = a.dot(u.cross(v));
-    let mut constant = 1.0;
-    let mut small = 0.0;
-    let mut magnitude = 0.0;
-    for (x, y) in [(a, b), (b, c), (c, a)] {
-        let (d, s) = ((x - y).length_squared(), (x + y).length_squared());
-        if d <= s {
-            constant += 1.0;
-            small -= 0.5 * d;
-            magnitude += 0.5 * d;
-        } else {
-            constant -= 1.0;
-            small += 0.5 * s;
-            magnitude += 0.5 * s;
-        }
-    }
-    let den = constant + small;
+    let (den, magnitude) = denominator(a, b, c, None);
+    // The chords' normalization error: up to (d_x - d_y)^2 <= 1e-30 each for vectors within
+    // 5e-16 of unit length when left out; with the defects, their rounding (about 4e-32) times
+    // twice the chord. Below this denominator the first could show.
+    let (den, magnitude, normalization) = if den.abs() < 1e-8 {
+        let defects = [a, b, c].map(super::exact::unit_defect);
+        let (den, magnitude) = denominator(a, b, c, Some(defects));
+        (den, magnitude, 5e-31 * crate::math::sqrt(magnitude))
+    } else {
+        (den, magnitude, 3e-30)
+    };
     let eps = f64::EPSILON;
     let d_det = 8.0 * eps * crate::math::sqrt(u.length_squared() * v.length_squared());
-    let d_den = 8.0 * eps * magnitude + eps * den.abs();
+    let d_den = 8.0 * eps * magnitude + eps * den.abs() + normalization;
     let norm = det * det + den * den;
     let err = if norm > 0.0 {
         2.0 * (den.abs() * d_det + det.abs() * d_den) / norm
@@ -441,6 +444,48 @@ pub(crate) fn signed_solid_angle_with_error(a: DVec3, b: DVec3, c: DVec3) -> (f6
         f64::INFINITY
     };
     (2.0 * atan2(det, den), err)
+}
+
+/// Van Oosterom–Strackee's denominator `1 + a.b + b.c + c.a` as an integer plus half-chords
+/// squared (`1 + x.y = 2 - |x - y|^2 / 2 = |x + y|^2 / 2`, the shorter chord of each pair), and
+/// the sum of the half-chords' magnitudes. With `defects` (`|x| - 1` per vertex), the chords
+/// of the unit vectors (see [`signed_solid_angle_with_error`]).
+fn denominator(a: DVec3, b: DVec3, c: DVec3, defects: Option<[f64; 3]>) -> (f64, f64) {
+    let mut constant = 1.0;
+    let mut small = 0.0;
+    let mut magnitude = 0.0;
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        let (x, y) = ([a, b, c][i], [a, b, c][j]);
+        let (dv, sv) = (x - y, x + y);
+        let (d, s) = (dv.length_squared(), sv.length_squared());
+        let near = d <= s;
+        let chord = match defects {
+            None => {
+                if near {
+                    d
+                } else {
+                    s
+                }
+            }
+            Some(e) => {
+                let (ex, ey) = (x * e[i], y * e[j]);
+                if near {
+                    (dv - (ex - ey)).length_squared()
+                } else {
+                    (sv - (ex + ey)).length_squared()
+                }
+            }
+        };
+        if near {
+            constant += 1.0;
+            small -= 0.5 * chord;
+        } else {
+            constant -= 1.0;
+            small += 0.5 * chord;
+        }
+        magnitude += 0.5 * chord;
+    }
+    (constant + small, magnitude)
 }
 
 /// The shorter of two vectors (the first on a tie).
@@ -500,5 +545,25 @@ mod tests {
         ] {
             assert_eq!(t.sample(u), t.sample(v));
         }
+    }
+
+    /// A fan triangle from the far side of a ring 1e-10 rad across: its apex lies within 1e-10
+    /// of the antipode of both other vertices, and the vectors are unit only to 2e-16. The
+    /// 60-digit area of the triangle of their directions (mpmath, normalized to 60 digits) is
+    /// 1.9620406324349051326; the chords of the rounded vectors gave 1.96204063242741 (7.5e-12
+    /// off, outside the bound claimed).
+    #[test]
+    fn area_with_an_apex_near_the_antipode_of_both_others() {
+        let a = DVec3::new(
+            0.21277109939609068,
+            -0.47526496887180014,
+            0.8537280999387719,
+        );
+        let b = DVec3::new(-0.21277109934982402, 0.475264968854496, -0.8537280999599359);
+        let c = DVec3::new(-0.2127710993157535, 0.4752649689184834, -0.853728099932806);
+        let (w, err) = signed_solid_angle_with_error(a, b, c);
+        let exact = 1.962_040_632_434_905_1;
+        assert!((w - exact).abs() <= err, "{w} vs {exact}, bound {err:e}");
+        assert!(err < 1e-14, "{err:e}");
     }
 }

@@ -8,9 +8,9 @@ use core::f64::consts::PI;
 use glam::{DVec2, DVec3};
 
 use super::gnomonic::enclosing_cap;
-use super::polygon::SphericalPolygon;
+use super::polygon::{COINCIDENT_TOLERANCE, SphericalPolygon};
 use super::predicates::{AXES, normalize_any, orient, tangent_frame};
-use super::sample::{SphericalTriangle, signed_solid_angle, signed_solid_angle_with_error};
+use super::sample::{SphericalTriangle, signed_solid_angle_with_error};
 use crate::GeomError;
 use crate::planar::{Cdt, constrained_delaunay};
 
@@ -56,7 +56,12 @@ impl SphericalPolygon {
     /// 5. otherwise the region is cut in two by the coordinate plane `x = 0` (exact hemisphere
     ///    clipping, [`SphericalPolygon::clip_to_hemisphere`]), each half solved the same way, then
     ///    `y = 0`, then `z = 0`; an octant always fits a chart. The cuts add vertices where edges
-    ///    cross the planes. No test family reaches this step.
+    ///    cross the planes and along the planes' circles, and the two halves share every vertex
+    ///    on a cut bit for bit. Regions reach this step when no cap narrower than a hemisphere
+    ///    holds their vertices, no stereographic pole of step 3 is both outside them and clear of
+    ///    their vertices (the sphere minus six or more small holes, a complement of many small
+    ///    occluders) or its chart cannot be repaired, and they are not one ring star-shaped about
+    ///    a candidate point (a ring wrapped most of the way round the sphere with long edges).
     ///
     /// Thesis 003 section 6.2 adds extra vertices where a triangulation would need arcs longer
     /// than `pi`; here steps 1-3 use none, and an extra vertex is added (steps 2 and 4) only
@@ -74,11 +79,17 @@ impl SphericalPolygon {
     /// reverse, and the areas add up to the region's within `2 pi`. The first two make the
     /// number of triangles over any direction off the edges equal to the region's indicator
     /// plus a constant `k`, and the third makes `k = 0`: the triangles tile the region exactly
-    /// (for step 5, each half exactly; the halves tile the region up to the rounding of the
-    /// crossing points the clipping computes). Deterministic; no sampling.
+    /// (for step 5, each half exactly, and the halves meet exactly along the cut; they tile the
+    /// region up to what the clipping moves: the crossing points rounded off their edges, and
+    /// vertices within the clip's tolerances of a cut plane snapped onto it). Deterministic; no
+    /// sampling.
     ///
     /// Triangles certified positive whose area rounds to zero (slivers below rounding between
     /// nearly collinear vertices) are left out: they cover nothing beyond rounding of an edge.
+    /// Distinct vertices closer than [`COINCIDENT_TOLERANCE`] (which validation accepts where
+    /// they are not consecutive, and step 5's cuts make where they cross a sliver's tip) are
+    /// triangulated as one: the triangles tile the polygon with those vertices merged, which
+    /// moves its boundary by less than `1e-15`.
     ///
     /// # Examples
     ///
@@ -102,8 +113,10 @@ impl SphericalPolygon {
     ///
     /// [`GeomError::Undecidable`] when no candidate passes the certificate (rounding in every
     /// chart made the planar triangulation disagree with the sphere at a near-degeneracy), or
-    /// when the triangles' areas miss the region's by more than `1e-9` relative (which would
-    /// mean a clipping fault). Never a wrong triangulation.
+    /// when the triangles' areas miss the region's by more than `1e-12` relative plus the
+    /// rounding bounds of both sums (and the move of merged vertices): a fault, or step 5's
+    /// clips moving the boundary by more than that at every plane tried. Never a wrong
+    /// triangulation.
     pub fn triangulate(&self) -> Result<Vec<SphericalTriangle>, GeomError> {
         if let Some(ring) = self.single_ring()
             && let Some(fan) = fan_from_first(ring)
@@ -111,13 +124,17 @@ impl SphericalPolygon {
             return Ok(fan);
         }
         let mut tris: Vec<[DVec3; 3]> = Vec::new();
-        solve(self, 0, &mut tris)?;
+        let mut moved = 0.0;
+        solve(self, 0, &mut tris, &mut moved)?;
         let mut out = Vec::with_capacity(tris.len());
-        let mut sum = 0.0;
+        let (mut sum, mut rounding) = (0.0, 0.0);
         for [a, b, c] in tris {
             match SphericalTriangle::from_unit(a, b, c) {
                 Ok(t) => {
                     sum += t.solid_angle();
+                    // The triangles are certified positive, so `(a, b, c)` is the
+                    // counter-clockwise order whose area `from_unit` took.
+                    rounding += signed_solid_angle_with_error(a, b, c).1;
                     out.push(t);
                 }
                 // Certified positive, area below rounding.
@@ -125,8 +142,12 @@ impl SphericalPolygon {
                 Err(e) => return Err(e),
             }
         }
-        let area = region_area(self);
-        if !((sum - area).abs() <= 1e-9 * area + 1e-300) {
+        let (area, area_err) = region_area_with_error(self);
+        // The certificate makes the triangles tile the polygon (for step 5, the halves the cuts
+        // leave: see `cut`), so the sums may differ only by their rounding.
+        let tol =
+            AREA_GUARD * area + rounding + out.len() as f64 * f64::EPSILON * sum + area_err + moved;
+        if !((sum - area).abs() <= tol) {
             return Err(GeomError::Undecidable(
                 "triangle areas do not add up to the polygon's",
             ));
@@ -174,14 +195,20 @@ fn fan_from_first(ring: &[DVec3]) -> Option<Vec<SphericalTriangle>> {
 
 /// The region's solid angle, reduced modulo `4 pi` only after the rings' signed fan sums (from
 /// a vertex or axis far from every antipode of the ring; a triangle's area is defined modulo `4 pi` even where its far edge
-/// passes the apex's antipode, see [`signed_solid_angle`]) are added, so that a tiny outer ring and its tiny hole cancel as small numbers (reducing each
+/// passes the apex's antipode, see [`signed_solid_angle_with_error`]) are added, so that a tiny outer ring and its tiny hole cancel as small numbers (reducing each
 /// ring first, as a ring's own left area must be, leaves the hole at `4 pi - epsilon`, which
 /// cannot hold `epsilon` to relative precision).
 fn region_area(poly: &SphericalPolygon) -> f64 {
+    region_area_with_error(poly).0
+}
+
+/// [`region_area`] and a bound on its rounding error: the fan terms' own bounds
+/// ([`signed_solid_angle_with_error`]) plus the rounding of their sum.
+fn region_area_with_error(poly: &SphericalPolygon) -> (f64, f64) {
     if poly.is_full() {
-        return 4.0 * PI;
+        return (4.0 * PI, 0.0);
     }
-    let mut sum = 0.0;
+    let (mut sum, mut err, mut magnitude) = (0.0, 0.0, 0.0);
     for ring in poly.rings() {
         // The apex: the first vertex, unless a vertex is near its antipode (where the arcs from
         // the apex are undefined); then the vertex or axis farthest from every antipode.
@@ -202,11 +229,22 @@ fn region_area(poly: &SphericalPolygon) -> f64 {
         for i in 0..n {
             let (b, c) = (ring[i], ring[(i + 1) % n]);
             if b != apex && c != apex {
-                sum += signed_solid_angle(apex, b, c);
+                let (w, e) = signed_solid_angle_with_error(apex, b, c);
+                sum += w;
+                err += e;
+                magnitude += w.abs();
             }
         }
     }
-    sum.rem_euclid(4.0 * PI)
+    // Recursive summation rounds by at most (terms - 1) eps times the sum of magnitudes; the
+    // reduction rounds only when it shifts the sum.
+    let terms = poly.vertex_count() as f64;
+    let reduced = sum.rem_euclid(4.0 * PI);
+    let shift = if reduced == sum { 0.0 } else { 4.0 * PI };
+    (
+        reduced,
+        err + terms * f64::EPSILON * magnitude + f64::EPSILON * shift,
+    )
 }
 
 /// A polygon as indexed geometry: its distinct vertices (equal bits are one vertex, so pinches
@@ -242,17 +280,95 @@ impl Indexed {
         Indexed { verts, edges }
     }
 
+    /// Merges distinct vertices closer than [`COINCIDENT_TOLERANCE`] (the same direction for
+    /// every purpose of the crate; validation rejects only consecutive ones) into the first of
+    /// them, and returns a bound on the solid angle that moves (each merged vertex's distance
+    /// times the length of its edges). No chart can tell such vertices apart, and step 5's clips
+    /// make them where a cut crosses a sliver's tip (two edges 1e-9 apart cross the plane
+    /// 1e-18 apart). Nothing is merged (and 0 returned) when a merge would shrink an edge to a
+    /// point.
+    fn merge_unresolved(&mut self) -> f64 {
+        let n = self.verts.len();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        order.sort_unstable_by(|&i, &j| {
+            self.verts[i as usize]
+                .x
+                .total_cmp(&self.verts[j as usize].x)
+        });
+        // Union-find with the smallest id as the root.
+        let mut rep: Vec<u32> = (0..n as u32).collect();
+        fn root(rep: &mut [u32], mut i: u32) -> u32 {
+            while rep[i as usize] != i {
+                rep[i as usize] = rep[rep[i as usize] as usize];
+                i = rep[i as usize];
+            }
+            i
+        }
+        let mut any = false;
+        for (k, &i) in order.iter().enumerate() {
+            let p = self.verts[i as usize];
+            for &j in &order[k + 1..] {
+                let q = self.verts[j as usize];
+                if q.x - p.x > COINCIDENT_TOLERANCE {
+                    break;
+                }
+                if (p - q).length() <= COINCIDENT_TOLERANCE {
+                    let (a, b) = (root(&mut rep, i), root(&mut rep, j));
+                    if a != b {
+                        rep[a.max(b) as usize] = a.min(b);
+                        any = true;
+                    }
+                }
+            }
+        }
+        if !any {
+            return 0.0;
+        }
+        let rep: Vec<u32> = (0..n as u32).map(|i| root(&mut rep, i)).collect();
+        if self
+            .edges
+            .iter()
+            .any(|&[i, j]| rep[i as usize] == rep[j as usize])
+        {
+            return 0.0;
+        }
+        let mut moved = 0.0;
+        for &[i, j] in &self.edges {
+            let (a, b) = (self.verts[i as usize], self.verts[j as usize]);
+            let shift = (a - self.verts[rep[i as usize] as usize]).length()
+                + (b - self.verts[rep[j as usize] as usize]).length();
+            moved += shift * (a - b).length();
+        }
+        // The merged vertices leave the vertex list (a chart would triangulate them as points).
+        let mut new_id = alloc::vec![u32::MAX; n];
+        let mut verts = Vec::with_capacity(n);
+        for i in 0..n {
+            if rep[i] == i as u32 {
+                new_id[i] = verts.len() as u32;
+                verts.push(self.verts[i]);
+            }
+        }
+        self.verts = verts;
+        for e in &mut self.edges {
+            *e = e.map(|i| new_id[rep[i as usize] as usize]);
+        }
+        moved
+    }
+
     /// The rings' vertex ids in order (for the single-ring fans).
     fn single_ring(&self) -> Vec<u32> {
         self.edges.iter().map(|e| e[0]).collect()
     }
 }
 
-/// Triangulates `poly` into `out`; `depth` is the number of coordinate cuts already made.
+/// Triangulates `poly` into `out`; `used` has bit `k` set for each coordinate plane `AXES[k]`
+/// already cut by, and `moved` collects a bound on the solid angle that merging unresolved
+/// vertices moves ([`Indexed::merge_unresolved`]).
 fn solve(
     poly: &SphericalPolygon,
-    depth: usize,
+    used: u8,
     out: &mut Vec<[DVec3; 3]>,
+    moved: &mut f64,
 ) -> Result<(), GeomError> {
     if poly.is_empty() {
         return Ok(());
@@ -262,6 +378,7 @@ fn solve(
         return Ok(());
     }
     let mut ix = Indexed::new(poly);
+    *moved += ix.merge_unresolved();
     let area = region_area(poly);
     let single = poly.ring_count() == 1;
     let emit = |ix: &Indexed, tris: &[[u32; 3]], out: &mut Vec<[DVec3; 3]>| {
@@ -343,15 +460,63 @@ fn solve(
             ix.verts.pop();
         }
     }
-    // 5. Cut by the next coordinate plane.
-    if depth < 3 {
-        let n = AXES[depth];
-        solve(&poly.clip_to_axis_hemisphere(n), depth + 1, out)?;
-        return solve(&poly.clip_to_axis_hemisphere(-n), depth + 1, out);
+    // 5. Cut by a coordinate plane not used yet (see `cut`).
+    if used != 0b111 {
+        let (k, up, down) = cut(poly, used);
+        solve(&up, used | 1 << k, out, moved)?;
+        return solve(&down, used | 1 << k, out, moved);
     }
     Err(GeomError::Undecidable(
         "no chart of an octant triangulates the polygon within rounding",
     ))
+}
+
+/// Relative part of the final guard of [`SphericalPolygon::triangulate`]: the triangles' areas
+/// must add up to the region's within this fraction of it, on top of the rounding bounds of both
+/// sums and the move of merged vertices. What step 5's clips move ([`cut`]) must fit in it.
+const AREA_GUARD: f64 = 1e-12;
+
+/// Step 5 of [`SphericalPolygon::triangulate`]: the halves `poly.clip_to_axis_hemisphere(n)` and
+/// `poly.clip_to_axis_hemisphere(-n)` for the coordinate axis `n = AXES[k]` not in `used` whose
+/// halves' solid angles come closest to adding up to the polygon's (the first that adds up
+/// exactly; the final guard of [`SphericalPolygon::triangulate`] decides whether the closest is
+/// close enough); with `k`.
+///
+/// Where the halves meet they agree bit for bit: every vertex the clip makes on the plane (an
+/// edge's crossing `w - n (w . n)` with `w = below (above . n) - above (below . n)`, a vertex
+/// near the plane projected as `p - n (p . n)`, a point of the circle `u cos t + v sin t` with
+/// `u`, `v` orthogonal to the axis) has its axis coordinate exactly zero, and an edge's crossing
+/// is the same expression for `n` and `-n` (heights negated exactly, `above` and `below`
+/// swapped), so both halves end their chains at the same vectors and their edges along the cut
+/// lie on the same great circle. What the halves can still miss is what the clip moves: a
+/// crossing rounded off its edge (about `1e-14` of the edge's length), vertices or edges within
+/// the clip's tolerances of the plane snapped onto it, and crossings of two edges that meet
+/// within `1e-11` of the plane, which the clip may take in the wrong order (a pinched polygon
+/// with nearly antipodal vertices lost 1.2e-11 sr to the cut `x = 0`, and none to `y = 0`; a
+/// hemisphere bounded by vertices on its circle, with a ring along it, 7.5e-12 to `y = 0` after
+/// `x = 0`, and none to `z = 0`). Measuring each candidate avoids that where another plane is
+/// clean; the rounding of the measures (a few ulps of `4 pi`) is far below what it looks for.
+fn cut(poly: &SphericalPolygon, used: u8) -> (usize, SphericalPolygon, SphericalPolygon) {
+    let area = region_area(poly);
+    let mut best: Option<(usize, SphericalPolygon, SphericalPolygon, f64)> = None;
+    for k in (0..3).filter(|k| used & 1 << k == 0) {
+        let (up, down) = (
+            poly.clip_to_axis_hemisphere(AXES[k]),
+            poly.clip_to_axis_hemisphere(-AXES[k]),
+        );
+        let miss = (region_area(&up) + region_area(&down) - area).abs();
+        if miss == 0.0 {
+            return (k, up, down);
+        }
+        if best.as_ref().is_none_or(|b| miss < b.3) {
+            best = Some((k, up, down, miss));
+        }
+    }
+    // `used` has a free axis whenever this is called.
+    best.map_or_else(
+        || (0, SphericalPolygon::empty(), SphericalPolygon::empty()),
+        |(k, up, down, _)| (k, up, down),
+    )
 }
 
 /// The full sphere as the four faces of a regular tetrahedron, positively oriented.

@@ -10,17 +10,10 @@
 //! cargo run --release -p arealight-demo -- --help    # the flags
 //! ```
 //!
-//! Prints a table, analytic first:
-//!
-//! ```text
-//! | method | time (s) | samples per light per pixel | MAE | RMSE |
-//! |---|---|---|---|---|
-//! | analytic | 1.23 | - | 0.0012 | 0.0034 |
-//! | ratio estimator (1x time) | 1.25 | 5 | 0.0050 | 0.0200 |
-//! | monte carlo (1x time) | 1.25 | 7 | 0.0100 | 0.0300 |
-//! | ratio estimator (10x time) | 12.6 | 61 | 0.0015 | 0.0060 |
-//! | monte carlo (10x time) | 12.4 | 80 | 0.0030 | 0.0090 |
-//! ```
+//! Prints a Markdown table with one row per method (analytic, then the ratio estimator and
+//! Monte Carlo at 1x and 10x the analytic time) and the columns time (s), samples per light per
+//! pixel, MAE and RMSE against the reference. Measured runs, with the command, machine and
+//! settings, are in BENCHMARKS.md, section "render: analytic, ratio estimator, Monte Carlo".
 //!
 //! Equal time: each stochastic method's cost per pixel is modelled as a setup (frame, light
 //! regions and their triangulations, for the ratio estimator the analytic unshadowed integrals)

@@ -344,3 +344,79 @@ impl Sliver {
         );
     }
 }
+
+/// The polygons of the tiny and horizon families, for targets that take polygons one at a time
+/// (`sphere_triangulate`): what `run` builds, without its checks.
+impl Tiny {
+    /// Both tiny rings (complemented as asked), the two as one polygon when they are disjoint
+    /// (near each other or near each other's antipode), that pair's complement, and the results
+    /// of the set operations between the two.
+    pub fn polygons(&self) -> Vec<SphericalPolygon> {
+        let Some(c) = dir(self.center) else { return Vec::new() };
+        let size = 10f64.powi(-6 - (self.size_exponent % 5) as i32) / 128.0;
+        let (u, v) = c.any_orthonormal_pair();
+        let ring = |center: DVec3, pts: &[(i8, i8)], off: (i8, i8)| -> Vec<DVec3> {
+            let (u, v) = if center.dot(c) < 0.0 { (u, -v) } else { (u, v) };
+            pts.iter()
+                .take(8)
+                .map(|&(x, y)| {
+                    let (x, y) = (x as f64 + off.0 as f64, y as f64 + off.1 as f64);
+                    (center + (u * x + v * y) * size).normalize()
+                })
+                .collect()
+        };
+        let ra = ring(c, &self.a, (0, 0));
+        let rb = ring(if self.antipodal { -c } else { c }, &self.b, self.b_offset);
+        let mut out = Vec::new();
+        if let Ok(both) = SphericalPolygon::new(vec![ra.clone(), rb.clone()]) {
+            out.push(both.complement());
+            out.push(both);
+        }
+        let (Ok(a0), Ok(b0)) = (SphericalPolygon::new(vec![ra]), SphericalPolygon::new(vec![rb])) else {
+            return out;
+        };
+        let a = if self.complement_a { a0.complement() } else { a0 };
+        let b = if self.complement_b { b0.complement() } else { b0 };
+        for op in [BoolOp::Intersection, BoolOp::Union, BoolOp::Difference, BoolOp::Xor] {
+            if let Ok(r) = a.boolean(&b, op) {
+                out.push(r);
+            }
+        }
+        out.push(a);
+        out.push(b);
+        out
+    }
+}
+
+impl Horizon {
+    /// The polygon with its vertex moved to `+eps`, `-eps` and onto the circle of `normal`
+    /// (complemented as asked), and the clips of each to both sides of that circle.
+    pub fn polygons(&self) -> Vec<SphericalPolygon> {
+        let Some(n) = dir(self.normal) else { return Vec::new() };
+        let mut ring: Vec<DVec3> = self.ring.iter().take(8).filter_map(|&v| dir(v)).collect();
+        if ring.len() < 3 {
+            return Vec::new();
+        }
+        let size = perimeter(&ring) / ring.len() as f64;
+        let scale = if self.relative { size } else { 1.0 };
+        let eps = 10f64.powi(-9 - (self.exponent % 8) as i32) * (1.0 + self.mantissa as f64 / 256.0) * scale;
+        let i = self.vertex as usize % ring.len();
+        if let Some((e, up)) = self.neighbour {
+            let j = (i + 1) % ring.len();
+            let h = 10f64.powi(-9 - (e % 8) as i32) * scale * if up { 1.0 } else { -1.0 };
+            ring[j] = at_height(ring[j], n, h);
+        }
+        let mut out = Vec::new();
+        for h in [eps, -eps, 0.0] {
+            let mut r = ring.clone();
+            r[i] = at_height(r[i], n, h);
+            if let Ok(p) = SphericalPolygon::new(vec![r]) {
+                let p = if self.complement { p.complement() } else { p };
+                out.push(p.clip_to_hemisphere(n));
+                out.push(p.clip_to_hemisphere(-n));
+                out.push(p);
+            }
+        }
+        out
+    }
+}
