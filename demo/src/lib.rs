@@ -53,3 +53,20 @@ pub fn with_threads<T: Send>(
         .map_err(|e| e.to_string())?
         .install(f)
 }
+
+/// The parsed command line, or, for a usage error, its message on stderr and exit status 2.
+pub fn args_or_exit<A>(parsed: Result<A, String>) -> A {
+    parsed.unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    })
+}
+
+/// Runs `run` on `threads` workers ([`with_threads`]); an error goes to stderr as
+/// `name: error` with exit status 1.
+pub fn run_or_exit(name: &str, threads: usize, run: impl FnOnce() -> Result<(), String> + Send) {
+    if let Err(e) = with_threads(threads, run) {
+        eprintln!("{name}: {e}");
+        std::process::exit(1);
+    }
+}

@@ -32,7 +32,7 @@ use arealight::shade::{Material, MonteCarlo, ReferenceBrdf};
 use arealight_demo::image::{out_dir, srgb, to_bytes, write_png};
 use arealight_demo::progress::Progress;
 use arealight_demo::trace::{Camera, nearest};
-use arealight_demo::{cornell_camera, parse_vec, with_threads};
+use arealight_demo::{args_or_exit, cornell_camera, parse_vec, run_or_exit};
 
 const HELP: &str = "\
 bake: per-vertex direct lighting of a scene file, to PLY with vertex colours, and a picture
@@ -103,17 +103,8 @@ fn parse_args() -> Result<Args, String> {
 }
 
 fn main() {
-    let args = match parse_args() {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(2);
-        }
-    };
-    if let Err(e) = with_threads(args.threads, || run(&args)) {
-        eprintln!("bake: {e}");
-        std::process::exit(1);
-    }
+    let args = args_or_exit(parse_args());
+    run_or_exit("bake", args.threads, || run(&args));
 }
 
 /// The baked mesh: welded grid vertices with their normals and radiance, the grid triangles, and

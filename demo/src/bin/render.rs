@@ -58,7 +58,9 @@ use arealight::glam::DVec3;
 use arealight::internals::{Demo, DemoConfig, demo_scene};
 use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scene};
 use arealight::visibility::{PluckerContext, PluckerVisibility};
+use arealight_demo::image::{to_bytes, write_png};
 use arealight_demo::progress::Progress;
+use arealight_demo::{args_or_exit, run_or_exit};
 use arealight_demo::trace::{Camera, ray_triangle};
 use rayon::prelude::*;
 use std::cell::RefCell;
@@ -275,52 +277,12 @@ fn shade_analytic(scene: &Scene, w: usize, hits: &[Hit]) -> (Vec<DVec3>, usize) 
     (img, failures)
 }
 
-/// Runs `f` on a rayon pool of `threads` workers (0: rayon's global pool, all cores).
-fn with_threads(
-    threads: usize,
-    f: impl FnOnce() -> Result<(), String> + Send,
-) -> Result<(), String> {
-    if threads == 0 {
-        return f();
-    }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())?
-        .install(f)
-}
-
 /// Part of the reference cache's file name: bump it whenever the scene, the camera or what the
 /// reference treats as opaque changes (v5: lights block each other).
 const SCENE_VERSION: &str = "v5";
 
 /// Scale of linear radiance before tone mapping.
 const EXPOSURE: f64 = 4.0;
-
-fn srgb(x: f64) -> u8 {
-    let t = 1.0 - (-EXPOSURE * x.max(0.0)).exp();
-    let s = if t <= 0.003_130_8 {
-        12.92 * t
-    } else {
-        1.055 * t.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8
-}
-
-fn write_png(path: &PathBuf, w: usize, h: usize, pixels: &[u8]) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut enc = png::Encoder::new(std::io::BufWriter::new(file), w as u32, h as u32);
-    enc.set_color(png::ColorType::Rgb);
-    enc.set_depth(png::BitDepth::Eight);
-    let mut wr = enc.write_header().map_err(|e| e.to_string())?;
-    wr.write_image_data(pixels).map_err(|e| e.to_string())
-}
-
-fn to_bytes(img: &[DVec3]) -> Vec<u8> {
-    img.iter()
-        .flat_map(|p| [srgb(p.x), srgb(p.y), srgb(p.z)])
-        .collect()
-}
 
 fn errors(img: &[DVec3], reference: &[DVec3]) -> (f64, f64) {
     let n = (img.len() * 3) as f64;
@@ -334,17 +296,8 @@ fn errors(img: &[DVec3], reference: &[DVec3]) -> (f64, f64) {
 }
 
 fn main() {
-    let args = match parse_args() {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(2);
-        }
-    };
-    if let Err(e) = with_threads(args.threads, || run(&args)) {
-        eprintln!("render: {e}");
-        std::process::exit(1);
-    }
+    let args = args_or_exit(parse_args());
+    run_or_exit("render", args.threads, || run(&args));
 }
 
 fn run(args: &Args) -> Result<(), String> {
@@ -636,7 +589,7 @@ fn print_table(rows: &[Row]) {
 /// Writes each image as a PNG, and all of them left to right in `render_side_by_side.png`.
 fn write_images(args: &Args, images: &[(&str, &Vec<DVec3>)]) -> Result<(), String> {
     let (w, h) = (args.width, args.height);
-    let bytes: Vec<Vec<u8>> = images.iter().map(|(_, img)| to_bytes(img)).collect();
+    let bytes: Vec<Vec<u8>> = images.iter().map(|(_, img)| to_bytes(img, EXPOSURE)).collect();
     for ((name, _), b) in images.iter().zip(&bytes) {
         write_png(&args.out.join(name), w, h, b)?;
     }

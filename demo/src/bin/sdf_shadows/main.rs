@@ -790,13 +790,7 @@ fn run(args: &Args, world: &World, hits: &[Option<Hit>], kind: LightKind) -> Res
 }
 
 fn main() {
-    let args = match parse_args() {
-        Ok(a) => a,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(2);
-        }
-    };
+    let args = arealight_demo::args_or_exit(parse_args());
     let cam = Camera::new(DVec3::new(0.3, -4.6, 3.1), DVec3::new(0.1, 0.3, 0.35), 42.0);
     // Shadow edges move by at most the silhouette error times the largest magnification from
     // an occluder to the floor (light at height 3, objects up to 1.2: 3 / 1.8); keep that under
