@@ -60,8 +60,8 @@ use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scen
 use arealight::visibility::{PluckerContext, PluckerVisibility};
 use arealight_demo::image::{to_bytes, write_png};
 use arealight_demo::progress::Progress;
-use arealight_demo::{args_or_exit, run_or_exit};
 use arealight_demo::trace::{Camera, ray_triangle};
+use arealight_demo::{args_or_exit, run_or_exit};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::path::PathBuf;
@@ -589,7 +589,10 @@ fn print_table(rows: &[Row]) {
 /// Writes each image as a PNG, and all of them left to right in `render_side_by_side.png`.
 fn write_images(args: &Args, images: &[(&str, &Vec<DVec3>)]) -> Result<(), String> {
     let (w, h) = (args.width, args.height);
-    let bytes: Vec<Vec<u8>> = images.iter().map(|(_, img)| to_bytes(img, EXPOSURE)).collect();
+    let bytes: Vec<Vec<u8>> = images
+        .iter()
+        .map(|(_, img)| to_bytes(img, EXPOSURE))
+        .collect();
     for ((name, _), b) in images.iter().zip(&bytes) {
         write_png(&args.out.join(name), w, h, b)?;
     }
