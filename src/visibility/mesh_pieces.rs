@@ -18,6 +18,7 @@
 //! mesh light or of a blocker component in the shaft, the region before the overlay is not a set of simple rings, or the overlay declines
 //! within rounding.
 
+use alloc::boxed::Box;
 use alloc::vec::Vec;
 
 use glam::{DVec2, DVec3};
@@ -49,6 +50,24 @@ pub(crate) struct MeshScratch {
     ring: Vec<u32>,
     buf: Vec<RingPoint>,
     cut: Vec<RingPoint>,
+}
+
+/// Vertices the scratch storage is first made for (a few hundred contour vertices in the
+/// light's chart are common for meshes of a thousand triangles): the buffers are reserved
+/// once rather than grown in steps on a context's first point.
+const SCRATCH_VERTICES: usize = 256;
+
+impl MeshScratch {
+    fn new() -> Self {
+        MeshScratch {
+            overlay: Overlay::with_capacity(SCRATCH_VERTICES),
+            edges: Vec::with_capacity(SCRATCH_VERTICES),
+            next: Vec::with_capacity(SCRATCH_VERTICES),
+            ring: Vec::with_capacity(SCRATCH_VERTICES),
+            buf: Vec::with_capacity(SCRATCH_VERTICES / 4),
+            cut: Vec::with_capacity(SCRATCH_VERTICES / 4),
+        }
+    }
 }
 
 /// The chart: centre `c` and axes `u`, `v` with `u x v = c` (so that counter-clockwise in the
@@ -100,7 +119,10 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         if !mesh_light && !out.is_simple() {
             return false;
         }
-        let mut s = out.mesh.take().unwrap_or_default();
+        let mut s = out
+            .mesh
+            .take()
+            .unwrap_or_else(|| Box::new(MeshScratch::new()));
         let ok = self.overlay_into(light, frame, mesh_light, meshes, out, &mut s);
         out.mesh = Some(s);
         ok

@@ -112,6 +112,9 @@ pub(crate) struct Overlay {
     seen: Vec<bool>,
     /// Identities of the input vertices the result passes through.
     out_ids: Vec<u64>,
+    /// Per edge, the next free slot while grouping (`sort_slots`); per crossing, its first slot.
+    fill: Vec<u32>,
+    first: Vec<u32>,
     /// The result: rings of directions (see [`Overlay::resolve`]).
     pub(crate) out: Vec<DVec3>,
     pub(crate) out_ends: Vec<u32>,
@@ -142,6 +145,23 @@ fn visible(w: [i32; 2]) -> bool {
 }
 
 impl Overlay {
+    /// Storage for about `n` input vertices (reserved once: the buffers then grow rarely).
+    pub(crate) fn with_capacity(n: usize) -> Self {
+        let mut o = Overlay::default();
+        o.pts.reserve(n);
+        o.ring_of.reserve(n);
+        o.bbox.reserve(n);
+        o.order.reserve(n);
+        o.active.reserve(n / 4);
+        o.xstart.reserve(n + 1);
+        o.fill.reserve(n);
+        o.kept.reserve(2 * n);
+        o.seen.reserve(2 * n);
+        o.out.reserve(n);
+        o.out_ids.reserve(n);
+        o
+    }
+
     /// Empties the input.
     pub(crate) fn clear(&mut self) {
         self.pts.clear();
@@ -338,7 +358,8 @@ impl Overlay {
         self.slots.clear();
         self.slots.resize(2 * self.cross.len(), Slot::default());
         // Fill from the ends backwards, so that `xstart` is left as it was.
-        let mut fill: Vec<u32> = Vec::new();
+        let fill = &mut self.fill;
+        fill.clear();
         fill.extend_from_slice(&self.xstart[1..]);
         for (ci, c) in self.cross.iter().enumerate().rev() {
             let (e, f) = (c.e as usize, c.f as usize);
@@ -378,7 +399,8 @@ impl Overlay {
             }
         }
         // Twins: the two slots of each crossing.
-        let mut first = Vec::new();
+        let first = &mut self.first;
+        first.clear();
         first.resize(self.cross.len(), u32::MAX);
         for i in 0..self.slots.len() {
             let ci = self.slots[i].cross as usize;
