@@ -335,6 +335,14 @@ fn main() {
                 bytes as f64 / tris as f64
             );
         }
+        let (bytes, tris) = s.visibility().contour_bytes();
+        if tris > 0 {
+            println!(
+                "{name}: contour structures {bytes} bytes over {tris} triangles ({:.1} bytes per \
+                 triangle)",
+                bytes as f64 / tris as f64
+            );
+        }
         let (pts, m) = (points(), material());
         let mut sum = DVec3::ZERO;
         for _ in 0..reps {

@@ -630,8 +630,9 @@ fn spherical_facing(
 /// - a point inside a convex light or on its surface receives nothing from it;
 /// - a two-sided quad light is shaded from both sides (the turned-around backend from behind),
 ///   with occluders on both sides, on the fast path;
-/// - a mesh occluder large enough for a hierarchy is left to the one-pass union (the fast path
-///   declines wherever it is among the blockers, as for touching blockers);
+/// - an open mesh occluder large enough for a hierarchy is left to the one-pass union (the fast
+///   path declines wherever it is among the blockers, as for touching blockers); a closed one
+///   takes the fast path (its contour, `visibility/mesh_pieces.rs`);
 /// - a light bounded by Bezier curves blocks another light by its triangulated flattening, on
 ///   the fast path (the light itself is flattened per point on the spherical path).
 #[test]
@@ -653,6 +654,15 @@ fn main_rules_hold_on_the_fast_path() {
             .clone(),
     );
     assert!(ball.mesh().triangle_count() >= arealight::visibility::BVH_MIN_TRIANGLES);
+    // The same ball with one triangle left out: open.
+    let open_ball = Body::Mesh(
+        TriangleMesh::new(
+            ball.mesh().vertices().to_vec(),
+            ball.mesh().triangles()[1..].to_vec(),
+        )
+        .unwrap(),
+    );
+    assert!(!open_ball.mesh().is_closed());
     // A Bezier-bounded light facing down under the quad: a blocker of the quad by its
     // triangulated flattening, with too few triangles for a hierarchy.
     let blob = {
@@ -677,6 +687,8 @@ fn main_rules_hold_on_the_fast_path() {
         occluders: Vec<Body>,
         /// Occluders whose presence among the blockers forbids the fast path.
         forbidden: Vec<usize>,
+        /// Fewest of the 300 points whose region the fast path must give (not empty).
+        fast_at_least: usize,
     }
     let cases = [
         Case {
@@ -687,6 +699,7 @@ fn main_rules_hold_on_the_fast_path() {
                 cube(DVec3::new(-0.3, 0.3, 1.0), DVec3::splat(0.1)),
             ],
             forbidden: vec![0],
+            fast_at_least: 0,
         },
         Case {
             name: "quad beside the light in its plane",
@@ -696,6 +709,7 @@ fn main_rules_hold_on_the_fast_path() {
                 cube(DVec3::ZERO.with_z(1.0), DVec3::splat(0.2)),
             ],
             forbidden: vec![0],
+            fast_at_least: 0,
         },
         Case {
             name: "box reaching a lamp face's plane",
@@ -705,18 +719,31 @@ fn main_rules_hold_on_the_fast_path() {
                 DVec3::new(0.15, 0.1, 0.05),
             )],
             forbidden: vec![0],
+            fast_at_least: 0,
         },
         Case {
-            name: "mesh occluder with a hierarchy",
+            name: "open mesh occluder with a hierarchy",
+            lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap()],
+            occluders: vec![
+                open_ball,
+                cube(DVec3::new(0.3, -0.2, 1.0), DVec3::splat(0.1)),
+            ],
+            forbidden: vec![0],
+            fast_at_least: 0,
+        },
+        Case {
+            name: "closed mesh occluder with a hierarchy",
             lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap()],
             occluders: vec![ball, cube(DVec3::new(0.3, -0.2, 1.0), DVec3::splat(0.1))],
-            forbidden: vec![0],
+            forbidden: vec![],
+            fast_at_least: 100,
         },
         Case {
             name: "Bezier light under the quad",
             lights: vec![Light::new(quad.clone(), DVec3::ONE).unwrap(), blob_light],
             occluders: vec![cube(DVec3::new(0.3, -0.2, 1.0), DVec3::splat(0.1))],
             forbidden: vec![],
+            fast_at_least: 100,
         },
         Case {
             name: "two-sided quad",
@@ -726,6 +753,7 @@ fn main_rules_hold_on_the_fast_path() {
                 cube(DVec3::new(-0.1, 0.1, 3.0), DVec3::splat(0.2)),
             ],
             forbidden: vec![],
+            fast_at_least: 0,
         },
     ];
     let mut rng = Rng::new(1717);
@@ -768,11 +796,11 @@ fn main_rules_hold_on_the_fast_path() {
                     failures.push(format!("{}: {x} took the fast path", case.name));
                 }
             }
+            fast_seen += usize::from(took && !pieces.is_empty());
             // Light 0's share (the only light, except beside the Bezier light).
             let got = if scene.lights().len() == 1 {
                 scene.shade_in(&mut ctx, x, n, v, &m)
             } else {
-                fast_seen += usize::from(took && !pieces.is_empty());
                 scene.shade_light(0, x, n, v, &m)
             };
             let Some((want, whole)) = spherical_facing(&scene, 0, &f, &m) else {
@@ -796,10 +824,11 @@ fn main_rules_hold_on_the_fast_path() {
                 case.name
             );
         }
-        if scene.lights().len() > 1 {
-            // The Bezier light was a blocker the fast path subtracted, not declined.
+        // The Bezier light and the closed mesh were blockers the fast path subtracted, not
+        // declined.
+        {
             assert!(
-                fast_seen >= 100,
+                fast_seen >= case.fast_at_least,
                 "{}: {fast_seen} points on the fast path",
                 case.name
             );

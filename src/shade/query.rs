@@ -104,8 +104,9 @@ pub(super) fn specular_setup(
 /// path's [`Pieces`], kept so that their buffers are reused from one query to the next.
 ///
 /// Inline storage covers lights and blockers of up to 16 vertices, so neither a context kept by
-/// the caller nor the one [`Scene::shade`] makes on the stack allocates for them; larger inputs
-/// spill to the heap once per context. A context holds no results: any context serves any
+/// the caller nor the one [`Scene::shade`] makes on the stack allocates for them; larger inputs,
+/// and closed mesh blockers and closed non-planar mesh lights of any size, spill to the heap
+/// once per context. A context holds no results: any context serves any
 /// scene. One per thread (it is `Send`, and the scene is shared).
 ///
 /// # Examples

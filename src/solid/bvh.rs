@@ -34,7 +34,8 @@ struct Node {
     count: u32,
 }
 
-/// A bounding-volume hierarchy over the triangles of one [`TriangleMesh`].
+/// A bounding-volume hierarchy over the triangles of one [`TriangleMesh`] (or over any boxes,
+/// [`Bvh::over_boxes`]).
 ///
 /// Queries never miss a triangle whose box passes the caller's test: every stored box contains
 /// the exact box of its triangles after the conversion back to `f64` (the conversion's rounding
@@ -77,13 +78,20 @@ impl Bvh {
     /// Builds the hierarchy over every triangle of `mesh` (about `n log n`).
     #[must_use]
     pub fn build(mesh: &TriangleMesh) -> Self {
-        let n = mesh.triangle_count();
-        let boxes: Vec<(DVec3, DVec3)> = (0..n)
+        let boxes: Vec<(DVec3, DVec3)> = (0..mesh.triangle_count())
             .map(|t| {
                 let [a, b, c] = mesh.triangle(t);
                 (a.min(b).min(c), a.max(b).max(c))
             })
             .collect();
+        Self::over_boxes(&boxes)
+    }
+
+    /// Builds the hierarchy over any axis-aligned boxes `(lo, hi)` (finite, `lo <= hi`): its
+    /// queries then name the boxes by their index, as [`Bvh::build`]'s name triangles.
+    #[must_use]
+    pub fn over_boxes(boxes: &[(DVec3, DVec3)]) -> Self {
+        let n = boxes.len();
         let (lo, hi) = boxes.iter().fold(
             (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
             |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),

@@ -6,6 +6,7 @@ use alloc::vec::Vec;
 use glam::DVec3;
 use smallvec::SmallVec;
 
+use super::contour::MeshContours;
 use super::cull::{LightCone, Shaft, above_horizon, may_occlude, shaft_triangles};
 use super::pieces::ConvexFaces;
 use super::union::{BlockerAccel, BlockerGeometry, LightRegion, one_pass};
@@ -241,7 +242,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     }
 
     /// The blocker's slot in a light's row of [`ClipVisibility::separations`].
-    fn slot(&self, b: Blocker) -> usize {
+    pub(super) fn slot(&self, b: Blocker) -> usize {
         match b {
             Blocker::Occluder(k) => k,
             Blocker::Light(k) => self.occluders.len() + k,
@@ -261,6 +262,25 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// The bounding-volume hierarchy of a blocker's triangles, if it has one.
     pub(super) fn bvh(&self, b: Blocker) -> Option<&Bvh> {
         self.accels[self.slot(b)].bvh.as_ref()
+    }
+
+    /// The precomputed contour structure of blocker `b`, if it is a closed mesh
+    /// (`visibility/contour.rs`).
+    pub(super) fn contours(&self, b: Blocker) -> Option<&MeshContours> {
+        self.accels[self.slot(b)].contours.as_ref()
+    }
+
+    /// Bytes held by the contour structures of closed meshes (edges with their faces by
+    /// component, facing hierarchies, component boxes and their hierarchy), and the number of
+    /// triangles they cover.
+    #[must_use]
+    pub fn contour_bytes(&self) -> (usize, usize) {
+        self.occluders
+            .iter()
+            .chain(self.lights.iter().map(AsRef::as_ref))
+            .zip(&self.accels)
+            .filter_map(|(b, a)| Some((a.contours.as_ref()?, b.mesh().triangle_count())))
+            .fold((0, 0), |(b, t), (c, n)| (b + c.byte_size(), t + n))
     }
 
     /// Bytes held by the bounding-volume hierarchies of all objects, and the number of
@@ -654,7 +674,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// emits nothing inwards: the light has no region there, though a convex light's silhouette
     /// is then the whole sphere and a non-convex one's front faces need not be empty. A point
     /// on the surface of a convex light has no front face either and receives nothing from it.
-    fn seen_from_inside(&self, light: usize, body: &Body, x: DVec3) -> bool {
+    pub(super) fn seen_from_inside(&self, light: usize, body: &Body, x: DVec3) -> bool {
         match body {
             Body::Convex(p) => !p.has_front_face(x),
             _ => self.solids[light].as_ref().is_some_and(|s| s.encloses(x)),

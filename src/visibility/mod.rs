@@ -14,7 +14,10 @@
 //! point and a light. This layer knows solids and spherical polygons, no radiance or BRDF.
 
 mod clip;
+mod contour;
 pub(crate) mod cull;
+mod mesh_pieces;
+mod overlay;
 mod pieces;
 pub mod plucker;
 mod union;

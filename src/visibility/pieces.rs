@@ -80,12 +80,14 @@
 //! right somewhere (a face within the facing tolerance of edge-on left out): there the
 //! spherical path decides, or gives up, exactly as without this path.
 
+use alloc::boxed::Box;
 use alloc::vec::Vec;
 
 use glam::DVec3;
 use smallvec::SmallVec;
 
 use super::cull::{LightCone, above_horizon, may_occlude};
+use super::mesh_pieces::MeshScratch;
 use super::{Blocker, ClipVisibility, Method};
 use crate::GeomError;
 use crate::solid::facing::{FacingAt, Side, face_side};
@@ -166,7 +168,8 @@ impl Chain {
 /// It is also the scratch storage of the fast path: a caller that keeps one across calls
 /// reuses its buffers. Inline room for 128 vertices in all, so small lights and blockers (up to
 /// 16 vertices each, a few blockers) allocate nothing; larger ones spill to the heap once per
-/// `Pieces` value.
+/// `Pieces` value, as do closed mesh blockers and closed non-planar mesh lights of any size,
+/// whose contour overlay keeps growable buffers here.
 #[derive(Debug, Clone)]
 pub struct Pieces {
     /// The region (`bufs[cur]`) and the one a subtraction builds (the other).
@@ -195,6 +198,11 @@ pub struct Pieces {
     /// Subtractions so far by boundary tracing and by inclusion–exclusion (diagnostics).
     traced: u64,
     cut: u64,
+    /// Scratch storage of the closed meshes' path (`visibility/mesh_pieces.rs`), made on its
+    /// first use: its growable buffers are no cost to points that never take that path.
+    pub(super) mesh: Option<Box<MeshScratch>>,
+    /// Regions resolved by that path's overlay (diagnostics).
+    pub(super) overlays: u64,
     /// Tests: take the general traversal for two crossings too, and count the subtractions
     /// that [`Pieces::traverse_two`] answered.
     #[cfg(test)]
@@ -256,6 +264,8 @@ impl Pieces {
             order: SmallVec::new(),
             traced: 0,
             cut: 0,
+            mesh: None,
+            overlays: 0,
             #[cfg(test)]
             general_only: false,
             #[cfg(test)]
@@ -283,6 +293,14 @@ impl Pieces {
         (self.traced, self.cut)
     }
 
+    /// How many regions this storage has resolved by the overlay of closed meshes' contours
+    /// (see the source of `visibility::mesh_pieces`), over all calls; for tests and benchmarks.
+    #[doc(hidden)]
+    #[must_use]
+    pub fn overlays(&self) -> u64 {
+        self.overlays
+    }
+
     /// Number of rings.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -298,6 +316,20 @@ impl Pieces {
     fn clear(&mut self) {
         self.bufs[self.cur].clear();
         self.simple = false;
+    }
+
+    /// Whether the rings are simple and disjoint (see the field).
+    pub(super) fn is_simple(&self) -> bool {
+        self.simple
+    }
+
+    /// Makes the region the rings `pts[ends[k - 1]..ends[k]]`, `simple` as the field says.
+    pub(super) fn set_region(&mut self, pts: &[DVec3], ends: &[u32], simple: bool) {
+        let chain = &mut self.bufs[self.cur];
+        chain.clear();
+        chain.pts.extend_from_slice(pts);
+        chain.ends.extend_from_slice(ends);
+        self.simple = simple;
     }
 
     /// Makes the region a subtraction built in the other buffer the current one.
@@ -987,7 +1019,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
     /// rounding. `Ok(true)` when `out` holds the region; `Ok(false)` when this path does not
     /// apply (see [`Pieces`] and the source of `visibility::pieces`) and the caller takes
     /// [`ClipVisibility::visible_region`]. Allocates nothing for lights and blockers of up to
-    /// 16 vertices (beyond what `out` already holds).
+    /// 16 vertices, closed meshes aside (beyond what `out` already holds: see [`Pieces`]).
     ///
     /// # Errors
     ///
@@ -1009,7 +1041,16 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         if !above_horizon(x, n, self.light_bounds[light]) {
             return Ok(true);
         }
-        if !self.light_rings(light, body, frame, out) {
+        if self.contour_light(light, body) {
+            // A closed non-planar mesh light: the union of its front faces, from its contour.
+            if self.seen_from_inside(light, body, x) {
+                return Ok(true);
+            }
+            if !self.overlay_region(light, frame, true, &[], out) {
+                out.clear();
+                return Ok(false);
+            }
+        } else if !self.light_rings(light, body, frame, out) {
             out.clear();
             return Ok(false);
         }
@@ -1035,6 +1076,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         let blockers = (0..no)
             .map(Blocker::Occluder)
             .chain((0..nl).filter(|&k| k != light).map(Blocker::Light));
+        // Closed mesh blockers, removed together by their contours after the others.
+        let mut meshes: SmallVec<[Blocker; 4]> = SmallVec::new();
         for b in blockers {
             let (separation, touches) = self.pair(light, b);
             if let Some(sep) = separation
@@ -1051,9 +1094,10 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
             // Interpenetrating blockers, and blockers with a vertex in the plane of a light
             // triangle (never subtracted whole: the touching part hides nothing), act face by
-            // face: the spherical path's business. Meshes large enough for a hierarchy go to
-            // the one-pass union, which culls their triangles by shafts. A Bezier-bounded
-            // light blocks others by its triangulated flattening, as on the spherical path.
+            // face: the spherical path's business. Closed meshes are removed by their
+            // contours after the loop; open meshes large enough for a hierarchy go to the
+            // one-pass union, which culls their triangles by shafts. A Bezier-bounded light
+            // blocks others by its triangulated flattening, as on the spherical path.
             let fits = separation.is_some()
                 && !touches
                 && match body {
@@ -1064,6 +1108,10 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                         };
                         planes && out.subtract()
                     }
+                    Body::Mesh(_) if self.contours(b).is_some() => {
+                        meshes.push(b);
+                        true
+                    }
                     other => {
                         self.bvh(b).is_none()
                             && self.subtract_triangles(light, other.mesh(), frame, out)
@@ -1073,7 +1121,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 return false;
             }
         }
-        true
+        meshes.is_empty() || self.overlay_region(light, frame, false, &meshes, out)
     }
 
     /// The light's own region as the first rings of `out`, clipped to the upper hemisphere;

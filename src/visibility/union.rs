@@ -54,6 +54,7 @@ use alloc::vec::Vec;
 use glam::{DVec2, DVec3};
 use smallvec::SmallVec;
 
+use super::contour::MeshContours;
 use super::cull::Shaft;
 use crate::GeomError;
 use crate::planar::predicates::vertices_inside_segment;
@@ -121,6 +122,9 @@ pub(crate) struct BlockerAccel {
     pub bvh: Option<Bvh>,
     /// For a closed mesh ([`TriangleMesh::is_closed`]): its components.
     pub closed: Option<Closed>,
+    /// For a closed mesh: its edges, components and facing hierarchies, for the fast path's
+    /// contours (`visibility/contour.rs`).
+    pub contours: Option<MeshContours>,
 }
 
 /// The connected components (through shared edges) of a closed mesh and their bounding boxes.
@@ -148,7 +152,16 @@ impl BlockerAccel {
         let mesh = body.mesh();
         let bvh = (mesh.triangle_count() >= bvh_min).then(|| Bvh::build(mesh));
         let closed = (matches!(body, Body::Mesh(_)) && mesh.is_closed()).then(|| Closed::new(mesh));
-        BlockerAccel { bvh, closed }
+        let contours = if matches!(body, Body::Mesh(_)) {
+            MeshContours::new(mesh)
+        } else {
+            None
+        };
+        BlockerAccel {
+            bvh,
+            closed,
+            contours,
+        }
     }
 }
 

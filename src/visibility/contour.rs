@@ -1,0 +1,616 @@
+//! Contours of closed meshes seen from a point, found through a hierarchy of facing bounds
+//! instead of a visit of every triangle (issue 17).
+//!
+//! Seen from a point, the front faces of a closed mesh (by the facing predicate,
+//! [`FacingAt::front`]) have as the boundary of their sum the contour edges, the edges between a
+//! front face and one that is not (thesis 003 eq. 4.1): every other edge is run once each way by
+//! two front faces and cancels. So the contour, oriented as its front face runs it, is a closed
+//! chain whose winding number about a direction is the number of front faces covering it: the
+//! union of the front faces is where it is positive. That is all the one-pass union needs of a
+//! closed mesh (see `visibility/union.rs` and [`super::overlay`]), and it is found here without
+//! hashing or even visiting the faces away from the contour:
+//!
+//! - the mesh's edges are stored with their two faces, grouped by connected component (a
+//!   component's contour is closed by itself, so whole components can be culled by a shaft
+//!   without opening a contour), through a bounding-volume hierarchy over the components' boxes
+//!   where there are many;
+//! - within a large component, a hierarchy over its edges keeps for each node a bound on the
+//!   signed distances of a point from all the face planes of its edges (a cone of normals about
+//!   an axis and the range of the planes' offsets from the node's centre, the normal cones of
+//!   Sander et al., *Silhouette clipping*, SIGGRAPH 2000, section 4, with the offsets anchored
+//!   at the node): a node whose faces are all front faces, or none, holds no contour edge and is
+//!   skipped with its subtree.
+//!
+//! A query declines where the point lies inside the box of a component it takes: outside it,
+//! the component lies in an open half-space away from the point (beyond a face plane of the
+//! box), so its front faces project into one open hemisphere and their boundaries are closed
+//! rings there, whose winding numbers add up to the count of front faces covering a direction.
+//! Inside it the front faces can surround the point (the walls and floor of a cup seen from
+//! its well), and the contour (the well's rim) then bounds the part they leave open.
+//!
+//! The bounds are conservative beyond rounding (see [`FacingNode`]): every face of a skipped
+//! node gets the same answer from the facing predicate itself, so the contour is exactly the
+//! one a visit of every edge finds.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use glam::DVec3;
+use smallvec::SmallVec;
+
+use super::cull::Shaft;
+use crate::math::sqrt;
+use crate::solid::facing::FacingAt;
+use crate::solid::{Bvh, TriangleMesh};
+
+/// Components with at least this many edges get a hierarchy of facing bounds; smaller ones are
+/// tested edge by edge (a box has 18 edges).
+const TREE_MIN_EDGES: usize = 48;
+
+/// Most edges in a leaf of the facing hierarchy.
+const LEAF_EDGES: usize = 6;
+
+/// Meshes with more components than this get a hierarchy over the components' boxes.
+const COMPONENT_BVH_MIN: usize = 16;
+
+/// No facing hierarchy for a component.
+const NO_TREE: u32 = u32::MAX;
+
+/// What is precomputed for the contours of one closed mesh ([`TriangleMesh::is_closed`]): its
+/// edges with their faces by component, the components' boxes, and the facing hierarchies.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct MeshContours {
+    comps: Vec<Component>,
+    /// Over the components' boxes, for meshes of many components.
+    comp_bvh: Option<Bvh>,
+    /// `[a, b, f0, f1]`: the edge `a -> b` runs counter-clockwise around face `f0`, `b -> a`
+    /// around `f1` ([`crate::solid::MeshEdge`]); grouped by component, and in leaf order within
+    /// a component with a hierarchy.
+    edges: Vec<[u32; 4]>,
+    nodes: Vec<FacingNode>,
+}
+
+/// A connected component (through shared edges) of a closed mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Component {
+    lo: DVec3,
+    hi: DVec3,
+    /// Its edges: `edges[start..end]`.
+    start: u32,
+    end: u32,
+    /// Root of its facing hierarchy, or [`NO_TREE`].
+    root: u32,
+}
+
+/// A node of a facing hierarchy: bounds on the signed distance `s_f = n_f . (x - p_f)` of a point
+/// `x` from the plane of every face `f` of its edges (`n_f` the face's unit normal as the mesh
+/// stores it, `p_f` a corner).
+///
+/// With `y = x - center`, `s_f = n_f . y + q_f` where `q_f = n_f . (center - p_f)` is the
+/// signed distance of the centre from the plane, and `n_f . y = axis . y + (n_f - axis) . y`
+/// with `|n_f - axis| <= spread`: so `s_f` lies in `[axis . y - spread |y| + q_lo, axis . y +
+/// spread |y| + q_hi]`. `spread`, `q_lo` and `q_hi` are widened at build time beyond their
+/// rounding (relative `1e-9`), far below the facing predicate's tolerance (`1e-11` of the mesh's
+/// size plus the point's distance), which is what the query compares the bounds with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct FacingNode {
+    center: DVec3,
+    axis: DVec3,
+    spread: f64,
+    q_lo: f64,
+    q_hi: f64,
+    /// A leaf's first edge; an inner node's second child (its first is the next node).
+    start: u32,
+    /// A leaf's edge count; 0 for an inner node.
+    count: u32,
+}
+
+/// How the facing bounds of a node classify its faces from a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum NodeFacing {
+    AllFront,
+    NoneFront,
+    Mixed,
+}
+
+impl FacingNode {
+    /// The class of the node's faces from the point `x` (facing predicate `at`): all front or
+    /// none only when the bounds clear the predicate's tolerance by half of it either way.
+    #[inline]
+    fn classify(&self, x: DVec3, tol: f64) -> NodeFacing {
+        let y = x - self.center;
+        let mid = self.axis.dot(y);
+        let spread = self.spread * sqrt(y.length_squared());
+        if mid - spread + self.q_lo > 1.5 * tol {
+            NodeFacing::AllFront
+        } else if mid + spread + self.q_hi < 0.5 * tol {
+            NodeFacing::NoneFront
+        } else {
+            NodeFacing::Mixed
+        }
+    }
+}
+
+/// Which components a contour query takes.
+#[derive(Clone, Copy)]
+pub(crate) enum Cull<'a> {
+    /// All of them (a light's own contour); the query declines when the point lies inside the
+    /// box of one of them.
+    All,
+    /// Those whose boxes may meet the shaft; the query declines when the point lies inside the
+    /// box of one of them.
+    Shaft(&'a Shaft),
+}
+
+impl MeshContours {
+    /// The precomputation for a closed mesh; `None` for a mesh that is not closed.
+    pub(crate) fn new(mesh: &TriangleMesh) -> Option<Self> {
+        if !mesh.is_closed() {
+            return None;
+        }
+        let nt = mesh.triangle_count();
+        // Components: union-find over the faces through the edges.
+        let mut parent: Vec<u32> = (0..nt as u32).collect();
+        fn root(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                parent[i as usize] = parent[parent[i as usize] as usize];
+                i = parent[i as usize];
+            }
+            i
+        }
+        for e in mesh.edges() {
+            let f1 = e.twin()?;
+            let (a, b) = (root(&mut parent, e.f0), root(&mut parent, f1));
+            parent[a.max(b) as usize] = a.min(b);
+        }
+        let mut id = vec![u32::MAX; nt];
+        let mut comp_of = Vec::with_capacity(nt);
+        let mut boxes: Vec<(DVec3, DVec3)> = Vec::new();
+        for t in 0..nt {
+            let r = root(&mut parent, t as u32) as usize;
+            let [a, b, c] = mesh.triangle(t);
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            if id[r] == u32::MAX {
+                id[r] = boxes.len() as u32;
+                boxes.push((lo, hi));
+            }
+            let k = id[r] as usize;
+            boxes[k] = (boxes[k].0.min(lo), boxes[k].1.max(hi));
+            comp_of.push(k as u32);
+        }
+        // Edges grouped by component (counting sort).
+        let nc = boxes.len();
+        let mut first = vec![0u32; nc + 1];
+        for e in mesh.edges() {
+            first[comp_of[e.f0 as usize] as usize + 1] += 1;
+        }
+        for k in 0..nc {
+            first[k + 1] += first[k];
+        }
+        let mut fill = first.clone();
+        let mut edges = vec![[0u32; 4]; mesh.edges().len()];
+        for e in mesh.edges() {
+            let k = comp_of[e.f0 as usize] as usize;
+            edges[fill[k] as usize] = [e.a, e.b, e.f0, e.f1];
+            fill[k] += 1;
+        }
+        let mut nodes = Vec::new();
+        let comps = (0..nc)
+            .map(|k| {
+                let (start, end) = (first[k] as usize, first[k + 1] as usize);
+                let root = if end - start >= TREE_MIN_EDGES {
+                    let r = nodes.len() as u32;
+                    build_tree(mesh, &mut edges[start..end], start as u32, &mut nodes);
+                    r
+                } else {
+                    NO_TREE
+                };
+                Component {
+                    lo: boxes[k].0,
+                    hi: boxes[k].1,
+                    start: start as u32,
+                    end: end as u32,
+                    root,
+                }
+            })
+            .collect();
+        let comp_bvh = (nc > COMPONENT_BVH_MIN).then(|| Bvh::over_boxes(&boxes));
+        Some(MeshContours {
+            comps,
+            comp_bvh,
+            edges,
+            nodes,
+        })
+    }
+
+    /// Heap bytes held (edges, nodes, components and their hierarchy) plus the struct.
+    pub(crate) fn byte_size(&self) -> usize {
+        self.edges.len() * core::mem::size_of::<[u32; 4]>()
+            + self.nodes.len() * core::mem::size_of::<FacingNode>()
+            + self.comps.len() * core::mem::size_of::<Component>()
+            + self.comp_bvh.as_ref().map_or(0, Bvh::byte_size)
+            + core::mem::size_of::<Self>()
+    }
+
+    /// Appends to `out` the contour edges of `mesh` (the mesh this was built for) seen from `x`,
+    /// each as its front face runs it, `(from, to)` by vertex index: the edges whose two faces
+    /// differ in [`FacingAt::front`]. Components are taken as `cull` says; `false` (with `out`
+    /// in any state) where it declines.
+    pub(crate) fn contour(
+        &self,
+        mesh: &TriangleMesh,
+        x: DVec3,
+        cull: Cull<'_>,
+        out: &mut Vec<(u32, u32)>,
+    ) -> bool {
+        let at = FacingAt::new(mesh, x);
+        let walk = Walk {
+            at,
+            normals: mesh.normals(),
+            offsets: mesh.offsets(),
+            edges: &self.edges,
+            nodes: &self.nodes,
+            x,
+        };
+        match cull {
+            Cull::All => {
+                for c in &self.comps {
+                    if !outside_box(c.lo, c.hi, x) {
+                        return false;
+                    }
+                    walk.component(c, out);
+                }
+                true
+            }
+            Cull::Shaft(shaft) => {
+                let mut ok = true;
+                let mut take = |c: &Component| {
+                    if ok && shaft.may_meet_box(c.lo, c.hi) {
+                        if outside_box(c.lo, c.hi, x) {
+                            walk.component(c, out);
+                        } else {
+                            ok = false;
+                        }
+                    }
+                };
+                match &self.comp_bvh {
+                    Some(bvh) => bvh.for_each_with(
+                        shaft.all_planes(),
+                        |lo, hi, mask| shaft.classify_box(lo, hi, mask),
+                        |k, _| take(&self.comps[k as usize]),
+                    ),
+                    None => self.comps.iter().for_each(take),
+                }
+                ok
+            }
+        }
+    }
+}
+
+/// Whether `x` lies outside the box `[lo, hi]` beyond rounding (relative `1e-9` of the box's
+/// size and position), as [`super::union::Closed`] decides it.
+fn outside_box(lo: DVec3, hi: DVec3, x: DVec3) -> bool {
+    let m = 1e-9 * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element());
+    x.cmplt(lo - DVec3::splat(m)).any() || x.cmpgt(hi + DVec3::splat(m)).any()
+}
+
+/// One contour query's view of the mesh.
+struct Walk<'a> {
+    at: FacingAt,
+    normals: &'a [DVec3],
+    offsets: &'a [f64],
+    edges: &'a [[u32; 4]],
+    nodes: &'a [FacingNode],
+    x: DVec3,
+}
+
+impl Walk<'_> {
+    #[inline(always)]
+    fn front(&self, f: u32) -> bool {
+        self.at
+            .front(self.normals[f as usize], self.offsets[f as usize])
+    }
+
+    #[inline(always)]
+    fn edges(&self, range: core::ops::Range<usize>, out: &mut Vec<(u32, u32)>) {
+        for &[a, b, f0, f1] in &self.edges[range] {
+            let (s0, s1) = (self.front(f0), self.front(f1));
+            if s0 != s1 {
+                out.push(if s0 { (a, b) } else { (b, a) });
+            }
+        }
+    }
+
+    fn component(&self, c: &Component, out: &mut Vec<(u32, u32)>) {
+        if c.root == NO_TREE {
+            self.edges(c.start as usize..c.end as usize, out);
+            return;
+        }
+        let tol = self.at.tol();
+        let mut stack: SmallVec<[u32; 64]> = SmallVec::new();
+        stack.push(c.root);
+        while let Some(i) = stack.pop() {
+            let n = &self.nodes[i as usize];
+            if n.classify(self.x, tol) != NodeFacing::Mixed {
+                continue;
+            }
+            if n.count > 0 {
+                self.edges(n.start as usize..(n.start + n.count) as usize, out);
+            } else {
+                stack.push(n.start);
+                stack.push(i + 1);
+            }
+        }
+    }
+}
+
+/// Builds the facing hierarchy over `edges` (a component's, starting at index `offset` of the
+/// mesh's edge list), reordering them into leaf order, appending its nodes (depth first: a
+/// node's first child is the next node).
+fn build_tree(
+    mesh: &TriangleMesh,
+    edges: &mut [[u32; 4]],
+    offset: u32,
+    nodes: &mut Vec<FacingNode>,
+) {
+    let verts = mesh.vertices();
+    let mid = |e: &[u32; 4]| 0.5 * (verts[e[0] as usize] + verts[e[1] as usize]);
+    // (parent awaiting its second child, first, end), relative to `edges`.
+    let mut stack: Vec<(Option<usize>, usize, usize)> = vec![(None, 0, edges.len())];
+    while let Some((parent, first, end)) = stack.pop() {
+        let node = nodes.len();
+        if let Some(p) = parent {
+            nodes[p].start = node as u32;
+        }
+        let range = &mut edges[first..end];
+        let leaf = range.len() <= LEAF_EDGES;
+        nodes.push(facing_bounds(
+            mesh,
+            range,
+            if leaf { offset + first as u32 } else { 0 },
+            leaf,
+        ));
+        if leaf {
+            continue;
+        }
+        // Median split along the longest axis of the edges' midpoints.
+        let (lo, hi) = range.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), e| (lo.min(mid(e)), hi.max(mid(e))),
+        );
+        let ext = hi - lo;
+        let axis = if ext.x >= ext.y && ext.x >= ext.z {
+            0
+        } else if ext.y >= ext.z {
+            1
+        } else {
+            2
+        };
+        let m = range.len() / 2;
+        range.select_nth_unstable_by(m, |a, b| mid(a)[axis].total_cmp(&mid(b)[axis]));
+        stack.push((Some(node), first + m, end));
+        stack.push((None, first, first + m));
+    }
+}
+
+/// The facing bounds of the faces of `edges` (see [`FacingNode`]).
+fn facing_bounds(mesh: &TriangleMesh, edges: &[[u32; 4]], start: u32, leaf: bool) -> FacingNode {
+    let verts = mesh.vertices();
+    let tris = mesh.triangles();
+    let normals = mesh.normals();
+    let faces = || edges.iter().flat_map(|e| [e[2], e[3]]);
+    let (lo, hi) = faces().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), f| {
+            let [a, b, c] = tris[f as usize].map(|i| verts[i as usize]);
+            (lo.min(a).min(b).min(c), hi.max(a).max(b).max(c))
+        },
+    );
+    let center = 0.5 * (lo + hi);
+    // The axis: the normalized sum of the normals (any unit vector is valid; this one is
+    // central for the cones the hierarchy's nodes hold).
+    let sum: DVec3 = faces().map(|f| normals[f as usize]).sum();
+    let axis = sum.try_normalize().unwrap_or(DVec3::Z);
+    let mut spread: f64 = 0.0;
+    let (mut q_lo, mut q_hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for f in faces() {
+        let n = normals[f as usize];
+        spread = spread.max((n - axis).length());
+        let p = verts[tris[f as usize][0] as usize];
+        let q = n.dot(center - p);
+        q_lo = q_lo.min(q);
+        q_hi = q_hi.max(q);
+    }
+    // Widened beyond the rounding of these sums and products (relative to their magnitudes).
+    let scale = (hi - lo).length() + center.abs().max_element();
+    let pad = 1e-9 * scale;
+    FacingNode {
+        center,
+        axis,
+        spread: spread * (1.0 + 1e-9) + 1e-12,
+        q_lo: q_lo - pad,
+        q_hi: q_hi + pad,
+        start,
+        count: if leaf { edges.len() as u32 } else { 0 },
+    }
+}
+
+/// The contour edges in `edges` (from [`MeshContours::contour`]) chained into closed rings of
+/// vertex indices, each passed to `emit`; `dir(v)` is vertex `v`'s direction from the point
+/// (any positive length), used where the contour passes through a vertex more than once.
+///
+/// The edges balance at every vertex (as many in as out: a sum of closed triangle boundaries),
+/// so walks close. Where several contour edges leave one vertex, each edge arriving there is
+/// paired with a leaving one so that the rings touch there without crossing (in the angular
+/// order of the edges about the vertex's direction: a non-crossing matching, as parentheses),
+/// which keeps the rings' crossings those of their edges' interiors for the overlay; the chain,
+/// and so its winding numbers, is the same whatever the pairing. `false` where the pairing
+/// cannot be decided within rounding or the walk does not close.
+pub(crate) fn chain_rings(
+    edges: &mut [(u32, u32)],
+    dir: impl Fn(u32) -> DVec3,
+    next: &mut Vec<u32>,
+    ring: &mut Vec<u32>,
+    mut emit: impl FnMut(&[u32]),
+) -> bool {
+    edges.sort_unstable();
+    let n = edges.len();
+    next.clear();
+    next.resize(n, u32::MAX);
+    // Edges out of each vertex are consecutive after sorting.
+    let mut i = 0;
+    while i < n {
+        let v = edges[i].0;
+        let mut j = i + 1;
+        while j < n && edges[j].0 == v {
+            j += 1;
+        }
+        if j - i > 1 && !pair_at(edges, i..j, &dir, next) {
+            return false;
+        }
+        i = j;
+    }
+    // Single successors.
+    for k in 0..n {
+        let b = edges[k].1;
+        let from = edges.partition_point(|e| e.0 < b);
+        if from < n && edges[from].0 == b && (from + 1 == n || edges[from + 1].0 != b) {
+            if next[k] != u32::MAX {
+                return false;
+            }
+            next[k] = from as u32;
+        }
+    }
+    // Walk.
+    let mut used = 0usize;
+    for s in 0..n {
+        if next[s] == u32::MAX - 1 {
+            continue;
+        }
+        ring.clear();
+        let mut k = s;
+        loop {
+            let nk = next[k];
+            if nk >= u32::MAX - 1 {
+                return false;
+            }
+            ring.push(edges[k].0);
+            next[k] = u32::MAX - 1;
+            used += 1;
+            k = nk as usize;
+            if k == s {
+                break;
+            }
+        }
+        emit(ring);
+    }
+    used == n
+}
+
+/// Pairs the edges arriving at vertex `v = edges[outs.start].0` with the edges `outs` leaving
+/// it (see [`chain_rings`]), writing `next[arriving] = leaving`.
+fn pair_at(
+    edges: &[(u32, u32)],
+    outs: core::ops::Range<usize>,
+    dir: &impl Fn(u32) -> DVec3,
+    next: &mut [u32],
+) -> bool {
+    let v = edges[outs.start].0;
+    // (edge index, other end's direction, +1 leaving / -1 arriving).
+    let mut around: SmallVec<[(usize, DVec3, i32); 8]> = SmallVec::new();
+    for k in outs.clone() {
+        around.push((k, dir(edges[k].1), 1));
+    }
+    for (k, e) in edges.iter().enumerate() {
+        if e.1 == v {
+            around.push((k, dir(e.0), -1));
+        }
+    }
+    if around.len() != 2 * outs.len() || around.len() > 8 {
+        return false;
+    }
+    let p = dir(v);
+    let r = around[0].1;
+    let bound = |a: DVec3, b: DVec3| 64.0 * f64::EPSILON * norm1(p) * norm1(a) * norm1(b);
+    // Angle about `p` (counter-clockwise seen from outside the sphere) from the first edge's
+    // tangent: half 0 for [0, pi), 1 for [pi, 2 pi).
+    let mut half: SmallVec<[u8; 8]> = SmallVec::new();
+    for &(_, w, _) in &around {
+        let s = p.cross(r).dot(w);
+        if w == r {
+            half.push(0);
+            continue;
+        }
+        if s.abs() <= bound(r, w) {
+            // Along the first tangent's great circle: the same direction (angle 0) or opposite.
+            let t_r = r - p * (p.dot(r) / p.length_squared());
+            let t_w = w - p * (p.dot(w) / p.length_squared());
+            if t_r.dot(t_w) > 0.0 {
+                return false;
+            }
+            half.push(1);
+            continue;
+        }
+        half.push(u8::from(s < 0.0));
+    }
+    let mut order: SmallVec<[usize; 8]> = (0..around.len()).collect();
+    let mut ok = true;
+    // Insertion sort by (half, angle within the half).
+    for i in 1..order.len() {
+        let mut k = i;
+        while k > 0 {
+            let (a, b) = (order[k - 1], order[k]);
+            let before = if half[a] != half[b] {
+                half[b] < half[a]
+            } else {
+                let s = p.cross(around[b].1).dot(around[a].1);
+                if s.abs() <= bound(around[a].1, around[b].1) {
+                    ok = false;
+                }
+                // b before a where a lies counter-clockwise of b.
+                s > 0.0
+            };
+            if !before {
+                break;
+            }
+            order.swap(k - 1, k);
+            k -= 1;
+        }
+    }
+    if !ok {
+        return false;
+    }
+    // Parenthesis matching from the lowest prefix sum.
+    let m = order.len();
+    let (mut sum, mut low, mut at) = (0i32, 0i32, 0usize);
+    for (i, &o) in order.iter().enumerate() {
+        sum += around[o].2;
+        if sum < low {
+            low = sum;
+            at = i + 1;
+        }
+    }
+    let mut open: SmallVec<[usize; 8]> = SmallVec::new();
+    for i in 0..m {
+        let o = order[(at + i) % m];
+        let (k, _, s) = around[o];
+        if s > 0 {
+            open.push(k);
+        } else {
+            let Some(leave) = open.pop() else {
+                return false;
+            };
+            if next[k] != u32::MAX {
+                return false;
+            }
+            next[k] = leave as u32;
+        }
+    }
+    open.is_empty()
+}
+
+/// `|v|_1`.
+#[inline]
+fn norm1(v: DVec3) -> f64 {
+    v.x.abs() + v.y.abs() + v.z.abs()
+}

@@ -1,0 +1,621 @@
+//! The visible part of a light as an overlay of rings in one gnomonic chart, resolved by the
+//! crossings of their edges and winding numbers carried along the rings (issue 17): the fast
+//! path's answer for closed mesh blockers and closed non-planar mesh lights.
+//!
+//! # What is computed
+//!
+//! Two families of closed rings in the chart (great circles are its lines): the light's `L`,
+//! whose winding number `w_L` about a point counts how often the light covers it (the light's
+//! region, or the contour of a mesh light's front faces: `w_L >= 1` on their union), and the
+//! blockers' `B`, whose winding `w_B` counts the blockers' front faces covering it (contours of
+//! closed meshes, see [`super::contour`]). The visible region is `V = {w_L >= 1 and w_B = 0}`.
+//! Its boundary is made of the pieces of edges (cut at every crossing with another edge) that
+//! have `V` on exactly one side, run with `V` on their left: the light's edges where no blocker
+//! covers them, the blockers' edges reversed where they cross the light's region uncovered
+//! behind.
+//!
+//! # How
+//!
+//! 1. The crossings of every pair of edges (candidates by a sweep over their `x` ranges, then
+//!    four orientation tests); consecutive edges, and edges meeting at a shared vertex (where
+//!    [`super::contour::chain_rings`] pairs them so that they do not cross), are not tested.
+//! 2. Winding numbers along each ring: at the first edge of each run of edges (a ring, or a
+//!    part of one between bridges, see below) both windings just right of the edge are counted
+//!    by a ray to infinity; along the run they change only at crossings, by one in the
+//!    crossing edge's family (its left side counts one more).
+//! 3. The pieces with `V` on one side only, linked into rings: at a vertex the boundary goes on
+//!    along the ring, at a crossing along the one other piece that keeps it (of the four pieces
+//!    meeting there exactly two bound `V` when `V` changes there: the windings of the four
+//!    sectors are `w`, `w + 1`, `w + 1`, `w + 2` in each family, and no two opposite sectors can
+//!    both be in `V`).
+//!
+//! Blocker rings enter clipped to a box of the chart around the light (Sutherland–Hodgman
+//! against the box's planes through the point, on direction vectors before projecting: the
+//! winding numbers inside the box are kept, outside they become 0). The parts of the rings
+//! along the box's sides (bridges) lie outside the light's region by a margin: they are never
+//! kept and never tested for crossings (they overlap along a side), but they count in the rays.
+//!
+//! # Exactness
+//!
+//! The projected points are taken as exact; every decision (the orientation tests, the order
+//! of two crossings along an edge, each ray's crossings) is an exact sign of an expression in
+//! them or is declined: it must clear its rounding bound (Shewchuk's error bound for the
+//! orientation, times 3), else the overlay returns `false` and the caller takes the general
+//! path. So the result is the exact overlay of the projected rings (up to the rounding of its
+//! crossing points), which differ from the true ones by the projection's rounding.
+
+use alloc::vec::Vec;
+
+use glam::{DVec2, DVec3};
+
+/// A vertex of an input ring: its chart position, its direction (for the output, any positive
+/// length), an identity (equal for the same mesh vertex), and whether the edge leaving it runs
+/// along a side of the clipping box.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RingPoint {
+    pub(crate) p: DVec2,
+    pub(crate) d: DVec3,
+    pub(crate) id: u64,
+    pub(crate) bridge: bool,
+}
+
+/// Which family a ring belongs to.
+pub(crate) const LIGHT: u8 = 0;
+pub(crate) const BLOCKER: u8 = 1;
+
+/// A crossing of edges `e` and `f` at parameters `te`, `tf` (with their rounding bounds).
+#[derive(Debug, Clone, Copy, Default)]
+struct Cross {
+    x: DVec2,
+    e: u32,
+    f: u32,
+    te: f64,
+    dte: f64,
+    tf: f64,
+    dtf: f64,
+    /// Sign of `(e's direction) x (f's direction)`.
+    s: i8,
+}
+
+/// A crossing seen from one of its edges, in that edge's order.
+#[derive(Debug, Clone, Copy, Default)]
+struct Slot {
+    t: f64,
+    dt: f64,
+    other: u32,
+    cross: u32,
+    /// Sign of `(this edge's direction) x (other's)`.
+    s: i8,
+    /// Index of the same crossing's slot on the other edge.
+    twin: u32,
+}
+
+/// Scratch storage and result of one overlay (reused across calls).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Overlay {
+    /// Input rings: ring `r` is `pts[ends[r - 1]..ends[r]]`, of family `family[r]`.
+    pub(crate) pts: Vec<RingPoint>,
+    pub(crate) ends: Vec<u32>,
+    pub(crate) family: Vec<u8>,
+    /// Per vertex: its ring.
+    ring_of: Vec<u32>,
+    bbox: Vec<[f64; 4]>,
+    order: Vec<u32>,
+    active: Vec<u32>,
+    cross: Vec<Cross>,
+    /// Per edge `e`: its crossings are `slots[xstart[e]..xstart[e + 1]]`, along it.
+    xstart: Vec<u32>,
+    slots: Vec<Slot>,
+    /// Per piece (`xstart[e] + e + j`, the `j`-th piece of edge `e`): 0, 1 kept forwards, 2
+    /// kept reversed; and visited by the walk.
+    kept: Vec<u8>,
+    seen: Vec<bool>,
+    /// Identities of the input vertices the result passes through.
+    out_ids: Vec<u64>,
+    /// Per edge, the next free slot while grouping (`sort_slots`); per crossing, its first slot.
+    fill: Vec<u32>,
+    first: Vec<u32>,
+    /// The result: rings of directions (see [`Overlay::resolve`]).
+    pub(crate) out: Vec<DVec3>,
+    pub(crate) out_ends: Vec<u32>,
+    /// The result's rings touch (a vertex used twice): not simple.
+    pub(crate) touching: bool,
+}
+
+/// Rounding bound factor of the orientation test: Shewchuk's `ccwerrboundA` is `3.33e-16`.
+const ORIENT_ERR: f64 = 1e-15;
+
+/// `orient2d(a, b, c)` (positive when `c` lies left of `a -> b`) and its rounding bound.
+#[inline(always)]
+fn orient(a: DVec2, b: DVec2, c: DVec2) -> (f64, f64) {
+    let (l, r) = ((a.x - c.x) * (b.y - c.y), (a.y - c.y) * (b.x - c.x));
+    (l - r, ORIENT_ERR * (l.abs() + r.abs()))
+}
+
+/// The sign of `v` as `-1` or `1` (`v` is not zero).
+#[inline(always)]
+fn sign(v: f64) -> i8 {
+    if v > 0.0 { 1 } else { -1 }
+}
+
+/// Whether the windings `w = (w_L, w_B)` are in the visible region.
+#[inline(always)]
+fn visible(w: [i32; 2]) -> bool {
+    w[0] >= 1 && w[1] == 0
+}
+
+impl Overlay {
+    /// Storage for about `n` input vertices (reserved once: the buffers then grow rarely).
+    pub(crate) fn with_capacity(n: usize) -> Self {
+        let mut o = Overlay::default();
+        o.pts.reserve(n);
+        o.ring_of.reserve(n);
+        o.bbox.reserve(n);
+        o.order.reserve(n);
+        o.active.reserve(n / 4);
+        o.xstart.reserve(n + 1);
+        o.fill.reserve(n);
+        o.kept.reserve(2 * n);
+        o.seen.reserve(2 * n);
+        o.out.reserve(n);
+        o.out_ids.reserve(n);
+        o
+    }
+
+    /// Empties the input.
+    pub(crate) fn clear(&mut self) {
+        self.pts.clear();
+        self.ends.clear();
+        self.family.clear();
+    }
+
+    /// Closes the ring started at `start` (of family `fam`); one of fewer than three vertices is
+    /// dropped.
+    pub(crate) fn close(&mut self, start: usize, fam: u8) {
+        if self.pts.len() - start >= 3 {
+            self.ends.push(self.pts.len() as u32);
+            self.family.push(fam);
+        } else {
+            self.pts.truncate(start);
+        }
+    }
+
+    #[inline(always)]
+    fn succ(&self, k: usize) -> usize {
+        let r = self.ring_of[k] as usize;
+        if k + 1 == self.ends[r] as usize {
+            if r == 0 { 0 } else { self.ends[r - 1] as usize }
+        } else {
+            k + 1
+        }
+    }
+
+    #[inline(always)]
+    fn pred(&self, k: usize) -> usize {
+        let r = self.ring_of[k] as usize;
+        let start = if r == 0 { 0 } else { self.ends[r - 1] as usize };
+        if k == start {
+            self.ends[r] as usize - 1
+        } else {
+            k - 1
+        }
+    }
+
+    #[inline(always)]
+    fn fam(&self, k: usize) -> usize {
+        self.family[self.ring_of[k] as usize] as usize
+    }
+
+    /// The visible region of the input rings into `out` / `out_ends` (directions: input
+    /// vertices by their `d`, crossings unprojected as `c + x u + y v` with `z` at least 0),
+    /// rings with the region on their left. `false` where a decision is within rounding (see
+    /// the module documentation) or the result does not link up.
+    pub(crate) fn resolve(&mut self, c: DVec3, u: DVec3, v: DVec3) -> bool {
+        self.out.clear();
+        self.out_ends.clear();
+        self.touching = false;
+        let n = self.pts.len();
+        self.ring_of.clear();
+        let mut start = 0usize;
+        for (r, &end) in self.ends.iter().enumerate() {
+            self.ring_of
+                .extend(core::iter::repeat_n(r as u32, end as usize - start));
+            start = end as usize;
+        }
+        if !self.crossings() {
+            return false;
+        }
+        if !self.sort_slots() {
+            return false;
+        }
+        self.kept.clear();
+        self.kept.resize(n + self.slots.len(), 0);
+        // Runs: whole rings without bridges, else the parts between bridges.
+        let mut start = 0usize;
+        for r in 0..self.ends.len() {
+            let end = self.ends[r] as usize;
+            let cyclic = !self.pts[start..end].iter().any(|p| p.bridge);
+            for k in start..end {
+                let first = if cyclic {
+                    k == start
+                } else {
+                    !self.pts[k].bridge && self.pts[self.pred(k)].bridge
+                };
+                if first && !self.propagate(k, cyclic) {
+                    return false;
+                }
+            }
+            start = end;
+        }
+        self.walk(c, u, v)
+    }
+
+    /// Step 1: every crossing of two non-bridge edges.
+    fn crossings(&mut self) -> bool {
+        let n = self.pts.len();
+        self.bbox.clear();
+        self.order.clear();
+        for k in 0..n {
+            let (a, b) = (self.pts[k].p, self.pts[self.succ(k)].p);
+            self.bbox
+                .push([a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y)]);
+            if !self.pts[k].bridge {
+                self.order.push(k as u32);
+            }
+        }
+        let bbox = &self.bbox;
+        self.order
+            .sort_unstable_by(|&a, &b| bbox[a as usize][0].total_cmp(&bbox[b as usize][0]));
+        self.active.clear();
+        self.cross.clear();
+        for i in 0..self.order.len() {
+            let e = self.order[i] as usize;
+            let be = self.bbox[e];
+            let bbox = &self.bbox;
+            self.active.retain(|&f| bbox[f as usize][1] >= be[0]);
+            for j in 0..self.active.len() {
+                let f = self.active[j] as usize;
+                let bf = self.bbox[f];
+                if bf[2] > be[3] || be[2] > bf[3] {
+                    continue;
+                }
+                if !self.test_pair(e, f) {
+                    return false;
+                }
+            }
+            self.active.push(e as u32);
+        }
+        true
+    }
+
+    /// Whether edges `e` and `f` cross (recorded) or not; `false` where that is within rounding
+    /// (touching, or an end within rounding of the other's line).
+    fn test_pair(&mut self, e: usize, f: usize) -> bool {
+        let (se, sf) = (self.succ(e), self.succ(f));
+        let (ie, je, i_f, jf) = (
+            self.pts[e].id,
+            self.pts[se].id,
+            self.pts[f].id,
+            self.pts[sf].id,
+        );
+        if ie == i_f || ie == jf || je == i_f || je == jf {
+            return true;
+        }
+        let (a, b, c, d) = (self.pts[e].p, self.pts[se].p, self.pts[f].p, self.pts[sf].p);
+        let (o1, b1) = orient(a, b, c);
+        let (o2, b2) = orient(a, b, d);
+        if o1.abs() <= b1 || o2.abs() <= b2 {
+            // An end of `f` within rounding of `e`'s line: only a problem where the segments
+            // may meet (their boxes overlap, tested by the caller; decided by `e`'s side).
+            let (o3, b3) = orient(c, d, a);
+            let (o4, b4) = orient(c, d, b);
+            if (o3 > b3 && o4 > b4) || (o3 < -b3 && o4 < -b4) {
+                return true;
+            }
+            return false;
+        }
+        if (o1 > 0.0) == (o2 > 0.0) {
+            return true;
+        }
+        let (o3, b3) = orient(c, d, a);
+        let (o4, b4) = orient(c, d, b);
+        if o3.abs() <= b3 || o4.abs() <= b4 {
+            return false;
+        }
+        if (o3 > 0.0) == (o4 > 0.0) {
+            return true;
+        }
+        let (de, df) = ((o3 - o4).abs(), (o1 - o2).abs());
+        let te = o3 / (o3 - o4);
+        let tf = o1 / (o1 - o2);
+        self.cross.push(Cross {
+            x: a + (b - a) * te,
+            e: e as u32,
+            f: f as u32,
+            te,
+            dte: 2.0 * (b3 + b4) / de + 4.0 * f64::EPSILON,
+            tf,
+            dtf: 2.0 * (b1 + b2) / df + 4.0 * f64::EPSILON,
+            // `(b - a) x (d - c) = o2 - o1`, of the sign of `o2`.
+            s: sign(o2),
+        });
+        true
+    }
+
+    /// Groups the crossings by edge, in order along each edge; `false` where two on one edge
+    /// are within rounding of each other.
+    fn sort_slots(&mut self) -> bool {
+        let n = self.pts.len();
+        self.xstart.clear();
+        self.xstart.resize(n + 1, 0);
+        for c in &self.cross {
+            self.xstart[c.e as usize + 1] += 1;
+            self.xstart[c.f as usize + 1] += 1;
+        }
+        for k in 0..n {
+            self.xstart[k + 1] += self.xstart[k];
+        }
+        self.slots.clear();
+        self.slots.resize(2 * self.cross.len(), Slot::default());
+        // Fill from the ends backwards, so that `xstart` is left as it was.
+        let fill = &mut self.fill;
+        fill.clear();
+        fill.extend_from_slice(&self.xstart[1..]);
+        for (ci, c) in self.cross.iter().enumerate().rev() {
+            let (e, f) = (c.e as usize, c.f as usize);
+            fill[e] -= 1;
+            self.slots[fill[e] as usize] = Slot {
+                t: c.te,
+                dt: c.dte,
+                other: c.f,
+                cross: ci as u32,
+                s: c.s,
+                twin: 0,
+            };
+            fill[f] -= 1;
+            self.slots[fill[f] as usize] = Slot {
+                t: c.tf,
+                dt: c.dtf,
+                other: c.e,
+                cross: ci as u32,
+                s: -c.s,
+                twin: 0,
+            };
+        }
+        for k in 0..n {
+            let g = &mut self.slots[self.xstart[k] as usize..self.xstart[k + 1] as usize];
+            // Insertion sort: a few crossings per edge.
+            for i in 1..g.len() {
+                let mut j = i;
+                while j > 0 && g[j].t < g[j - 1].t {
+                    g.swap(j - 1, j);
+                    j -= 1;
+                }
+            }
+            for i in 1..g.len() {
+                if g[i - 1].t + g[i - 1].dt >= g[i].t - g[i].dt {
+                    return false;
+                }
+            }
+        }
+        // Twins: the two slots of each crossing.
+        let first = &mut self.first;
+        first.clear();
+        first.resize(self.cross.len(), u32::MAX);
+        for i in 0..self.slots.len() {
+            let ci = self.slots[i].cross as usize;
+            if first[ci] == u32::MAX {
+                first[ci] = i as u32;
+            } else {
+                let j = first[ci] as usize;
+                self.slots[i].twin = j as u32;
+                self.slots[j].twin = i as u32;
+            }
+        }
+        true
+    }
+
+    /// The windings `(w_L, w_B)` of every edge but `skip` about `q`, by a ray from `q` along
+    /// `+x` (`along_x`) or `+y`; `None` where a crossing of the ray is within rounding of `q`.
+    fn ray(&self, q: DVec2, along_x: bool, skip: usize) -> Option<[i32; 2]> {
+        let mut w = [0i32; 2];
+        for k in 0..self.pts.len() {
+            if k == skip {
+                continue;
+            }
+            let bx = &self.bbox[k];
+            let (p0, p1) = (self.pts[k].p, self.pts[self.succ(k)].p);
+            let ahead_of = if along_x {
+                // Half-open in `y`: a vertex at `q.y` counts as above, for both its edges.
+                if (p0.y > q.y) == (p1.y > q.y) || bx[1] < q.x {
+                    continue;
+                }
+                |o: f64, p0: DVec2, p1: DVec2| (o > 0.0) == (p1.y > p0.y)
+            } else {
+                if (p0.x > q.x) == (p1.x > q.x) || bx[3] < q.y {
+                    continue;
+                }
+                |o: f64, p0: DVec2, p1: DVec2| (o < 0.0) == (p1.x > p0.x)
+            };
+            let (o, b) = orient(p0, p1, q);
+            if o.abs() <= b {
+                return None;
+            }
+            if ahead_of(o, p0, p1) {
+                w[self.fam(k)] += if o > 0.0 { 1 } else { -1 };
+            }
+        }
+        Some(w)
+    }
+
+    /// Step 2 for the run starting at edge `e0`: windings from a ray at the middle of its first
+    /// piece, carried along the run, each piece classified.
+    fn propagate(&mut self, e0: usize, cyclic: bool) -> bool {
+        let (s0, s1) = (self.xstart[e0] as usize, self.xstart[e0 + 1] as usize);
+        let t1 = if s1 > s0 {
+            self.slots[s0].t - self.slots[s0].dt
+        } else {
+            1.0
+        };
+        if !(t1 > 0.0) {
+            return false;
+        }
+        let (a, b) = (self.pts[e0].p, self.pts[self.succ(e0)].p);
+        let d = b - a;
+        let q = a + d * (0.5 * t1);
+        let along_x = d.y.abs() >= d.x.abs();
+        let Some(mut w) = self.ray(q, along_x, e0) else {
+            return false;
+        };
+        // The edge itself, for a point just to its right.
+        let own = if along_x { d.y < 0.0 } else { d.x > 0.0 };
+        if own {
+            w[self.fam(e0)] -= 1;
+        }
+        let w0 = w;
+        let mut e = e0;
+        loop {
+            let fam = self.fam(e);
+            let (s0, s1) = (self.xstart[e] as usize, self.xstart[e + 1] as usize);
+            for j in 0..=(s1 - s0) {
+                let mut left = w;
+                left[fam] += 1;
+                let (l, r) = (visible(left), visible(w));
+                self.kept[s0 + e + j] = if l && !r {
+                    1
+                } else if r && !l {
+                    2
+                } else {
+                    0
+                };
+                if j < s1 - s0 {
+                    let sl = self.slots[s0 + j];
+                    w[self.fam(sl.other as usize)] -= i32::from(sl.s);
+                }
+            }
+            e = self.succ(e);
+            if cyclic {
+                if e == e0 {
+                    break;
+                }
+            } else if self.pts[e].bridge {
+                break;
+            }
+        }
+        !cyclic || w == w0
+    }
+
+    /// Step 3: the kept pieces linked into rings.
+    fn walk(&mut self, c: DVec3, u: DVec3, v: DVec3) -> bool {
+        let n = self.pts.len();
+        self.seen.clear();
+        self.seen.resize(self.kept.len(), false);
+        self.out_ids.clear();
+        for e in 0..n {
+            let (s0, s1) = (self.xstart[e] as usize, self.xstart[e + 1] as usize);
+            for j in 0..=(s1 - s0) {
+                let id = s0 + e + j;
+                if self.kept[id] == 0 || self.seen[id] {
+                    continue;
+                }
+                let ring_start = self.out.len();
+                let (mut ce, mut cj, mut fwd) = (e, j, self.kept[id] == 1);
+                loop {
+                    let pid = self.xstart[ce] as usize + ce + cj;
+                    if self.seen[pid] {
+                        return false;
+                    }
+                    self.seen[pid] = true;
+                    let cnt = (self.xstart[ce + 1] - self.xstart[ce]) as usize;
+                    if fwd && cj == 0 {
+                        self.out_ids.push(self.pts[ce].id);
+                    } else if !fwd && cj == cnt {
+                        self.out_ids.push(self.pts[self.succ(ce)].id);
+                    }
+                    let p = self.start_point(ce, cj, fwd, c, u, v);
+                    self.out.push(p);
+                    let Some((ne, nj, nf)) = self.step(ce, cj, fwd) else {
+                        return false;
+                    };
+                    if (ne, nj) == (e, j) {
+                        break;
+                    }
+                    (ce, cj, fwd) = (ne, nj, nf);
+                }
+                if self.out.len() - ring_start >= 3 {
+                    self.out_ends.push(self.out.len() as u32);
+                } else {
+                    self.out.truncate(ring_start);
+                }
+            }
+        }
+        // A mesh vertex where the contour passes more than once (rings paired there by
+        // `chain_rings`) can be a vertex of the result more than once: its rings then touch
+        // (or one ring pinches), which the boundary tracing of `visibility/pieces.rs` does not
+        // take. Crossings cannot repeat (see the module documentation), nor can the light's
+        // own vertices (its rings are simple and disjoint, or a contour's mesh vertices).
+        self.out_ids.sort_unstable();
+        self.touching = self.out_ids.windows(2).any(|w| w[0] == w[1]);
+        true
+    }
+
+    /// The direction where the `j`-th piece of edge `e` starts, as run (`fwd`) or reversed.
+    fn start_point(&self, e: usize, j: usize, fwd: bool, c: DVec3, u: DVec3, v: DVec3) -> DVec3 {
+        let (s0, s1) = (self.xstart[e] as usize, self.xstart[e + 1] as usize);
+        let cnt = s1 - s0;
+        let slot = if fwd {
+            if j == 0 {
+                return self.pts[e].d;
+            }
+            s0 + j - 1
+        } else {
+            if j == cnt {
+                return self.pts[self.succ(e)].d;
+            }
+            s0 + j
+        };
+        let x = self.cross[self.slots[slot].cross as usize].x;
+        let d = c + u * x.x + v * x.y;
+        DVec3::new(d.x, d.y, d.z.max(0.0))
+    }
+
+    /// The kept piece after the `j`-th piece of edge `e` (as run, `fwd`, or reversed) along the
+    /// boundary; `None` where there is not exactly one.
+    fn step(&self, e: usize, j: usize, fwd: bool) -> Option<(usize, usize, bool)> {
+        let (s0, s1) = (self.xstart[e] as usize, self.xstart[e + 1] as usize);
+        let cnt = s1 - s0;
+        let kept = |e: usize, j: usize| self.kept[self.xstart[e] as usize + e + j];
+        let slot = if fwd {
+            if j == cnt {
+                let e2 = self.succ(e);
+                return (kept(e2, 0) == 1).then_some((e2, 0, true));
+            }
+            s0 + j
+        } else {
+            if j == 0 {
+                let e2 = self.pred(e);
+                let c2 = (self.xstart[e2 + 1] - self.xstart[e2]) as usize;
+                return (kept(e2, c2) == 2).then_some((e2, c2, false));
+            }
+            s0 + j - 1
+        };
+        // At a crossing: the one other piece that leaves it.
+        let sl = self.slots[slot];
+        let f = sl.other as usize;
+        let jf = sl.twin as usize - self.xstart[f] as usize;
+        let mut found = None;
+        let mut count = 0;
+        let straight = if fwd {
+            (e, j + 1, 1u8)
+        } else {
+            (e, j - 1, 2u8)
+        };
+        for (pe, pj, want) in [straight, (f, jf + 1, 1u8), (f, jf, 2u8)] {
+            if kept(pe, pj) == want {
+                count += 1;
+                found = Some((pe, pj, want == 1));
+            }
+        }
+        if count == 1 { found } else { None }
+    }
+}
