@@ -94,8 +94,9 @@ pub(crate) enum Node {
     Visible,
     /// A class of lines that stab an occluder.
     Invisible,
-    /// A class not yet decided, with the occluders that may block some of its lines.
-    Undefined(Vec<u32>),
+    /// A class not yet decided, with the occluders that may block some of its lines: `len`
+    /// ids from `start` in the tree's list pool.
+    Undefined { start: u32, len: u32 },
 }
 
 /// Counters of one tree's growth.
@@ -106,6 +107,9 @@ pub struct TreeCounters {
     /// Orientation tests of an occluder's vertex-to-vertex lines against a node (Alg. 1 lines
     /// 6-13).
     pub insertion_tests: u64,
+    /// Fragments found visible at an undefined leaf, without developing it, because no
+    /// occluder of its list can hide any of their lines from the query point.
+    pub shortcuts: u64,
 }
 
 /// The lazily built tree of one light polygon and one set of occluders.
@@ -119,8 +123,13 @@ pub(crate) struct Tree {
     cell: SmallVec<[DVec3; 4]>,
     occluders: Vec<Occluder>,
     nodes: Vec<Node>,
-    /// Occluder ids held by undefined leaves.
-    listed: usize,
+    /// The lists of the undefined leaves, each a range written once (an expanded leaf's range
+    /// becomes garbage until [`Tree::compact`]).
+    lists: Vec<u32>,
+    /// Ids in `lists` that no leaf refers to any more.
+    garbage: usize,
+    /// Scratch stack of the insertion: the lists on their way down (`insert`).
+    work: Vec<u32>,
     rng: u64,
     peak_bytes: usize,
     pub(crate) counters: TreeCounters,
@@ -140,7 +149,9 @@ impl Tree {
             cell: cell.iter().copied().collect(),
             occluders,
             nodes: Vec::new(),
-            listed: 0,
+            lists: Vec::new(),
+            garbage: 0,
+            work: Vec::new(),
             rng: seed | 1,
             peak_bytes: 0,
             counters: TreeCounters::default(),
@@ -154,12 +165,14 @@ impl Tree {
     pub(crate) fn reset(&mut self) {
         self.nodes.clear();
         self.nodes.push(Node::Invisible);
-        let all: Vec<u32> = (0..self.occluders.len() as u32).collect();
-        self.listed = all.len();
-        self.nodes.push(if all.is_empty() {
+        self.lists.clear();
+        self.garbage = 0;
+        let n = self.occluders.len() as u32;
+        self.lists.extend(0..n);
+        self.nodes.push(if n == 0 {
             Node::Visible
         } else {
-            Node::Undefined(all)
+            Node::Undefined { start: 0, len: n }
         });
         self.note_size();
     }
@@ -189,12 +202,36 @@ impl Tree {
         self.nodes.len()
     }
 
-    /// The memory the tree holds, in bytes (nodes, leaf lists, occluders; allocator slack not
-    /// counted).
+    /// The memory the tree holds, in bytes (nodes, the list pool with its garbage, occluders;
+    /// allocator slack not counted).
     pub(crate) fn bytes(&self) -> usize {
         self.nodes.len() * size_of::<Node>()
-            + self.listed * size_of::<u32>()
+            + self.lists.len() * size_of::<u32>()
             + self.occluders.len() * size_of::<Occluder>()
+    }
+
+    /// The list of the undefined leaf `(start, len)`.
+    #[inline]
+    pub(crate) fn list(&self, start: u32, len: u32) -> &[u32] {
+        &self.lists[start as usize..(start + len) as usize]
+    }
+
+    /// Rewrites the list pool with the live lists only, once garbage is most of it: the pool
+    /// then stays within twice the lists the leaves hold.
+    fn compact(&mut self) {
+        if self.garbage < 4096 || 2 * self.garbage < self.lists.len() {
+            return;
+        }
+        let mut fresh = Vec::with_capacity(self.lists.len() - self.garbage);
+        for node in &mut self.nodes {
+            if let Node::Undefined { start, len } = node {
+                let s = *start as usize;
+                *start = fresh.len() as u32;
+                fresh.extend_from_slice(&self.lists[s..s + *len as usize]);
+            }
+        }
+        self.lists = fresh;
+        self.garbage = 0;
     }
 
     /// The largest [`Tree::bytes`] so far.
@@ -206,38 +243,39 @@ impl Tree {
         self.peak_bytes = self.peak_bytes.max(self.bytes());
     }
 
+    /// Develops the undefined leaf `n` (Alg. 1 lines 31-35) with the occluder `ro` of its
+    /// list: `ro` replaces the leaf by its own classes (`bsp(ro)`, [`Tree::merge`]), and the
+    /// others are inserted into them ([`Tree::insert`]). `n` becomes the root of `bsp(ro)`.
+    pub(crate) fn expand_with(&mut self, n: u32, ro: u32) {
+        let Node::Undefined { start, len } = self.nodes[n as usize] else {
+            return;
+        };
+        let base = self.work.len();
+        let (s, e) = (start as usize, (start + len) as usize);
+        self.work
+            .extend(self.lists[s..e].iter().copied().filter(|&o| o != ro));
+        self.garbage += len as usize;
+        self.nodes[n as usize] = Node::Visible;
+        self.merge(n, ro);
+        self.counters.merges += 1;
+        let end = self.work.len();
+        if end > base {
+            self.insert(n, base, end);
+        }
+        self.work.truncate(base);
+        self.note_size();
+        self.compact();
+    }
+
     /// A pseudo-random index below `n` (xorshift64): the occluder merged at a leaf is chosen at
     /// random (seed 002 section 4.3, as the pivot of quicksort).
-    fn pick(&mut self, n: usize) -> usize {
+    pub(crate) fn pick(&mut self, n: usize) -> usize {
         let mut x = self.rng;
         x ^= x << 13;
         x ^= x >> 7;
         x ^= x << 17;
         self.rng = x;
         ((x >> 11) % n as u64) as usize
-    }
-
-    /// Develops the undefined leaf `n` (Alg. 1 lines 31-35): a random occluder `ro` of its list
-    /// replaces the leaf by its own classes (`bsp(ro)`, [`Tree::merge`]), and the others are
-    /// inserted into them ([`Tree::insert`]). `n` becomes the root of `bsp(ro)`.
-    pub(crate) fn expand(&mut self, n: u32) {
-        let Node::Undefined(mut list) =
-            core::mem::replace(&mut self.nodes[n as usize], Node::Visible)
-        else {
-            return;
-        };
-        self.listed -= list.len();
-        if list.is_empty() {
-            return;
-        }
-        let k = self.pick(list.len());
-        let ro = list.swap_remove(k);
-        self.merge(n, ro);
-        self.counters.merges += 1;
-        if !list.is_empty() {
-            self.insert(n, list);
-        }
-        self.note_size();
     }
 
     /// Writes `bsp(o)` (seed 002 Fig. 4) with its root at node `at`: a chain over the occluder's
@@ -302,25 +340,40 @@ impl Tree {
         (self.nodes.len() - 1) as u32
     }
 
-    /// Inserts `list` into the subtree at `n` (Alg. 1 lines 1-13): at an inner node, by the
-    /// orientation of each occluder's vertex-to-vertex lines (Theorem 1,
+    /// Inserts the list `work[lo..hi]` into the subtree at `n` (Alg. 1 lines 1-13): at an inner
+    /// node, by the orientation of each occluder's vertex-to-vertex lines (Theorem 1,
     /// [`Tree::orientation`]): strictly positive to `pos`, strictly negative to `neg`, anything
     /// else to both (conservative). At a leaf: a visible class becomes undefined with the list,
     /// an undefined one adds it, an invisible one ignores it.
-    fn insert(&mut self, n: u32, list: Vec<u32>) {
-        let (occ, edge, pos, neg) = match &mut self.nodes[n as usize] {
+    ///
+    /// The list is partitioned in place into positive, both and negative ids; the negative
+    /// child's part (both and negative) is copied to the top of `work` before the positive
+    /// child's part is inserted in place, so the lists need no allocation of their own.
+    fn insert(&mut self, n: u32, lo: usize, hi: usize) {
+        let (occ, edge, pos, neg) = match self.nodes[n as usize] {
             Node::Invisible => return,
-            Node::Undefined(l) => {
-                l.extend_from_slice(&list);
-                self.listed += list.len();
+            Node::Undefined { start, len } => {
+                let s = start as usize;
+                let at = self.lists.len();
+                self.lists.extend_from_within(s..s + len as usize);
+                self.lists.extend_from_slice(&self.work[lo..hi]);
+                self.garbage += len as usize;
+                self.nodes[n as usize] = Node::Undefined {
+                    start: at as u32,
+                    len: (self.lists.len() - at) as u32,
+                };
                 return;
             }
             Node::Visible => {
-                self.listed += list.len();
-                self.nodes[n as usize] = Node::Undefined(list);
+                let at = self.lists.len();
+                self.lists.extend_from_slice(&self.work[lo..hi]);
+                self.nodes[n as usize] = Node::Undefined {
+                    start: at as u32,
+                    len: (hi - lo) as u32,
+                };
                 return;
             }
-            &mut Node::Inner {
+            Node::Inner {
                 occ,
                 edge,
                 pos,
@@ -339,29 +392,40 @@ impl Tree {
             .iter()
             .map(|&c| Orienter::new(ha, hb, c))
             .collect();
-        let (mut to_pos, mut to_neg) = (Vec::new(), Vec::new());
-        for &o in &list {
+        // Three-way partition: [lo, p) positive, [p, q) both, [q, hi) negative.
+        let (mut p, mut i, mut q) = (lo, lo, hi);
+        while i < q {
+            let o = self.work[i];
             let side = match self.orientation(o, &from_cell, false) {
                 Sign::Zero => self.orientation(o, &from_light, true),
                 strict => strict,
             };
             match side {
-                Sign::Positive => to_pos.push(o),
-                Sign::Negative => to_neg.push(o),
-                Sign::Zero => {
-                    to_pos.push(o);
-                    to_neg.push(o);
+                Sign::Positive => {
+                    self.work.swap(p, i);
+                    p += 1;
+                    i += 1;
+                }
+                Sign::Zero => i += 1,
+                Sign::Negative => {
+                    q -= 1;
+                    self.work.swap(i, q);
                 }
             }
         }
-        self.counters.insertion_tests += list.len() as u64;
-        drop(list);
-        if !to_pos.is_empty() {
-            self.insert(pos, to_pos);
+        self.counters.insertion_tests += (hi - lo) as u64;
+        let top = self.work.len();
+        if hi > p {
+            self.work.extend_from_within(p..hi);
         }
-        if !to_neg.is_empty() {
-            self.insert(neg, to_neg);
+        if q > lo {
+            self.insert(pos, lo, q);
         }
+        let end = self.work.len();
+        if end > top {
+            self.insert(neg, top, end);
+        }
+        self.work.truncate(top);
     }
 
     /// The orientation of the lines occluder `o` blocks, relative to a node's line, bounded by

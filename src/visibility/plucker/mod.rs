@@ -487,6 +487,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             stats.note_tree(tree);
             stats.merges += tree.counters.merges - before.merges;
             stats.insertion_tests += tree.counters.insertion_tests - before.insertion_tests;
+            stats.shortcuts += tree.counters.shortcuts - before.shortcuts;
             before = tree.counters;
             match result {
                 Ok(()) => break,
@@ -806,6 +807,9 @@ pub struct PluckerStats {
     pub merges: u64,
     /// Orientation tests of insertion, over all trees (Alg. 1 lines 6-13).
     pub insertion_tests: u64,
+    /// Fragments found visible at an undefined leaf without developing it, over all trees
+    /// (no occluder of the leaf can hide them from the query point).
+    pub shortcuts: u64,
 }
 
 impl PluckerStats {

@@ -251,8 +251,17 @@ pub(crate) fn query(
                     break;
                 }
                 Node::Invisible => break,
-                Node::Undefined(_) => {
-                    tree.expand(n);
+                Node::Undefined { start, len: listed } => {
+                    let frag = &pool[s as usize..(s + len) as usize];
+                    let Some(ro) = relevant_occluder(tree, x, frag, start, listed) else {
+                        // No occluder of the class can hide any line from the point through
+                        // the fragment: it is visible from this point, whatever the class
+                        // holds for other points of the tile.
+                        tree.counters.shortcuts += 1;
+                        out.push(frag.iter().copied().collect());
+                        break;
+                    };
+                    tree.expand_with(n, ro);
                     if tree.bytes() > cap {
                         return Err(CapExceeded);
                     }
@@ -261,6 +270,91 @@ pub(crate) fn query(
         }
     }
     Ok(())
+}
+
+/// An occluder of the undefined leaf's list (`len` ids from `start`) that may hide some line
+/// from the point `x` (tree coordinates) through the convex fragment `frag` (relative to `x`),
+/// found from a pseudo-random place in the list; `None` when a plane through `x` certifiably
+/// separates every occluder of the list from the fragment, so that the fragment is visible
+/// from `x`.
+///
+/// The leaf's list holds every occluder that may block a line of its class (seed 002 Alg. 1:
+/// insertion only leaves out occluders whose blocked lines are strictly on the other side of
+/// an ancestor's line), and the fragment's lines from `x` are in the class. Seed 002 merges a
+/// random occluder of the list; the list is conservative for the whole tile and for the whole
+/// class, so most of its occluders miss the lines of one point's fragment, and merging them
+/// splits the fragment by planes that change nothing. Merging only an occluder that may block
+/// the fragment develops the tree where the query needs it, and a fragment that none may block
+/// needs no development at all. A separating plane is one through `x` and an edge of the
+/// fragment or of the occluder (two convex cones with a common apex are disjoint iff such a
+/// plane separates them), accepted only when the filter certifies every sign strictly, so a
+/// doubtful occluder counts as one that may block.
+fn relevant_occluder(
+    tree: &mut Tree,
+    x: DVec3,
+    frag: &[DVec3],
+    start: u32,
+    len: u32,
+) -> Option<u32> {
+    let k = frag.len();
+    let c = frag.iter().copied().sum::<DVec3>() / k as f64;
+    let mut planes: SmallVec<[Orienter; 8]> = SmallVec::new();
+    let mut inside = None;
+    for i in 0..k {
+        let or = Orienter::new(frag[i], frag[(i + 1) % k], DVec3::ZERO);
+        let side = or.strict_sign(c);
+        if side.is_none() || (inside.is_some() && inside != side) {
+            // The fragment's cone is degenerate within rounding: no plane of it is trusted.
+            inside = None;
+            planes.clear();
+            break;
+        }
+        inside = side;
+        planes.push(or);
+    }
+    let outside = inside.map(Sign::flip);
+    let first = tree.pick(len as usize);
+    for step in 0..len as usize {
+        let i = (first + step) % len as usize;
+        let o = tree.list(start, len)[i];
+        if !separated(tree.occluder(o).vertices(), x, frag, &planes, outside) {
+            return Some(o);
+        }
+    }
+    None
+}
+
+/// Whether a plane through the origin (the point) strictly separates the occluder with
+/// vertices `verts - x` from the fragment `frag`: one of the fragment's edge planes `planes`
+/// (with the side `outside` away from the fragment), or one through an edge of the occluder.
+fn separated(
+    verts: &[DVec3],
+    x: DVec3,
+    frag: &[DVec3],
+    planes: &[Orienter],
+    outside: Option<Sign>,
+) -> bool {
+    let mut v: SmallVec<[DVec3; 5]> = SmallVec::new();
+    v.extend(verts.iter().map(|&b| b - x));
+    if let Some(out) = outside {
+        for pl in planes {
+            if v.iter().all(|&p| pl.strict_sign(p) == Some(out)) {
+                return true;
+            }
+        }
+    }
+    let m = v.len();
+    for j in 0..m {
+        let or = Orienter::new(v[j], v[(j + 1) % m], DVec3::ZERO);
+        let Some(inner) = or.strict_sign(v[(j + 2) % m]) else {
+            continue;
+        };
+        let away = Some(inner.flip());
+        if frag.iter().all(|&e| or.strict_sign(e) == away) {
+            return true;
+        }
+    }
+    false
 }
 
 /// Corners of a fragment's spherical polygon closer than this (chord length) are merged before
