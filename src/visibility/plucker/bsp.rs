@@ -83,12 +83,18 @@ pub(crate) enum Node {
     /// to `pos`, negative to `neg`; lines with side zero (all of a fragment, which happens only
     /// when the shading point lies on the edge's line) go to `pos` when `zero_pos`, else `neg`:
     /// always the child where that edge does not close the occluder's invisible class.
+    ///
+    /// `pending` occluder ids (`len` from `start` in the list pool) are still to be inserted
+    /// below the node: insertion is deferred until a query passes the node
+    /// ([`Tree::push_down`]).
     Inner {
         occ: u32,
         edge: u8,
         pos: u32,
         neg: u32,
         zero_pos: bool,
+        pending_start: u32,
+        pending_len: u32,
     },
     /// A class of lines that stab no occluder.
     Visible,
@@ -128,36 +134,99 @@ pub(crate) struct Tree {
     lists: Vec<u32>,
     /// Ids in `lists` that no leaf refers to any more.
     garbage: usize,
-    /// Scratch stack of the insertion: the lists on their way down (`insert`).
+    /// Scratch of the insertion: a list on its way down ([`Tree::push_down`]).
     work: Vec<u32>,
+    /// The other buffer of [`Tree::compact`].
+    spare: Vec<u32>,
     rng: u64,
     peak_bytes: usize,
     pub(crate) counters: TreeCounters,
 }
 
+/// The allocations of a tree, kept by a caller that builds one tree after another (the
+/// per-call path): [`Tree::with_buffers`] takes them, [`Tree::into_buffers`] gives them back.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TreeBuffers {
+    pub(crate) occluders: Vec<Occluder>,
+    nodes: Vec<Node>,
+    lists: Vec<u32>,
+    work: Vec<u32>,
+    spare: Vec<u32>,
+}
+
 impl Tree {
     /// The tree of a single undefined leaf holding every occluder (Alg. 2 line 8), for query
     /// lines from the convex hull of `cell` through the convex hull of `light`.
+    #[cfg(test)]
     pub(crate) fn new(
         cell: &[DVec3],
         light: &[DVec3],
         occluders: Vec<Occluder>,
         seed: u64,
     ) -> Tree {
+        Tree::with_buffers(
+            cell,
+            light,
+            TreeBuffers {
+                occluders,
+                ..TreeBuffers::default()
+            },
+            seed,
+        )
+    }
+
+    /// [`Tree::new`] with the occluders in `bufs` and its other allocations reused.
+    pub(crate) fn with_buffers(
+        cell: &[DVec3],
+        light: &[DVec3],
+        bufs: TreeBuffers,
+        seed: u64,
+    ) -> Tree {
+        let TreeBuffers {
+            occluders,
+            nodes,
+            lists,
+            mut work,
+            spare,
+        } = bufs;
+        work.clear();
         let mut t = Tree {
             light: light.iter().copied().collect(),
             cell: cell.iter().copied().collect(),
             occluders,
-            nodes: Vec::new(),
-            lists: Vec::new(),
+            nodes,
+            lists,
             garbage: 0,
-            work: Vec::new(),
+            work,
+            spare,
             rng: seed | 1,
             peak_bytes: 0,
             counters: TreeCounters::default(),
         };
         t.reset();
         t
+    }
+
+    /// The tree's allocations, emptied, for the next [`Tree::with_buffers`].
+    pub(crate) fn into_buffers(self) -> TreeBuffers {
+        let Tree {
+            mut occluders,
+            mut nodes,
+            mut lists,
+            work,
+            spare,
+            ..
+        } = self;
+        occluders.clear();
+        nodes.clear();
+        lists.clear();
+        TreeBuffers {
+            occluders,
+            nodes,
+            lists,
+            work,
+            spare,
+        }
     }
 
     /// Back to the root leaf with every occluder (the fallback when the tree outgrows its cap,
@@ -202,11 +271,11 @@ impl Tree {
         self.nodes.len()
     }
 
-    /// The memory the tree holds, in bytes (nodes, the list pool with its garbage, occluders;
-    /// allocator slack not counted).
+    /// The memory the tree holds, in bytes (nodes, the list pool with its garbage and the
+    /// compaction's other buffer, occluders; other allocator slack not counted).
     pub(crate) fn bytes(&self) -> usize {
         self.nodes.len() * size_of::<Node>()
-            + self.lists.len() * size_of::<u32>()
+            + (self.lists.len() + self.spare.capacity()) * size_of::<u32>()
             + self.occluders.len() * size_of::<Occluder>()
     }
 
@@ -222,15 +291,22 @@ impl Tree {
         if self.garbage < 4096 || 2 * self.garbage < self.lists.len() {
             return;
         }
-        let mut fresh = Vec::with_capacity(self.lists.len() - self.garbage);
+        let mut fresh = core::mem::take(&mut self.spare);
+        fresh.clear();
         for node in &mut self.nodes {
-            if let Node::Undefined { start, len } = node {
+            if let Node::Undefined { start, len }
+            | Node::Inner {
+                pending_start: start,
+                pending_len: len,
+                ..
+            } = node
+            {
                 let s = *start as usize;
                 *start = fresh.len() as u32;
                 fresh.extend_from_slice(&self.lists[s..s + *len as usize]);
             }
         }
-        self.lists = fresh;
+        self.spare = core::mem::replace(&mut self.lists, fresh);
         self.garbage = 0;
     }
 
@@ -260,11 +336,120 @@ impl Tree {
         self.counters.merges += 1;
         let end = self.work.len();
         if end > base {
-            self.insert(n, base, end);
+            self.give(n, base, end);
         }
         self.work.truncate(base);
         self.note_size();
         self.compact();
+    }
+
+    /// Inserts the pending list of the inner node `n` one level down (Alg. 1 lines 6-13, one
+    /// node at a time): by the orientation of each occluder's vertex-to-vertex lines (Theorem 1,
+    /// [`Tree::orientation`]), strictly positive to `pos`, strictly negative to `neg`, anything
+    /// else to both (conservative); each child adds its part to its own list ([`Tree::give`]).
+    ///
+    /// Seed 002 inserts the other occluders of a developed leaf through the whole of
+    /// `bsp(ro)` at once; here a node's occluders wait until a query passes it, so the exits of
+    /// `bsp(ro)` that no query reaches, and the nodes below them, are never classified. The
+    /// query pushes every node it passes, so the leaf it reaches holds every occluder that may
+    /// block its class.
+    pub(crate) fn push_down(&mut self, n: u32) {
+        let Node::Inner {
+            occ,
+            edge,
+            pos,
+            neg,
+            pending_start,
+            pending_len,
+            ..
+        } = &mut self.nodes[n as usize]
+        else {
+            return;
+        };
+        if *pending_len == 0 {
+            return;
+        }
+        let (occ, edge, pos, neg) = (*occ, *edge, *pos, *neg);
+        let (s, len) = (*pending_start as usize, *pending_len as usize);
+        *pending_len = 0;
+        self.garbage += len;
+        let lo = self.work.len();
+        self.work.extend_from_slice(&self.lists[s..s + len]);
+        let hi = self.work.len();
+        let (ha, hb) = self.occluders[occ as usize].edge(edge);
+        let from_light: SmallVec<[Orienter; 8]> = self
+            .light
+            .iter()
+            .map(|&a| Orienter::new(ha, hb, a))
+            .collect();
+        let from_cell: SmallVec<[Orienter; 4]> = self
+            .cell
+            .iter()
+            .map(|&c| Orienter::new(ha, hb, c))
+            .collect();
+        // Three-way partition: [lo, p) positive, [p, q) both, [q, hi) negative.
+        let (mut p, mut i, mut q) = (lo, lo, hi);
+        while i < q {
+            let o = self.work[i];
+            let side = match self.orientation(o, &from_cell, false) {
+                Sign::Zero => self.orientation(o, &from_light, true),
+                strict => strict,
+            };
+            match side {
+                Sign::Positive => {
+                    self.work.swap(p, i);
+                    p += 1;
+                    i += 1;
+                }
+                Sign::Zero => i += 1,
+                Sign::Negative => {
+                    q -= 1;
+                    self.work.swap(i, q);
+                }
+            }
+        }
+        self.counters.insertion_tests += len as u64;
+        if q > lo {
+            self.give(pos, lo, q);
+        }
+        if hi > p {
+            self.give(neg, p, hi);
+        }
+        self.work.truncate(lo);
+        self.note_size();
+        self.compact();
+    }
+
+    /// Adds the ids `work[lo..hi]` to what node `n` holds: an invisible class ignores them, a
+    /// visible one becomes undefined with them, an undefined leaf or an inner node's pending
+    /// list is rewritten with them at the end of the pool.
+    fn give(&mut self, n: u32, lo: usize, hi: usize) {
+        let at = self.lists.len() as u32;
+        let (start, len) = match &mut self.nodes[n as usize] {
+            Node::Invisible => return,
+            Node::Visible => {
+                self.nodes[n as usize] = Node::Undefined {
+                    start: at,
+                    len: (hi - lo) as u32,
+                };
+                self.lists.extend_from_slice(&self.work[lo..hi]);
+                return;
+            }
+            Node::Undefined { start, len }
+            | Node::Inner {
+                pending_start: start,
+                pending_len: len,
+                ..
+            } => {
+                let old = (*start as usize, *len as usize);
+                *start = at;
+                *len += (hi - lo) as u32;
+                old
+            }
+        };
+        self.lists.extend_from_within(start..start + len);
+        self.lists.extend_from_slice(&self.work[lo..hi]);
+        self.garbage += len;
     }
 
     /// A pseudo-random index below `n` (xorshift64): the occluder merged at a leaf is chosen at
@@ -303,6 +488,8 @@ impl Tree {
                     pos: p,
                     neg: m,
                     zero_pos: false,
+                    pending_start: 0,
+                    pending_len: 0,
                 };
                 self.chain(p, o, (1..k).collect(), true);
                 let mut edges: SmallVec<[u8; 8]> = (1..k).collect();
@@ -330,6 +517,8 @@ impl Tree {
                 pos,
                 neg,
                 zero_pos: !positive,
+                pending_start: 0,
+                pending_len: 0,
             };
             at = next;
         }
@@ -338,94 +527,6 @@ impl Tree {
     fn push(&mut self, node: Node) -> u32 {
         self.nodes.push(node);
         (self.nodes.len() - 1) as u32
-    }
-
-    /// Inserts the list `work[lo..hi]` into the subtree at `n` (Alg. 1 lines 1-13): at an inner
-    /// node, by the orientation of each occluder's vertex-to-vertex lines (Theorem 1,
-    /// [`Tree::orientation`]): strictly positive to `pos`, strictly negative to `neg`, anything
-    /// else to both (conservative). At a leaf: a visible class becomes undefined with the list,
-    /// an undefined one adds it, an invisible one ignores it.
-    ///
-    /// The list is partitioned in place into positive, both and negative ids; the negative
-    /// child's part (both and negative) is copied to the top of `work` before the positive
-    /// child's part is inserted in place, so the lists need no allocation of their own.
-    fn insert(&mut self, n: u32, lo: usize, hi: usize) {
-        let (occ, edge, pos, neg) = match self.nodes[n as usize] {
-            Node::Invisible => return,
-            Node::Undefined { start, len } => {
-                let s = start as usize;
-                let at = self.lists.len();
-                self.lists.extend_from_within(s..s + len as usize);
-                self.lists.extend_from_slice(&self.work[lo..hi]);
-                self.garbage += len as usize;
-                self.nodes[n as usize] = Node::Undefined {
-                    start: at as u32,
-                    len: (self.lists.len() - at) as u32,
-                };
-                return;
-            }
-            Node::Visible => {
-                let at = self.lists.len();
-                self.lists.extend_from_slice(&self.work[lo..hi]);
-                self.nodes[n as usize] = Node::Undefined {
-                    start: at as u32,
-                    len: (hi - lo) as u32,
-                };
-                return;
-            }
-            Node::Inner {
-                occ,
-                edge,
-                pos,
-                neg,
-                ..
-            } => (occ, edge, pos, neg),
-        };
-        let (ha, hb) = self.occluders[occ as usize].edge(edge);
-        let from_light: SmallVec<[Orienter; 8]> = self
-            .light
-            .iter()
-            .map(|&a| Orienter::new(ha, hb, a))
-            .collect();
-        let from_cell: SmallVec<[Orienter; 4]> = self
-            .cell
-            .iter()
-            .map(|&c| Orienter::new(ha, hb, c))
-            .collect();
-        // Three-way partition: [lo, p) positive, [p, q) both, [q, hi) negative.
-        let (mut p, mut i, mut q) = (lo, lo, hi);
-        while i < q {
-            let o = self.work[i];
-            let side = match self.orientation(o, &from_cell, false) {
-                Sign::Zero => self.orientation(o, &from_light, true),
-                strict => strict,
-            };
-            match side {
-                Sign::Positive => {
-                    self.work.swap(p, i);
-                    p += 1;
-                    i += 1;
-                }
-                Sign::Zero => i += 1,
-                Sign::Negative => {
-                    q -= 1;
-                    self.work.swap(i, q);
-                }
-            }
-        }
-        self.counters.insertion_tests += (hi - lo) as u64;
-        let top = self.work.len();
-        if hi > p {
-            self.work.extend_from_within(p..hi);
-        }
-        if q > lo {
-            self.insert(pos, lo, q);
-        }
-        let end = self.work.len();
-        if end > top {
-            self.insert(neg, top, end);
-        }
-        self.work.truncate(top);
     }
 
     /// The orientation of the lines occluder `o` blocks, relative to a node's line, bounded by

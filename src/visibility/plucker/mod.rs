@@ -447,6 +447,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 &tile.geom,
                 seed,
                 &mut ws.cull,
+                bsp::TreeBuffers::default(),
             ) {
                 Some(t) => {
                     stats.trees_built += 1;
@@ -534,6 +535,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             &geom,
             0x2545_f491_4f6c_dd1d,
             &mut ws.cull,
+            core::mem::take(&mut ws.tree),
         ) else {
             return Ok(Status::Done);
         };
@@ -554,6 +556,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 return Ok(Status::TooBig);
             }
         }
+        ws.tree = tree.into_buffers();
         for frag in &ws.frags {
             push_piece(out, frag, DVec3::ZERO, frame)?;
         }
@@ -825,6 +828,8 @@ struct Workspace {
     scratch: Scratch,
     frags: Vec<Fragment>,
     cull: Vec<u32>,
+    /// The allocations of the last per-point tree.
+    tree: bsp::TreeBuffers,
 }
 
 #[derive(Debug, Clone)]
