@@ -139,6 +139,10 @@ pub(crate) struct Tree {
     /// The other buffer of [`Tree::compact`].
     spare: Vec<u32>,
     rng: u64,
+    /// At least `|p - c|` in each coordinate, after rounding, for every occluder vertex `p`
+    /// and every cell or light corner `c`: the reach of the insertion's sign filter
+    /// ([`Orienter::reach_bound`]).
+    reach: f64,
     peak_bytes: usize,
     pub(crate) counters: TreeCounters,
 }
@@ -200,9 +204,23 @@ impl Tree {
             work,
             spare,
             rng: seed | 1,
+            reach: 0.0,
             peak_bytes: 0,
             counters: TreeCounters::default(),
         };
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        let occ = t.occluders.iter().flat_map(|o| o.vertices().iter());
+        for &p in t.cell.iter().chain(t.light.iter()).chain(occ) {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        // A difference of two coordinates in [lo, hi] is at most their span, rounded up by one
+        // rounding; a non-finite span leaves the reach at zero (every sign takes the per-point
+        // filter).
+        let span = (hi - lo).max_element() * (1.0 + 4.0 * f64::EPSILON);
+        if span.is_finite() {
+            t.reach = span;
+        }
         t.reset();
         t
     }
@@ -377,15 +395,17 @@ impl Tree {
         self.work.extend_from_slice(&self.lists[s..s + len]);
         let hi = self.work.len();
         let (ha, hb) = self.occluders[occ as usize].edge(edge);
-        let from_light: SmallVec<[Orienter; 8]> = self
+        let reach = self.reach;
+        let bounded = |o: Orienter| (o, o.reach_bound(reach));
+        let from_light: SmallVec<[(Orienter, f64); 8]> = self
             .light
             .iter()
-            .map(|&a| Orienter::new(ha, hb, a))
+            .map(|&a| bounded(Orienter::new(ha, hb, a)))
             .collect();
-        let from_cell: SmallVec<[Orienter; 4]> = self
+        let from_cell: SmallVec<[(Orienter, f64); 4]> = self
             .cell
             .iter()
-            .map(|&c| Orienter::new(ha, hb, c))
+            .map(|&c| bounded(Orienter::new(ha, hb, c)))
             .collect();
         // Three-way partition: [lo, p) positive, [p, q) both, [q, hi) negative.
         let (mut p, mut i, mut q) = (lo, lo, hi);
@@ -544,11 +564,11 @@ impl Tree {
     /// tile corner through an occluder vertex, `b -> a` from an occluder vertex to a light
     /// vertex. `orienters[k]` evaluates `det[p - o_k, h_a - o_k, h_b - o_k]`, the side of the
     /// line `o_k -> p`: as is for the tile (`reverse` false), reversed for the light.
-    fn orientation(&self, o: u32, orienters: &[Orienter], reverse: bool) -> Sign {
+    fn orientation(&self, o: u32, orienters: &[(Orienter, f64)], reverse: bool) -> Sign {
         let (mut pos, mut neg) = (false, false);
-        for or in orienters {
+        for (or, bound) in orienters {
             for &b in self.occluders[o as usize].vertices() {
-                let Some(s) = or.strict_sign(b) else {
+                let Some(s) = or.strict_sign_within(b, *bound) else {
                     return Sign::Zero;
                 };
                 match if reverse { s.flip() } else { s } {
