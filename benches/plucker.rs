@@ -348,18 +348,31 @@ fn one_pass(spec: &str) {
     {
         ctx = ctx.with_budget(b);
     }
-    for f in &case.frames {
+    pass(variant, clip, &pl, &mut ctx, &case.frames);
+    eprintln!("{spec}: {} queries, {:?}", case.frames.len(), ctx.stats());
+}
+
+/// The queries of one pass, apart so that callgrind can count them alone
+/// (`--collect-atstart=no --toggle-collect='plucker::pass*'`).
+#[inline(never)]
+fn pass(
+    variant: &str,
+    clip: &arealight::visibility::ClipVisibility<Light>,
+    pl: &PluckerVisibility<Light>,
+    ctx: &mut PluckerContext,
+    frames: &[ShadingFrame],
+) {
+    for f in frames {
         match variant {
             "none" => {}
             "clip" => drop(black_box(clip.visible_region(0, f))),
             "plucker_call" => drop(black_box(pl.visible_region(0, f).unwrap())),
             "plucker_reuse" | "plucker_reset" => {
-                drop(black_box(pl.visible_region_in(&mut ctx, 0, f).unwrap()))
+                drop(black_box(pl.visible_region_in(ctx, 0, f).unwrap()))
             }
             _ => panic!("PLUCKER_ONE_PASS: variant {variant}"),
         }
     }
-    eprintln!("{spec}: {} queries, {:?}", case.frames.len(), ctx.stats());
 }
 
 criterion_group!(benches, scale);

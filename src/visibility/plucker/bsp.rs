@@ -83,19 +83,26 @@ pub(crate) enum Node {
     /// to `pos`, negative to `neg`; lines with side zero (all of a fragment, which happens only
     /// when the shading point lies on the edge's line) go to `pos` when `zero_pos`, else `neg`:
     /// always the child where that edge does not close the occluder's invisible class.
+    ///
+    /// `pending` occluder ids (`len` from `start` in the list pool) are still to be inserted
+    /// below the node: insertion is deferred until a query passes the node
+    /// ([`Tree::push_down`]).
     Inner {
         occ: u32,
         edge: u8,
         pos: u32,
         neg: u32,
         zero_pos: bool,
+        pending_start: u32,
+        pending_len: u32,
     },
     /// A class of lines that stab no occluder.
     Visible,
     /// A class of lines that stab an occluder.
     Invisible,
-    /// A class not yet decided, with the occluders that may block some of its lines.
-    Undefined(Vec<u32>),
+    /// A class not yet decided, with the occluders that may block some of its lines: `len`
+    /// ids from `start` in the tree's list pool.
+    Undefined { start: u32, len: u32 },
 }
 
 /// Counters of one tree's growth.
@@ -106,6 +113,9 @@ pub struct TreeCounters {
     /// Orientation tests of an occluder's vertex-to-vertex lines against a node (Alg. 1 lines
     /// 6-13).
     pub insertion_tests: u64,
+    /// Fragments found visible at an undefined leaf, without developing it, because no
+    /// occluder of its list can hide any of their lines from the query point.
+    pub shortcuts: u64,
 }
 
 /// The lazily built tree of one light polygon and one set of occluders.
@@ -119,34 +129,122 @@ pub(crate) struct Tree {
     cell: SmallVec<[DVec3; 4]>,
     occluders: Vec<Occluder>,
     nodes: Vec<Node>,
-    /// Occluder ids held by undefined leaves.
-    listed: usize,
+    /// The lists of the undefined leaves, each a range written once (an expanded leaf's range
+    /// becomes garbage until [`Tree::compact`]).
+    lists: Vec<u32>,
+    /// Ids in `lists` that no leaf refers to any more.
+    garbage: usize,
+    /// Scratch of the insertion: a list on its way down ([`Tree::push_down`]).
+    work: Vec<u32>,
+    /// The other buffer of [`Tree::compact`].
+    spare: Vec<u32>,
     rng: u64,
+    /// At least `|p - c|` in each coordinate, after rounding, for every occluder vertex `p`
+    /// and every cell or light corner `c`: the reach of the insertion's sign filter
+    /// ([`Orienter::reach_bound`]).
+    reach: f64,
     peak_bytes: usize,
     pub(crate) counters: TreeCounters,
+}
+
+/// The allocations of a tree, kept by a caller that builds one tree after another (the
+/// per-call path): [`Tree::with_buffers`] takes them, [`Tree::into_buffers`] gives them back.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TreeBuffers {
+    pub(crate) occluders: Vec<Occluder>,
+    nodes: Vec<Node>,
+    lists: Vec<u32>,
+    work: Vec<u32>,
+    spare: Vec<u32>,
 }
 
 impl Tree {
     /// The tree of a single undefined leaf holding every occluder (Alg. 2 line 8), for query
     /// lines from the convex hull of `cell` through the convex hull of `light`.
+    #[cfg(test)]
     pub(crate) fn new(
         cell: &[DVec3],
         light: &[DVec3],
         occluders: Vec<Occluder>,
         seed: u64,
     ) -> Tree {
+        Tree::with_buffers(
+            cell,
+            light,
+            TreeBuffers {
+                occluders,
+                ..TreeBuffers::default()
+            },
+            seed,
+        )
+    }
+
+    /// [`Tree::new`] with the occluders in `bufs` and its other allocations reused.
+    pub(crate) fn with_buffers(
+        cell: &[DVec3],
+        light: &[DVec3],
+        bufs: TreeBuffers,
+        seed: u64,
+    ) -> Tree {
+        let TreeBuffers {
+            occluders,
+            nodes,
+            lists,
+            mut work,
+            spare,
+        } = bufs;
+        work.clear();
         let mut t = Tree {
             light: light.iter().copied().collect(),
             cell: cell.iter().copied().collect(),
             occluders,
-            nodes: Vec::new(),
-            listed: 0,
+            nodes,
+            lists,
+            garbage: 0,
+            work,
+            spare,
             rng: seed | 1,
+            reach: 0.0,
             peak_bytes: 0,
             counters: TreeCounters::default(),
         };
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        let occ = t.occluders.iter().flat_map(|o| o.vertices().iter());
+        for &p in t.cell.iter().chain(t.light.iter()).chain(occ) {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        // A difference of two coordinates in [lo, hi] is at most their span, rounded up by one
+        // rounding; a non-finite span leaves the reach at zero (every sign takes the per-point
+        // filter).
+        let span = (hi - lo).max_element() * (1.0 + 4.0 * f64::EPSILON);
+        if span.is_finite() {
+            t.reach = span;
+        }
         t.reset();
         t
+    }
+
+    /// The tree's allocations, emptied, for the next [`Tree::with_buffers`].
+    pub(crate) fn into_buffers(self) -> TreeBuffers {
+        let Tree {
+            mut occluders,
+            mut nodes,
+            mut lists,
+            work,
+            spare,
+            ..
+        } = self;
+        occluders.clear();
+        nodes.clear();
+        lists.clear();
+        TreeBuffers {
+            occluders,
+            nodes,
+            lists,
+            work,
+            spare,
+        }
     }
 
     /// Back to the root leaf with every occluder (the fallback when the tree outgrows its cap,
@@ -154,12 +252,14 @@ impl Tree {
     pub(crate) fn reset(&mut self) {
         self.nodes.clear();
         self.nodes.push(Node::Invisible);
-        let all: Vec<u32> = (0..self.occluders.len() as u32).collect();
-        self.listed = all.len();
-        self.nodes.push(if all.is_empty() {
+        self.lists.clear();
+        self.garbage = 0;
+        let n = self.occluders.len() as u32;
+        self.lists.extend(0..n);
+        self.nodes.push(if n == 0 {
             Node::Visible
         } else {
-            Node::Undefined(all)
+            Node::Undefined { start: 0, len: n }
         });
         self.note_size();
     }
@@ -189,12 +289,43 @@ impl Tree {
         self.nodes.len()
     }
 
-    /// The memory the tree holds, in bytes (nodes, leaf lists, occluders; allocator slack not
-    /// counted).
+    /// The memory the tree holds, in bytes (nodes, the list pool with its garbage and the
+    /// compaction's other buffer, occluders; other allocator slack not counted).
     pub(crate) fn bytes(&self) -> usize {
         self.nodes.len() * size_of::<Node>()
-            + self.listed * size_of::<u32>()
+            + (self.lists.len() + self.spare.capacity()) * size_of::<u32>()
             + self.occluders.len() * size_of::<Occluder>()
+    }
+
+    /// The list of the undefined leaf `(start, len)`.
+    #[inline]
+    pub(crate) fn list(&self, start: u32, len: u32) -> &[u32] {
+        &self.lists[start as usize..(start + len) as usize]
+    }
+
+    /// Rewrites the list pool with the live lists only, once garbage is most of it: the pool
+    /// then stays within twice the lists the leaves hold.
+    fn compact(&mut self) {
+        if self.garbage < 4096 || 2 * self.garbage < self.lists.len() {
+            return;
+        }
+        let mut fresh = core::mem::take(&mut self.spare);
+        fresh.clear();
+        for node in &mut self.nodes {
+            if let Node::Undefined { start, len }
+            | Node::Inner {
+                pending_start: start,
+                pending_len: len,
+                ..
+            } = node
+            {
+                let s = *start as usize;
+                *start = fresh.len() as u32;
+                fresh.extend_from_slice(&self.lists[s..s + *len as usize]);
+            }
+        }
+        self.spare = core::mem::replace(&mut self.lists, fresh);
+        self.garbage = 0;
     }
 
     /// The largest [`Tree::bytes`] so far.
@@ -206,38 +337,150 @@ impl Tree {
         self.peak_bytes = self.peak_bytes.max(self.bytes());
     }
 
+    /// Develops the undefined leaf `n` (Alg. 1 lines 31-35) with the occluder `ro` of its
+    /// list: `ro` replaces the leaf by its own classes (`bsp(ro)`, [`Tree::merge`]), and the
+    /// others are inserted into them ([`Tree::insert`]). `n` becomes the root of `bsp(ro)`.
+    pub(crate) fn expand_with(&mut self, n: u32, ro: u32) {
+        let Node::Undefined { start, len } = self.nodes[n as usize] else {
+            return;
+        };
+        let base = self.work.len();
+        let (s, e) = (start as usize, (start + len) as usize);
+        self.work
+            .extend(self.lists[s..e].iter().copied().filter(|&o| o != ro));
+        self.garbage += len as usize;
+        self.nodes[n as usize] = Node::Visible;
+        self.merge(n, ro);
+        self.counters.merges += 1;
+        let end = self.work.len();
+        if end > base {
+            self.give(n, base, end);
+        }
+        self.work.truncate(base);
+        self.note_size();
+        self.compact();
+    }
+
+    /// Inserts the pending list of the inner node `n` one level down (Alg. 1 lines 6-13, one
+    /// node at a time): by the orientation of each occluder's vertex-to-vertex lines (Theorem 1,
+    /// [`Tree::orientation`]), strictly positive to `pos`, strictly negative to `neg`, anything
+    /// else to both (conservative); each child adds its part to its own list ([`Tree::give`]).
+    ///
+    /// Seed 002 inserts the other occluders of a developed leaf through the whole of
+    /// `bsp(ro)` at once; here a node's occluders wait until a query passes it, so the exits of
+    /// `bsp(ro)` that no query reaches, and the nodes below them, are never classified. The
+    /// query pushes every node it passes, so the leaf it reaches holds every occluder that may
+    /// block its class.
+    pub(crate) fn push_down(&mut self, n: u32) {
+        let Node::Inner {
+            occ,
+            edge,
+            pos,
+            neg,
+            pending_start,
+            pending_len,
+            ..
+        } = &mut self.nodes[n as usize]
+        else {
+            return;
+        };
+        if *pending_len == 0 {
+            return;
+        }
+        let (occ, edge, pos, neg) = (*occ, *edge, *pos, *neg);
+        let (s, len) = (*pending_start as usize, *pending_len as usize);
+        *pending_len = 0;
+        self.garbage += len;
+        let lo = self.work.len();
+        self.work.extend_from_slice(&self.lists[s..s + len]);
+        let hi = self.work.len();
+        let (ha, hb) = self.occluders[occ as usize].edge(edge);
+        let reach = self.reach;
+        let bounded = |o: Orienter| (o, o.reach_bound(reach));
+        let from_light: SmallVec<[(Orienter, f64); 8]> = self
+            .light
+            .iter()
+            .map(|&a| bounded(Orienter::new(ha, hb, a)))
+            .collect();
+        let from_cell: SmallVec<[(Orienter, f64); 4]> = self
+            .cell
+            .iter()
+            .map(|&c| bounded(Orienter::new(ha, hb, c)))
+            .collect();
+        // Three-way partition: [lo, p) positive, [p, q) both, [q, hi) negative.
+        let (mut p, mut i, mut q) = (lo, lo, hi);
+        while i < q {
+            let o = self.work[i];
+            let side = match self.orientation(o, &from_cell, false) {
+                Sign::Zero => self.orientation(o, &from_light, true),
+                strict => strict,
+            };
+            match side {
+                Sign::Positive => {
+                    self.work.swap(p, i);
+                    p += 1;
+                    i += 1;
+                }
+                Sign::Zero => i += 1,
+                Sign::Negative => {
+                    q -= 1;
+                    self.work.swap(i, q);
+                }
+            }
+        }
+        self.counters.insertion_tests += len as u64;
+        if q > lo {
+            self.give(pos, lo, q);
+        }
+        if hi > p {
+            self.give(neg, p, hi);
+        }
+        self.work.truncate(lo);
+        self.note_size();
+        self.compact();
+    }
+
+    /// Adds the ids `work[lo..hi]` to what node `n` holds: an invisible class ignores them, a
+    /// visible one becomes undefined with them, an undefined leaf or an inner node's pending
+    /// list is rewritten with them at the end of the pool.
+    fn give(&mut self, n: u32, lo: usize, hi: usize) {
+        let at = self.lists.len() as u32;
+        let (start, len) = match &mut self.nodes[n as usize] {
+            Node::Invisible => return,
+            Node::Visible => {
+                self.nodes[n as usize] = Node::Undefined {
+                    start: at,
+                    len: (hi - lo) as u32,
+                };
+                self.lists.extend_from_slice(&self.work[lo..hi]);
+                return;
+            }
+            Node::Undefined { start, len }
+            | Node::Inner {
+                pending_start: start,
+                pending_len: len,
+                ..
+            } => {
+                let old = (*start as usize, *len as usize);
+                *start = at;
+                *len += (hi - lo) as u32;
+                old
+            }
+        };
+        self.lists.extend_from_within(start..start + len);
+        self.lists.extend_from_slice(&self.work[lo..hi]);
+        self.garbage += len;
+    }
+
     /// A pseudo-random index below `n` (xorshift64): the occluder merged at a leaf is chosen at
     /// random (seed 002 section 4.3, as the pivot of quicksort).
-    fn pick(&mut self, n: usize) -> usize {
+    pub(crate) fn pick(&mut self, n: usize) -> usize {
         let mut x = self.rng;
         x ^= x << 13;
         x ^= x >> 7;
         x ^= x << 17;
         self.rng = x;
         ((x >> 11) % n as u64) as usize
-    }
-
-    /// Develops the undefined leaf `n` (Alg. 1 lines 31-35): a random occluder `ro` of its list
-    /// replaces the leaf by its own classes (`bsp(ro)`, [`Tree::merge`]), and the others are
-    /// inserted into them ([`Tree::insert`]). `n` becomes the root of `bsp(ro)`.
-    pub(crate) fn expand(&mut self, n: u32) {
-        let Node::Undefined(mut list) =
-            core::mem::replace(&mut self.nodes[n as usize], Node::Visible)
-        else {
-            return;
-        };
-        self.listed -= list.len();
-        if list.is_empty() {
-            return;
-        }
-        let k = self.pick(list.len());
-        let ro = list.swap_remove(k);
-        self.merge(n, ro);
-        self.counters.merges += 1;
-        if !list.is_empty() {
-            self.insert(n, list);
-        }
-        self.note_size();
     }
 
     /// Writes `bsp(o)` (seed 002 Fig. 4) with its root at node `at`: a chain over the occluder's
@@ -265,6 +508,8 @@ impl Tree {
                     pos: p,
                     neg: m,
                     zero_pos: false,
+                    pending_start: 0,
+                    pending_len: 0,
                 };
                 self.chain(p, o, (1..k).collect(), true);
                 let mut edges: SmallVec<[u8; 8]> = (1..k).collect();
@@ -292,6 +537,8 @@ impl Tree {
                 pos,
                 neg,
                 zero_pos: !positive,
+                pending_start: 0,
+                pending_len: 0,
             };
             at = next;
         }
@@ -300,68 +547,6 @@ impl Tree {
     fn push(&mut self, node: Node) -> u32 {
         self.nodes.push(node);
         (self.nodes.len() - 1) as u32
-    }
-
-    /// Inserts `list` into the subtree at `n` (Alg. 1 lines 1-13): at an inner node, by the
-    /// orientation of each occluder's vertex-to-vertex lines (Theorem 1,
-    /// [`Tree::orientation`]): strictly positive to `pos`, strictly negative to `neg`, anything
-    /// else to both (conservative). At a leaf: a visible class becomes undefined with the list,
-    /// an undefined one adds it, an invisible one ignores it.
-    fn insert(&mut self, n: u32, list: Vec<u32>) {
-        let (occ, edge, pos, neg) = match &mut self.nodes[n as usize] {
-            Node::Invisible => return,
-            Node::Undefined(l) => {
-                l.extend_from_slice(&list);
-                self.listed += list.len();
-                return;
-            }
-            Node::Visible => {
-                self.listed += list.len();
-                self.nodes[n as usize] = Node::Undefined(list);
-                return;
-            }
-            &mut Node::Inner {
-                occ,
-                edge,
-                pos,
-                neg,
-                ..
-            } => (occ, edge, pos, neg),
-        };
-        let (ha, hb) = self.occluders[occ as usize].edge(edge);
-        let from_light: SmallVec<[Orienter; 8]> = self
-            .light
-            .iter()
-            .map(|&a| Orienter::new(ha, hb, a))
-            .collect();
-        let from_cell: SmallVec<[Orienter; 4]> = self
-            .cell
-            .iter()
-            .map(|&c| Orienter::new(ha, hb, c))
-            .collect();
-        let (mut to_pos, mut to_neg) = (Vec::new(), Vec::new());
-        for &o in &list {
-            let side = match self.orientation(o, &from_cell, false) {
-                Sign::Zero => self.orientation(o, &from_light, true),
-                strict => strict,
-            };
-            match side {
-                Sign::Positive => to_pos.push(o),
-                Sign::Negative => to_neg.push(o),
-                Sign::Zero => {
-                    to_pos.push(o);
-                    to_neg.push(o);
-                }
-            }
-        }
-        self.counters.insertion_tests += list.len() as u64;
-        drop(list);
-        if !to_pos.is_empty() {
-            self.insert(pos, to_pos);
-        }
-        if !to_neg.is_empty() {
-            self.insert(neg, to_neg);
-        }
     }
 
     /// The orientation of the lines occluder `o` blocks, relative to a node's line, bounded by
@@ -379,11 +564,11 @@ impl Tree {
     /// tile corner through an occluder vertex, `b -> a` from an occluder vertex to a light
     /// vertex. `orienters[k]` evaluates `det[p - o_k, h_a - o_k, h_b - o_k]`, the side of the
     /// line `o_k -> p`: as is for the tile (`reverse` false), reversed for the light.
-    fn orientation(&self, o: u32, orienters: &[Orienter], reverse: bool) -> Sign {
+    fn orientation(&self, o: u32, orienters: &[(Orienter, f64)], reverse: bool) -> Sign {
         let (mut pos, mut neg) = (false, false);
-        for or in orienters {
+        for (or, bound) in orienters {
             for &b in self.occluders[o as usize].vertices() {
-                let Some(s) = or.strict_sign(b) else {
+                let Some(s) = or.strict_sign_within(b, *bound) else {
                     return Sign::Zero;
                 };
                 match if reverse { s.flip() } else { s } {

@@ -295,6 +295,39 @@ impl Orienter {
     pub(crate) fn strict_sign(&self, p: DVec3) -> Option<Sign> {
         self.eval_filtered(p).1
     }
+
+    /// A bound of [`ORIENT_ERROR`] times the permanent for every point `p` with
+    /// `|p - o|` at most `reach` in each coordinate (after rounding): the permanent is
+    /// `sum |d_i| mabs_i <= reach * sum mabs_i`. Slightly widened so that it is never below the
+    /// per-point bound of [`Orienter::strict_sign`] computed for such a point, and zero (no
+    /// fast answer) where that bound's error model does not hold.
+    #[inline]
+    pub(crate) fn reach_bound(&self, reach: f64) -> f64 {
+        let b = ORIENT_ERROR * reach * (self.mabs.x + self.mabs.y + self.mabs.z) * (1.0 + 1e-10);
+        if reach * (self.mabs.x + self.mabs.y + self.mabs.z) > 2.0 * PERMANENT_FLOOR {
+            b
+        } else {
+            0.0
+        }
+    }
+
+    /// [`Orienter::strict_sign`] for a point within the reach of `bound`
+    /// ([`Orienter::reach_bound`]): a value beyond `bound` is certified with one dot product,
+    /// without the point's own permanent; anything else takes the per-point filter, so the
+    /// answer is the same.
+    #[inline]
+    pub(crate) fn strict_sign_within(&self, p: DVec3, bound: f64) -> Option<Sign> {
+        let s = (p - self.o).dot(self.m);
+        if bound > 0.0 {
+            if s > bound {
+                return Some(Sign::Positive);
+            }
+            if s < -bound {
+                return Some(Sign::Negative);
+            }
+        }
+        self.strict_sign(p)
+    }
 }
 
 /// How a line meets a convex planar polygon ([`line_polygon`]).
@@ -446,7 +479,7 @@ mod tests {
         // integer arithmetic, the exact fallback decides the rest, and generic inputs are
         // decided by the filter alone.
         let mut rng = Rng(11);
-        let (mut undecided, mut generic_undecided, mut zeros) = (0, 0, 0);
+        let (mut undecided, mut generic_undecided, mut zeros, mut by_reach) = (0, 0, 0, 0);
         for case in 0..40000 {
             let m = 1i64 << (5 + case % 31);
             let pt = |rng: &mut Rng| [rng.int(m), rng.int(m), rng.int(m)].map(i128::from);
@@ -486,7 +519,25 @@ mod tests {
                     generic_undecided += usize::from(generic);
                 }
             }
+            // The reach filter, with the reach of these points (their largest coordinate
+            // difference), answers as the per-point filter, and from its bound alone for most
+            // generic points.
+            let reach = [0, 1, 2]
+                .map(|i| (p[i] - o[i]).abs().max((a[i] - o[i]).abs()))
+                .into_iter()
+                .max()
+                .unwrap() as f64
+                * s;
+            let bound = or.reach_bound(reach);
+            assert_eq!(
+                or.strict_sign_within(f(p), bound),
+                or.strict_sign(f(p)),
+                "case {case}: reach filter"
+            );
+            let v = (f(p) - f(o)).dot(or.m);
+            by_reach += usize::from(generic && bound > 0.0 && v.abs() > bound);
         }
+        assert!(by_reach > 5000, "{by_reach}");
         assert!(zeros > 5000, "{zeros}");
         assert!(
             undecided > 5000 && generic_undecided < 20,

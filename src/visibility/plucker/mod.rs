@@ -447,6 +447,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 &tile.geom,
                 seed,
                 &mut ws.cull,
+                bsp::TreeBuffers::default(),
             ) {
                 Some(t) => {
                     stats.trees_built += 1;
@@ -487,6 +488,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             stats.note_tree(tree);
             stats.merges += tree.counters.merges - before.merges;
             stats.insertion_tests += tree.counters.insertion_tests - before.insertion_tests;
+            stats.shortcuts += tree.counters.shortcuts - before.shortcuts;
             before = tree.counters;
             match result {
                 Ok(()) => break,
@@ -533,6 +535,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             &geom,
             0x2545_f491_4f6c_dd1d,
             &mut ws.cull,
+            core::mem::take(&mut ws.tree),
         ) else {
             return Ok(Status::Done);
         };
@@ -553,6 +556,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 return Ok(Status::TooBig);
             }
         }
+        ws.tree = tree.into_buffers();
         for frag in &ws.frags {
             push_piece(out, frag, DVec3::ZERO, frame)?;
         }
@@ -806,6 +810,9 @@ pub struct PluckerStats {
     pub merges: u64,
     /// Orientation tests of insertion, over all trees (Alg. 1 lines 6-13).
     pub insertion_tests: u64,
+    /// Fragments found visible at an undefined leaf without developing it, over all trees
+    /// (no occluder of the leaf can hide them from the query point).
+    pub shortcuts: u64,
 }
 
 impl PluckerStats {
@@ -821,6 +828,8 @@ struct Workspace {
     scratch: Scratch,
     frags: Vec<Fragment>,
     cull: Vec<u32>,
+    /// The allocations of the last per-point tree.
+    tree: bsp::TreeBuffers,
 }
 
 #[derive(Debug, Clone)]

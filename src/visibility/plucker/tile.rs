@@ -27,7 +27,7 @@ use glam::DVec3;
 use smallvec::SmallVec;
 
 use super::Blocker;
-use super::bsp::{Crossing, MAX_OCCLUDER_VERTICES, Occluder, Tree};
+use super::bsp::{Crossing, MAX_OCCLUDER_VERTICES, Occluder, Tree, TreeBuffers};
 use super::line::{Orienter, Sign};
 use super::query::{clip_above, is_sliver, keep_positive, weld};
 use crate::solid::TriangleMesh;
@@ -342,7 +342,9 @@ pub(crate) struct GroupSource<'a> {
 /// culling, the owner filter and the edge-on test are cut to `H_f` and above the tile plane and
 /// become the occluders, all in one undefined root leaf.
 ///
-/// `None` when nothing of the group lies above the tile plane.
+/// `None` when nothing of the group lies above the tile plane. The tree takes its allocations
+/// from `bufs`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn build_group_tree<'m>(
     bvh: &Bvh,
     mesh_of: &dyn Fn(Blocker) -> &'m TriangleMesh,
@@ -351,6 +353,7 @@ pub(crate) fn build_group_tree<'m>(
     tile: &TileGeometry,
     seed: u64,
     scratch: &mut Vec<u32>,
+    mut bufs: TreeBuffers,
 ) -> Option<GroupTree> {
     let o = tile.origin;
     let p0 = tile.p0 - o;
@@ -387,7 +390,8 @@ pub(crate) fn build_group_tree<'m>(
     }
     scratch.clear();
     bvh.cull(&planes, scratch);
-    let mut occluders = Vec::new();
+    let mut occluders = core::mem::take(&mut bufs.occluders);
+    occluders.clear();
     let mut near = Vec::new();
     for &i in scratch.iter() {
         let bt = bvh.tri(i);
@@ -463,8 +467,9 @@ pub(crate) fn build_group_tree<'m>(
             });
         }
     }
+    bufs.occluders = occluders;
     Some(GroupTree {
-        tree: Tree::new(&cell_local, &light, occluders, seed),
+        tree: Tree::with_buffers(&cell_local, &light, bufs, seed),
         near,
         band,
     })
