@@ -11,10 +11,10 @@ use super::clip::HORIZON_TOLERANCE;
 use super::gnomonic::{Gnomonic, enclosing_cap};
 use super::order::{order_directed_edges, order_directed_edges_within};
 use super::polygon::{SphericalPolygon, Verts, close_ring, regularized};
-use super::predicates::tangent_frame;
+use super::predicates::{arc_lever, tangent_frame};
 use crate::GeomError;
 use crate::planar::predicates::vertices_inside_segment;
-use crate::planar::{BoolOp, FillRule, Shape, boolean};
+use crate::planar::{BoolOp, FillRule, SNAP_REL, Shape, boolean_at_scale};
 
 /// Smallest cosine of the enclosing cap's radius for the single-projection path: projected
 /// coordinates stay below `1 / MIN_CAP_COS` (here 1e3), well inside the range where the planar
@@ -228,6 +228,17 @@ struct Planar {
     rebuilt: bool,
 }
 
+/// Smallest coordinate scale at which the planar operations of a projection set their
+/// tolerances ([`boolean_at_scale`]): their snapping distance is then at least
+/// `SNAP_REL / 8` (about `1.8e-15`). A point taken through a projection and back is rounded by
+/// a few `1e-16` (unit vectors carry `1.1e-16` per component), whatever the size of the
+/// operands; a planar result whose features (distances between vertices, from vertices to
+/// edges they are not on) are several times that keeps its topology when unprojected. Charts of
+/// operands larger than about 7 degrees have coordinates above this scale and are unaffected;
+/// for smaller ones the planar coordinates (down to `1e-10` for tiny polygons) would otherwise
+/// set tolerances far below what unit vectors resolve.
+const PLANE_MIN_SCALE: f64 = 0.125;
+
 fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
     // All vertices lie in the open hemisphere about the center, so each ring separates a bounded
     // planar part from the far side; the far side's membership is that of -center, which lies
@@ -251,8 +262,14 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
         }
         Ok(contours)
     };
+    // The planar operation resolves contacts between the operands at its snapping distance,
+    // but takes each operand's own features as exact: a vertex closer than that to an edge of
+    // its own operand (in rings of integer directions, normalized, `1e-19` is common) stays a
+    // near-contact, and a crossing computed on that edge, unprojected, passes on either side of
+    // it. Such an operand is resolved at the operation's resolution first.
+    let scale = |s: &Shape| s.facts.bbox_scale().max(PLANE_MIN_SCALE);
     match Shape::new(project()?) {
-        Ok(shape) => Ok(Planar {
+        Ok(shape) if shape.is_clear_at(SNAP_REL * scale(&shape)) => Ok(Planar {
             shape,
             complemented,
             rebuilt: false,
@@ -263,9 +280,14 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
         // where rings nearly meet: results of earlier operations can carry two rings whose
         // shared edge has vertex copies `1e-12` apart (each copy an intersection point computed
         // in another projection), which cross in the plane. The ring soup under the positive
-        // fill rule is the same region with those contacts welded (the planar resolution).
-        Err(_) => Ok(Planar {
-            shape: Shape::with_fill_rule(project()?, FillRule::Positive)?,
+        // fill rule is the same region with those contacts welded, and vertices near edges put
+        // on them (the planar resolution).
+        _ => Ok(Planar {
+            shape: Shape::with_fill_rule_resolving_at_scale(
+                project()?,
+                FillRule::Positive,
+                PLANE_MIN_SCALE,
+            )?,
             complemented,
             rebuilt: true,
         }),
@@ -297,7 +319,9 @@ fn weld_tolerance(sin_r: f64) -> f64 {
 }
 
 /// Both operands with every vertex replaced by the first vertex (in either operand) within
-/// `tolerance` of it; repeats that this creates along a ring are dropped. `None` when no
+/// `tolerance` of it, where that moves the edges at either vertex by at most `tolerance`
+/// ([`arc_lever`]: not always for an edge between nearly antipodal vertices); repeats that this
+/// creates along a ring are dropped. `None` when no
 /// two vertices are that close (the common case), so the operands are used as they are.
 fn weld(
     a: &SphericalPolygon,
@@ -305,6 +329,28 @@ fn weld(
     tolerance: f64,
 ) -> Option<(SphericalPolygon, SphericalPolygon)> {
     let all: Vec<DVec3> = a.rings().chain(b.rings()).flatten().copied().collect();
+    // Where each ring starts and ends in `all`, to find a vertex's neighbours.
+    let bounds: SmallVec<[(usize, usize); 4]> = a
+        .rings()
+        .chain(b.rings())
+        .scan(0usize, |at, r| {
+            let s = *at;
+            *at += r.len();
+            Some((s, *at))
+        })
+        .collect();
+    // How far a vertex's edges move per unit it moves ([`arc_lever`]): moving a vertex of an
+    // edge between nearly antipodal vertices by the tolerance would move the edge, and the
+    // region, by far more.
+    let lever = |k: usize| {
+        let &(s, e) = bounds
+            .iter()
+            .find(|&&(s, e)| (s..e).contains(&k))
+            .unwrap_or(&(k, k + 1));
+        let prev = if k == s { e - 1 } else { k - 1 };
+        let next = if k + 1 == e { s } else { k + 1 };
+        arc_lever(all[prev], all[k]).max(arc_lever(all[k], all[next]))
+    };
     // Sort by x so that each vertex is compared only with those within the tolerance window.
     let mut order: Vec<usize> = (0..all.len()).collect();
     order.sort_by(|&i, &j| all[i].x.total_cmp(&all[j].x).then(i.cmp(&j)));
@@ -314,7 +360,8 @@ fn weld(
             if all[j].x - all[i].x > tolerance {
                 break;
             }
-            if (all[i] - all[j]).length() <= tolerance {
+            let d = (all[i] - all[j]).length();
+            if d <= tolerance && (d == 0.0 || d * lever(i).max(lever(j)) <= tolerance) {
                 // The earliest vertex (by input position) represents the group.
                 let (ri, rj) = (rep[i], rep[j]);
                 let r = ri.min(rj);
@@ -352,7 +399,10 @@ fn weld(
 
 /// `into` with every vertex of `from` that lies within `tolerance` of one of its edges (beside
 /// it: the foot of the perpendicular inside the arc, the vertex not an endpoint) inserted into
-/// that edge, and the largest such distance; `None` when there is none (the common case).
+/// that edge, where the two arcs replacing the edge stay within `tolerance` of it (a vertex that
+/// close to an edge longer than a quarter circle turns the arcs about their far ends, by up to
+/// [`arc_lever`] times the distance), and the largest such displacement; `None` when there is
+/// none (the common case).
 ///
 /// This is snap rounding at the resolution validation demands. Two operands' edges leaving a
 /// shared vertex in almost the same direction, or crossing at an almost flat angle, would give
@@ -387,8 +437,13 @@ fn snap_to_edges(
                 }
                 // Beside the arc: turning from p to v and from v to q both go its way round.
                 if p.cross(v).dot(nrm) > 0.0 && v.cross(q).dot(nrm) > 0.0 {
-                    inserts.push((base + i, v, (v - p).length_squared()));
-                    bend = bend.max(off / len);
+                    // The two arcs that replace the edge move from it by up to the offset
+                    // times their levers ([`arc_lever`]); the tolerance bounds that.
+                    let moved = off / len * arc_lever(p, v).max(arc_lever(v, q));
+                    if moved <= tolerance {
+                        inserts.push((base + i, v, (v - p).length_squared()));
+                        bend = bend.max(moved);
+                    }
                 }
             }
         }
@@ -481,22 +536,23 @@ fn projected(
     let clean = clean && !pa.rebuilt && !pb.rebuilt;
     let (ca, cb) = (pa.complemented, pb.complemented);
     let (sa, sb) = (&pa.shape, &pb.shape);
+    let plane = |x: &Shape, y: &Shape, o: BoolOp| boolean_at_scale(x, y, o, PLANE_MIN_SCALE);
     // Rewrite the operation on possibly complemented operands as one on bounded shapes, with
     // the result possibly complemented (De Morgan).
     let (shape, complemented) = match (op, ca, cb) {
-        (BoolOp::Intersection, false, false) => (boolean(sa, sb, BoolOp::Intersection)?, false),
-        (BoolOp::Intersection, true, false) => (boolean(sb, sa, BoolOp::Difference)?, false),
-        (BoolOp::Intersection, false, true) => (boolean(sa, sb, BoolOp::Difference)?, false),
-        (BoolOp::Intersection, true, true) => (boolean(sa, sb, BoolOp::Union)?, true),
-        (BoolOp::Union, false, false) => (boolean(sa, sb, BoolOp::Union)?, false),
-        (BoolOp::Union, true, false) => (boolean(sa, sb, BoolOp::Difference)?, true),
-        (BoolOp::Union, false, true) => (boolean(sb, sa, BoolOp::Difference)?, true),
-        (BoolOp::Union, true, true) => (boolean(sa, sb, BoolOp::Intersection)?, true),
-        (BoolOp::Difference, false, false) => (boolean(sa, sb, BoolOp::Difference)?, false),
-        (BoolOp::Difference, true, false) => (boolean(sa, sb, BoolOp::Union)?, true),
-        (BoolOp::Difference, false, true) => (boolean(sa, sb, BoolOp::Intersection)?, false),
-        (BoolOp::Difference, true, true) => (boolean(sb, sa, BoolOp::Difference)?, false),
-        (BoolOp::Xor, _, _) => (boolean(sa, sb, BoolOp::Xor)?, ca != cb),
+        (BoolOp::Intersection, false, false) => (plane(sa, sb, BoolOp::Intersection)?, false),
+        (BoolOp::Intersection, true, false) => (plane(sb, sa, BoolOp::Difference)?, false),
+        (BoolOp::Intersection, false, true) => (plane(sa, sb, BoolOp::Difference)?, false),
+        (BoolOp::Intersection, true, true) => (plane(sa, sb, BoolOp::Union)?, true),
+        (BoolOp::Union, false, false) => (plane(sa, sb, BoolOp::Union)?, false),
+        (BoolOp::Union, true, false) => (plane(sa, sb, BoolOp::Difference)?, true),
+        (BoolOp::Union, false, true) => (plane(sb, sa, BoolOp::Difference)?, true),
+        (BoolOp::Union, true, true) => (plane(sa, sb, BoolOp::Intersection)?, true),
+        (BoolOp::Difference, false, false) => (plane(sa, sb, BoolOp::Difference)?, false),
+        (BoolOp::Difference, true, false) => (plane(sa, sb, BoolOp::Union)?, true),
+        (BoolOp::Difference, false, true) => (plane(sa, sb, BoolOp::Intersection)?, false),
+        (BoolOp::Difference, true, true) => (plane(sb, sa, BoolOp::Difference)?, false),
+        (BoolOp::Xor, _, _) => (plane(sa, sb, BoolOp::Xor)?, ca != cb),
     };
     let mut verts = Verts::new();
     let mut ends: SmallVec<[u32; 2]> = SmallVec::new();
