@@ -350,6 +350,86 @@ fn intersection_of_tiny_polygons_is_a_valid_polygon() {
     }
 }
 
+/// The value of [`intersection_of_tiny_polygons_is_a_valid_polygon`], computed independently.
+/// `A` is the outside of the triangle `T`; `B`'s ring passes through its own vertex
+/// `P = (-117, -1)` (to `4e-19` rad), cutting off a clockwise lobe `P, (-1, 10), (-1, -1)` that
+/// is not part of `B`, and `T` (with its base on the line `y = -1`) lies partly in that lobe.
+/// So `A n B = B - (T - lobe)`: `B` by a fan of signed Van Oosterom-Strackee triangles, `T n
+/// lobe` by Sutherland-Hodgman of two convex triangles. Exact offsets (shoelace, rational clip):
+/// `|B| = 12670`, `|T| = 414`, `|T n lobe| = 87.317` units of `size^2`, so `A n B = 12343.3`
+/// units (`7.5338e-21` sr). Both projections compute that area but their rings cross themselves
+/// within rounding (`SelfIntersecting`), and the octant split's piece, projected about the
+/// octant's center, is valid with `11932` units: a valid polygon of the wrong region.
+#[test]
+#[ignore = "sphere boolean: A n B = 7.2828e-21 sr vs B - (T - lobe) = 7.5338e-21 (the octant \
+            split's piece is valid and wrong; both projections are SelfIntersecting)"]
+fn intersection_of_tiny_polygons_has_the_right_area() {
+    use arealight::planar::BoolOp;
+    let c = v(127.0, -1.0, 65.0).normalize();
+    let size = 1e-10 / 128.0;
+    let (u, w) = c.any_orthonormal_pair();
+    let ring = |pts: &[(f64, f64)]| -> Vec<DVec3> {
+        pts.iter()
+            .map(|&(x, y)| (c + (u * x + w * y) * size).normalize())
+            .collect()
+    };
+    let ra = ring(&[(11., 45.), (-63., -1.), (-81., -1.)]);
+    let rb = ring(&[
+        (4., -116.),
+        (43., 65.),
+        (-117., -1.),
+        (-1., 10.),
+        (-1., -1.),
+        (-119., -1.),
+    ]);
+    let a = SphericalPolygon::new(vec![ra.clone()]).unwrap();
+    let b = SphericalPolygon::new(vec![rb.clone()]).unwrap();
+    let fan = |r: &[DVec3]| -> f64 {
+        (1..r.len() - 1)
+            .map(|k| triangle_area(r[0], r[k], r[k + 1]))
+            .sum()
+    };
+    let wb = fan(&rb);
+    // Both counter-clockwise.
+    let t = [ra[0], ra[2], ra[1]];
+    let lobe = [rb[2], rb[4], rb[3]];
+    let mut t_in_lobe = t.to_vec();
+    for k in 0..3 {
+        // The normal from the edge's difference vector (the cross product of two unit
+        // vectors `1e-10` apart loses all but six digits).
+        let (p, q) = (lobe[k], lobe[(k + 1) % 3]);
+        t_in_lobe = clip_to_great_circle(&t_in_lobe, p.cross(q - p));
+    }
+    let (wt, wtl) = (convex_area(&t), convex_area(&t_in_lobe));
+    let s2 = size * size;
+    assert!(
+        (wb / s2 - 12670.0).abs() < 0.1 && (wt / s2 - 414.0).abs() < 0.1,
+        "{} {}",
+        wb / s2,
+        wt / s2
+    );
+    assert!((wtl / s2 - 87.317).abs() < 0.01, "{}", wtl / s2);
+    let want = wb - (wt - wtl);
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = [&ra, &rb]
+        .iter()
+        .flat_map(|r| (0..r.len()).map(|k| arc(r[k], r[(k + 1) % r.len()])))
+        .sum();
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        match p.boolean(q, BoolOp::Intersection) {
+            Ok(r) => {
+                r.validate().unwrap_or_else(|e| panic!("{e}: {r:?}"));
+                let got = r.solid_angle();
+                assert!(
+                    (got - want).abs() <= 1e-14 * per,
+                    "A n B = {got:e} vs B - (T - lobe) = {want:e}"
+                );
+            }
+            Err(e) => assert!(e.is_undecidable(), "{e}"),
+        }
+    }
+}
+
 /// Found by the `sphere_sliver` fuzz target once its identities were checked at the issue's
 /// `1e-10 * 4 pi` (they were at `1e-9 * 4 pi`): a triangle larger than a hemisphere with a
 /// nearly antipodal edge `a -> b` (`|a + b| = 0.0137`), and its copy with `a` moved by `2.1e-9`
@@ -407,8 +487,15 @@ fn difference_identity_next_to_a_nearly_antipodal_edge() {
     let per: f64 = (0..3)
         .map(|k| arc(ra[k], ra[(k + 1) % 3]) + arc(rb[k], rb[(k + 1) % 3]))
         .sum();
-    assert!((d - exact).abs() <= 1e-11 * per, "A - B = {d:e} vs {exact:e}");
-    assert!((i - (wa - exact)).abs() <= 1e-11 * per, "A n B = {i} vs {}", wa - exact);
+    assert!(
+        (d - exact).abs() <= 1e-11 * per,
+        "A - B = {d:e} vs {exact:e}"
+    );
+    assert!(
+        (i - (wa - exact)).abs() <= 1e-11 * per,
+        "A n B = {i} vs {}",
+        wa - exact
+    );
 }
 
 /// Sutherland-Hodgman: the part of a convex spherical polygon (minor arcs, within a hemisphere)
@@ -426,8 +513,11 @@ fn clip_to_great_circle(ring: &[DVec3], n: DVec3) -> Vec<DVec3> {
             out.push(p);
         }
         if (sp > eps && sq < -eps) || (sp < -eps && sq > eps) {
-            // The point of the arc on the circle: p sq - q sp is orthogonal to n.
-            out.push((p * sq - q * sp).normalize());
+            // The point of the arc on the circle: p sq - q sp is orthogonal to n, and a
+            // positive combination of p and q (on the minor arc, not its antipode) with the
+            // sign of sq.
+            let x = p * sq - q * sp;
+            out.push((if sq > 0.0 { x } else { -x }).normalize());
         }
     }
     out
@@ -439,4 +529,90 @@ fn convex_area(ring: &[DVec3]) -> f64 {
     (1..ring.len() - 1)
         .map(|k| triangle_area(ring[0], ring[k], ring[k + 1]))
         .sum()
+}
+
+/// Found by the `sphere_tiny` fuzz target while the charts of tiny polygons were being moved
+/// to a coarser planar resolution: `A` is a triangle `6.6e-11` rad long and at most `9e-15`
+/// wide (`3e-25` sr), `B` a triangle `1.1e-10` long, both with vertices exactly on the planes
+/// `y = 0` and `z = 0` (through the axis `-x`), `B`'s long edge through `A`'s corner. At the
+/// coarse resolution the planar split did not settle (two crossings within a snapping distance
+/// of each other); the octant split then cut `A` into a piece thinner than the hemisphere clip's
+/// horizon tolerance, which the clip returned as its whole hemisphere, and `A - B` came back as
+/// a hemisphere (`2 pi` sr), valid and silently wrong. Checked: valid results, the identities,
+/// and each value against the operands' Van Oosterom-Strackee areas (`A n B` is a triangle of
+/// about `1e-27` sr, so `A - B` is `A` and `A u B` is `A + B`), within the operation's
+/// resolution in this regime (`1e-14` rad times the perimeters).
+#[test]
+fn boolean_of_tiny_slivers_on_the_coordinate_planes() {
+    use arealight::planar::BoolOp;
+    let ra = [
+        v(-1.0, -7.8125e-13, 0.0),
+        v(-1.0, 0.0, 0.0),
+        v(-1.0, 6.5625e-11, -7.8125e-13),
+    ];
+    let rb = [
+        v(-1.0, -7.8125e-13, -1.3281250000000001e-11),
+        v(-1.0, -7.8125e-13, 9.921875000000001e-11),
+        v(-1.0, 0.0, 7.109375e-11),
+    ];
+    let a = SphericalPolygon::new(vec![ra.to_vec()]).unwrap();
+    let b = SphericalPolygon::new(vec![rb.to_vec()]).unwrap();
+    let (wa, wb) = (
+        triangle_area(ra[0], ra[1], ra[2]),
+        triangle_area(rb[0], rb[1], rb[2]),
+    );
+    assert!(wa > 0.0 && wb > 0.0, "{wa:e} {wb:e}");
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = (0..3)
+        .map(|k| arc(ra[k], ra[(k + 1) % 3]) + arc(rb[k], rb[(k + 1) % 3]))
+        .sum();
+    let tol = 1e-14 * per;
+    let mut got = Vec::new();
+    for (p, q, op, want) in [
+        (&a, &b, BoolOp::Intersection, 0.0),
+        (&a, &b, BoolOp::Difference, wa),
+        (&b, &a, BoolOp::Difference, wb),
+        (&a, &b, BoolOp::Union, wa + wb),
+        (&a, &b, BoolOp::Xor, wa + wb),
+    ] {
+        let r = p.boolean(q, op).unwrap_or_else(|e| panic!("{op:?}: {e}"));
+        r.validate()
+            .unwrap_or_else(|e| panic!("{op:?}: {e}: {r:?}"));
+        let w = r.solid_angle();
+        assert!((w - want).abs() <= tol, "{op:?}: {w:e} vs {want:e}");
+        got.push(w);
+    }
+    let [i, d, _, u, x] = got[..] else {
+        unreachable!()
+    };
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    assert!((d + i - a.solid_angle()).abs() <= id);
+    assert!((u - (wa + wb - i)).abs() <= id && (x - (u - i)).abs() <= id);
+}
+
+/// The hemisphere clip behind the octant split of [`boolean_of_tiny_slivers_on_the_coordinate_planes`]:
+/// a triangle `6.6e-11` rad long lying in `z <= 0`, two of its vertices within the clip's
+/// `HORIZON_TOLERANCE` (`1e-14`) of the circle `z = 0` (one on it, one `9.2e-15` below), clipped
+/// to `z <= 0`, returns the whole lower hemisphere (`2 pi` sr) instead of itself (`3e-25` sr).
+/// A fault of `src/sphere/clip.rs` (its owner's file, left to it); `boolean` no longer returns
+/// such a piece (its octant split checks that the pieces add up to the operands).
+#[test]
+#[ignore = "sphere clip: a piece thinner than HORIZON_TOLERANCE along the circle is read as the hemisphere"]
+fn clip_of_a_sliver_along_the_horizon_is_not_the_hemisphere() {
+    let t = [
+        v(-1.0, 0.0, 0.0),
+        v(-1.0, 6.5625e-11, -7.8125e-13),
+        v(-1.0, 0.0, -9.191176470588236e-15),
+    ];
+    let p = SphericalPolygon::new(vec![t.to_vec()]).unwrap();
+    let w = triangle_area(t[0], t[1], t[2]);
+    let c = p.clip_to_hemisphere(-DVec3::Z);
+    c.validate().unwrap();
+    // The clip may move the region by HORIZON_TOLERANCE times the edges' lengths.
+    let per = 2.0 * 6.6e-11;
+    assert!(
+        (c.solid_angle() - w).abs() <= 4.0 * 1e-14 * per,
+        "{:e} vs {w:e}",
+        c.solid_angle()
+    );
 }

@@ -92,14 +92,23 @@ impl SphericalPolygon {
             && cos_r >= MIN_CAP_COS
         {
             let sin_r = crate::math::sqrt((1.0 - cos_r * cos_r).max(0.0));
+            let weld_tol = weld_tolerance(sin_r);
             // A result that met a near-degeneracy (vertices welded, parts regularized away, rings
-            // touching or within SEPARATION of each other) is validated; one that fails
-            // validation, or a planar operation that cannot settle a configuration within
-            // rounding, goes to the octant split (other coordinates, simpler pieces).
-            match projected(self, other, op, c, weld_tolerance(sin_r)) {
+            // touching or within SEPARATION of each other), or whose chart resolves finer than
+            // unit vectors carry, is validated. One that fails validation, or a planar operation
+            // that cannot settle a configuration within rounding, is computed again at the
+            // resolution of unit vectors ([`PLANE_MIN_SCALE`]) where that is coarser, and
+            // otherwise goes to the octant split (other coordinates, simpler pieces).
+            match projected(self, other, op, c, weld_tol, Resolution::Chart) {
                 Ok((r, true)) => return Ok(r),
                 Ok((r, false)) if r.validate().is_ok() => return Ok(r),
                 _ => {}
+            }
+            if sin_r < PLANE_MIN_SCALE
+                && let Ok((r, _)) = projected(self, other, op, c, weld_tol, Resolution::Floor)
+                && r.validate().is_ok()
+            {
+                return Ok(r);
             }
         }
         if let Some(r) = separated(self, other, op) {
@@ -228,18 +237,33 @@ struct Planar {
     rebuilt: bool,
 }
 
-/// Smallest coordinate scale at which the planar operations of a projection set their
-/// tolerances ([`boolean_at_scale`]): their snapping distance is then at least
-/// `SNAP_REL / 8` (about `1.8e-15`). A point taken through a projection and back is rounded by
-/// a few `1e-16` (unit vectors carry `1.1e-16` per component), whatever the size of the
-/// operands; a planar result whose features (distances between vertices, from vertices to
-/// edges they are not on) are several times that keeps its topology when unprojected. Charts of
-/// operands larger than about 7 degrees have coordinates above this scale and are unaffected;
-/// for smaller ones the planar coordinates (down to `1e-10` for tiny polygons) would otherwise
-/// set tolerances far below what unit vectors resolve.
+/// Smallest coordinate scale of a chart whose planar results are trusted without validation,
+/// and the scale at which charts below it are resolved when their own resolution fails
+/// ([`Resolution::Floor`], [`boolean_at_scale`]): a snapping distance of `SNAP_REL / 8` (about
+/// `1.8e-15`).
+///
+/// A point taken through a projection and back is rounded by a few `1e-16` (unit vectors carry
+/// `1.1e-16` per component), whatever the size of the operands; a planar result whose features
+/// (distances between vertices, from vertices to edges they are not on) are several times that
+/// keeps its topology when unprojected. The planar operation's tolerances are relative to its
+/// coordinates, which for operands narrower than about 7 degrees are below this scale (down to
+/// `1e-10` for tiny polygons, tolerances of `1e-24`): such results can carry features that
+/// unprojection re-decides by rounding.
 const PLANE_MIN_SCALE: f64 = 0.125;
 
-fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
+/// The resolution of the planar operation in a chart.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Resolution {
+    /// Tolerances relative to the chart's own coordinates (the planar operation as it is):
+    /// the finest, and the result is valid as it is whenever the chart's scale is at least
+    /// [`PLANE_MIN_SCALE`].
+    Chart,
+    /// Tolerances at the scale [`PLANE_MIN_SCALE`] at least, and each operand's own
+    /// near-contacts at that distance resolved first: what unit vectors carry.
+    Floor,
+}
+
+fn to_plane(p: &SphericalPolygon, g: &Gnomonic, res: Resolution) -> Result<Planar, GeomError> {
     // All vertices lie in the open hemisphere about the center, so each ring separates a bounded
     // planar part from the far side; the far side's membership is that of -center, which lies
     // far from every edge.
@@ -266,10 +290,13 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
     // but takes each operand's own features as exact: a vertex closer than that to an edge of
     // its own operand (in rings of integer directions, normalized, `1e-19` is common) stays a
     // near-contact, and a crossing computed on that edge, unprojected, passes on either side of
-    // it. Such an operand is resolved at the operation's resolution first.
-    let scale = |s: &Shape| s.facts.bbox_scale().max(PLANE_MIN_SCALE);
+    // it. At the floor resolution such an operand is resolved at that resolution first.
+    let clear = |s: &Shape| {
+        res == Resolution::Chart
+            || s.is_clear_at(SNAP_REL * s.facts.bbox_scale().max(PLANE_MIN_SCALE))
+    };
     match Shape::new(project()?) {
-        Ok(shape) if shape.is_clear_at(SNAP_REL * scale(&shape)) => Ok(Planar {
+        Ok(shape) if clear(&shape) => Ok(Planar {
             shape,
             complemented,
             rebuilt: false,
@@ -283,11 +310,14 @@ fn to_plane(p: &SphericalPolygon, g: &Gnomonic) -> Result<Planar, GeomError> {
         // fill rule is the same region with those contacts welded, and vertices near edges put
         // on them (the planar resolution).
         _ => Ok(Planar {
-            shape: Shape::with_fill_rule_resolving_at_scale(
-                project()?,
-                FillRule::Positive,
-                PLANE_MIN_SCALE,
-            )?,
+            shape: match res {
+                Resolution::Chart => Shape::with_fill_rule(project()?, FillRule::Positive)?,
+                Resolution::Floor => Shape::with_fill_rule_resolving_at_scale(
+                    project()?,
+                    FillRule::Positive,
+                    PLANE_MIN_SCALE,
+                )?,
+            },
             complemented,
             rebuilt: true,
         }),
@@ -506,6 +536,7 @@ fn projected(
     op: BoolOp,
     c: DVec3,
     weld_tol: f64,
+    res: Resolution,
 ) -> Result<(SphericalPolygon, bool), GeomError> {
     let g = Gnomonic::new(c)?;
     // Welding and snapping move vertices by up to a few weld tolerances; an operand with its
@@ -532,11 +563,17 @@ fn projected(
     );
     let a = snapped.0.as_ref().unwrap_or(a);
     let b = snapped.1.as_ref().unwrap_or(b);
-    let (pa, pb) = (to_plane(a, &g)?, to_plane(b, &g)?);
-    let clean = clean && !pa.rebuilt && !pb.rebuilt;
+    let (pa, pb) = (to_plane(a, &g, res)?, to_plane(b, &g, res)?);
+    let min_scale = match res {
+        Resolution::Chart => 0.0,
+        Resolution::Floor => PLANE_MIN_SCALE,
+    };
+    // A chart below the floor resolves finer than its unprojected result can carry.
+    let coarse = pa.shape.facts.bbox_scale().max(pb.shape.facts.bbox_scale()) >= PLANE_MIN_SCALE;
+    let clean = clean && coarse && !pa.rebuilt && !pb.rebuilt;
     let (ca, cb) = (pa.complemented, pb.complemented);
     let (sa, sb) = (&pa.shape, &pb.shape);
-    let plane = |x: &Shape, y: &Shape, o: BoolOp| boolean_at_scale(x, y, o, PLANE_MIN_SCALE);
+    let plane = |x: &Shape, y: &Shape, o: BoolOp| boolean_at_scale(x, y, o, min_scale);
     // Rewrite the operation on possibly complemented operands as one on bounded shapes, with
     // the result possibly complemented (De Morgan).
     let (shape, complemented) = match (op, ca, cb) {
@@ -651,6 +688,13 @@ fn split(
 ) -> Result<SphericalPolygon, GeomError> {
     let mut edges: Vec<(DVec3, DVec3)> = Vec::new();
     let mut any = false;
+    // Solid angles of the operands' pieces and of the pieces' results, summed over the octants:
+    // the pieces must partition the operands, and the merged result must have the area of its
+    // pieces. Both are exact identities that rounding changes by far less than
+    // [`SPLIT_AREA_TOLERANCE`]; a clip or a merge that breaks them (a piece thinner than the
+    // clip's horizon tolerance read as its whole hemisphere, pieces joined at the wrong
+    // vertices) is reported instead of returned.
+    let (mut sum_a, mut sum_b, mut sum_r) = (0.0, 0.0, 0.0);
     for k in 0..8u8 {
         let s = |bit: u8| if k & bit == 0 { 1.0 } else { -1.0 };
         let (sx, sy, sz) = (s(1), s(2), s(4));
@@ -663,17 +707,39 @@ fn split(
         if pa.is_empty() && pb.is_empty() {
             continue;
         }
+        sum_a += pa.solid_angle();
+        sum_b += pb.solid_angle();
         // Each piece lies in its octant, which the open hemisphere about the octant's center
-        // holds with a margin (cosine 1/sqrt 3).
+        // holds with a margin (cosine 1/sqrt 3). The weld distance follows the pieces' extent,
+        // as in a single projection: pieces of tiny operands are welded at what they resolve.
         let piece = match trivial(&pa, &pb, op) {
             Some(r) => r,
-            None => projected(&pa, &pb, op, DVec3::new(sx, sy, sz), WELD_TOLERANCE)?.0,
+            None => {
+                let verts: SmallVec<[DVec3; 24]> =
+                    pa.rings().chain(pb.rings()).flatten().copied().collect();
+                let weld_tol = enclosing_cap(&verts).map_or(WELD_TOLERANCE, |(_, cos_r)| {
+                    weld_tolerance(crate::math::sqrt((1.0 - cos_r * cos_r).max(0.0)))
+                });
+                let center = DVec3::new(sx, sy, sz);
+                match projected(&pa, &pb, op, center, weld_tol, Resolution::Chart) {
+                    Ok((r, _)) => r,
+                    Err(_) => projected(&pa, &pb, op, center, weld_tol, Resolution::Floor)?.0,
+                }
+            }
         };
+        sum_r += piece.solid_angle();
         for ring in piece.rings() {
             any = true;
             let n = ring.len();
             edges.extend((0..n).map(|i| (ring[i], ring[(i + 1) % n])));
         }
+    }
+    let off = |x: f64, y: f64| !((x - y).abs() <= SPLIT_AREA_TOLERANCE);
+    if off(sum_a, a.solid_angle()) || off(sum_b, b.solid_angle()) {
+        return Err(GeomError::Undecidable(
+            "the octant pieces of an operand do not add up to it; its contacts with the \
+             coordinate planes are below what hemisphere clipping resolves",
+        ));
     }
     if !any {
         return Ok(SphericalPolygon::empty());
@@ -683,20 +749,30 @@ fn split(
         // Every piece boundary lay on a cut and cancelled: the pieces tile the whole sphere.
         return Ok(SphericalPolygon::full());
     }
+    let fits = |r: &SphericalPolygon| r.validate().is_ok() && !off(r.solid_angle(), sum_r);
     match order_directed_edges(&edges) {
-        Ok(r) if r.validate().is_ok() => Ok(r),
+        Ok(r) if fits(&r) => Ok(r),
         // The pieces' rings join at copies of one vertex a few ulps apart (the octants'
         // projections round differently), which the silhouette tolerance of
         // `order_directed_edges` (1e-9) joins; but it also merges distinct vertices of a piece
         // closer than that (a notch left by a sliver occluder, a crossing 1e-11 from a vertex),
         // collapsing a valid piece into an edge walked twice. Joined only within
         // [`SPLIT_MATCH`], such features survive.
-        first => match order_directed_edges_within(&edges, SPLIT_MATCH) {
-            Ok(r) if r.validate().is_ok() => Ok(r),
-            _ => first,
+        _ => match order_directed_edges_within(&edges, SPLIT_MATCH) {
+            Ok(r) if fits(&r) => Ok(r),
+            _ => Err(GeomError::Undecidable(
+                "the octant pieces of the result do not join into rings of their area",
+            )),
         },
     }
 }
+
+/// How far (in steradians) the octant pieces of [`split`] may miss the exact identities
+/// `sum of pieces = operand` and `merged result = sum of piece results`: rounding and the
+/// clip's horizon snapping (`HORIZON_TOLERANCE` times the edges' lengths) change them by about
+/// `1e-12`, a wrong piece by a good part of its octant; a tenth of the identities' own
+/// `1e-9` (the issue's `1e-10 * 4 pi`).
+const SPLIT_AREA_TOLERANCE: f64 = 1e-10;
 
 /// Chord length within which [`split`] joins piece endpoints when the silhouette tolerance
 /// fails: far above the rounding of a unit vector through an octant's projection and back (a
@@ -734,10 +810,15 @@ fn cancel_cut_edges(edges: Vec<(DVec3, DVec3)>) -> Result<Vec<(DVec3, DVec3)>, G
         // Events: (angle, vertex, weight change).
         let mut events: Vec<(f64, DVec3, i32)> = Vec::with_capacity(2 * list.len() + 4);
         for &(a, b) in list {
-            let ccw = a.cross(b).dot(e) > 0.0;
-            let (s, t) = if ccw { (a, b) } else { (b, a) };
+            // The edge is a minor arc: counter-clockwise when the angle turns the short way
+            // round in the positive sense. Decided from the same angles that place the events
+            // (the sign of `(a x b) . e` can disagree with them for an edge a few ulps long,
+            // and would turn it into an interval of almost the whole circle).
+            let (ta, tb) = (ang(a), ang(b));
+            let turn = tb - ta;
+            let ccw = (turn > 0.0 && turn < PI) || turn < -PI;
+            let (s, t, ts, tt) = if ccw { (a, b, ta, tb) } else { (b, a, tb, ta) };
             let w = if ccw { 1 } else { -1 };
-            let (ts, tt) = (ang(s), ang(t));
             if tt >= ts {
                 events.push((ts, s, w));
                 events.push((tt, t, -w));
@@ -794,4 +875,38 @@ fn cancel_cut_edges(edges: Vec<(DVec3, DVec3)>) -> Result<Vec<(DVec3, DVec3)>, G
     // The wrap vertex -u is synthetic; pieces meeting there from both sides re-join, since the
     // two halves of a wrapped interval share it exactly.
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The octant split on two tiny triangles lying across the planes `y = 0` and `z = 0`
+    /// (`tests/sphere_issue24.rs`, `boolean_of_tiny_slivers_on_the_coordinate_planes`): the clip
+    /// turns `A`'s piece in one octant into that octant's hemisphere, and the split used to
+    /// return `A - B` as a hemisphere. Whatever the clip does, the split now returns the region
+    /// within its resolution or gives up.
+    #[test]
+    fn split_gives_up_when_pieces_do_not_add_up() {
+        let v = DVec3::new;
+        let a = SphericalPolygon::new(alloc::vec![alloc::vec![
+            v(-1.0, -7.8125e-13, 0.0),
+            v(-1.0, 0.0, 0.0),
+            v(-1.0, 6.5625e-11, -7.8125e-13),
+        ]])
+        .unwrap();
+        let b = SphericalPolygon::new(alloc::vec![alloc::vec![
+            v(-1.0, -7.8125e-13, -1.3281250000000001e-11),
+            v(-1.0, -7.8125e-13, 9.921875000000001e-11),
+            v(-1.0, 0.0, 7.109375e-11),
+        ]])
+        .unwrap();
+        for op in [BoolOp::Difference, BoolOp::Union, BoolOp::Xor] {
+            match split(&a, &b, op) {
+                Err(e) => assert!(e.is_undecidable(), "{op:?}: {e}"),
+                // A few 1e-23 sr at most, not a hemisphere.
+                Ok(r) => assert!(r.solid_angle() < 1e-20, "{op:?}: {r:?}"),
+            }
+        }
+    }
 }

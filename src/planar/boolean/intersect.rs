@@ -72,29 +72,49 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     let mut ins_a = Inserts::new();
     let mut ins_b = Inserts::new();
     let mut by_x = SnapIndex::default();
-    for pass in 0..MAX_PASSES {
+    let mut all_pairs = true;
+    for _ in 0..MAX_PASSES {
         ins_a.clear();
         ins_b.clear();
         find(
-            a,
-            b,
-            &dirty_a,
-            &dirty_b,
-            pass == 0,
-            snap2,
-            &mut by_x,
-            &mut ins_a,
-            &mut ins_b,
+            a, b, &dirty_a, &dirty_b, all_pairs, snap2, &mut by_x, &mut ins_a, &mut ins_b,
         );
         if ins_a.is_empty() && ins_b.is_empty() {
             return Ok(());
         }
+        // A crossing snaps to the vertices that exist when it is found, not to the other
+        // crossings of its pass: two crossings within the snapping distance of each other (two
+        // edges crossing a third where they nearly meet) would each be inserted next to the
+        // other, pass after pass, into the edges that end at the other. Welding makes them one
+        // point; the rebuilt rings are tested again in full.
+        let close = new_points_close(&ins_a, &ins_b, snap2);
         apply(a, &mut ins_a, &mut dirty_a);
         apply(b, &mut ins_b, &mut dirty_b);
+        all_pairs = close && weld(a, b, scale) == Weld::Moved;
+        if all_pairs {
+            by_x = SnapIndex::default();
+        }
     }
     Err(GeomError::Undecidable(
         "edge intersections did not settle; the operands have long nearly-overlapping edges",
     ))
+}
+
+/// Whether two distinct points computed in one pass (bent insertions) lie within the snapping
+/// distance of each other. Passes insert a few points, so all pairs are compared.
+fn new_points_close(ins_a: &Inserts, ins_b: &Inserts, snap2: f64) -> bool {
+    let bent = |x: &&Insert| x.bent;
+    let pts: SmallVec<[DVec2; 16]> = ins_a
+        .iter()
+        .chain(ins_b.iter())
+        .filter(bent)
+        .map(|x| x.p)
+        .collect();
+    pts.iter().enumerate().any(|(i, &p)| {
+        pts[i + 1..]
+            .iter()
+            .any(|&q| p != q && (p - q).length_squared() <= snap2)
+    })
 }
 
 /// Splits the rings of one ring soup at every contact among all its edges, within a ring and
