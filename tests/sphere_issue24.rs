@@ -351,18 +351,17 @@ fn intersection_of_tiny_polygons_is_a_valid_polygon() {
 }
 
 /// The value of [`intersection_of_tiny_polygons_is_a_valid_polygon`], computed independently.
-/// `A` is the outside of the triangle `T`; `B`'s ring passes through its own vertex
-/// `P = (-117, -1)` (to `4e-19` rad), cutting off a clockwise lobe `P, (-1, 10), (-1, -1)` that
-/// is not part of `B`, and `T` (with its base on the line `y = -1`) lies partly in that lobe.
-/// So `A n B = B - (T - lobe)`: `B` by a fan of signed Van Oosterom-Strackee triangles, `T n
-/// lobe` by Sutherland-Hodgman of two convex triangles. Exact offsets (shoelace, rational clip):
+/// `A` is the outside of the triangle `T`; `B`'s ring passes its own vertex `P = (-117, -1)`
+/// `4e-19` rad from its edge along `y = -1`, cutting off a clockwise lobe `P, (-1, 10), (-1, -1)`
+/// that is not part of `B`, and `T` (its base on the line `y = -1`) lies partly in that lobe. So
+/// `A n B = B - (T - lobe)`: `B` by a fan of signed Van Oosterom-Strackee triangles, `T n lobe`
+/// by Sutherland-Hodgman of two convex triangles. Exact offsets (shoelace, rational clip):
 /// `|B| = 12670`, `|T| = 414`, `|T n lobe| = 87.317` units of `size^2`, so `A n B = 12343.3`
-/// units (`7.5338e-21` sr). Both projections compute that area but their rings cross themselves
-/// within rounding (`SelfIntersecting`), and the octant split's piece, projected about the
-/// octant's center, is valid with `11932` units: a valid polygon of the wrong region.
+/// units (`7.5338e-21` sr). It came back valid with `7.2828e-21` sr (11932 units, another
+/// region): the planar split's edge boxes had no snapping margin, so `P`, `5e-7` units above the
+/// edge's box of no height, was never tested against it; the chart's result kept the edge past
+/// `P` (a self-crossing ring on the sphere) and the octant split's piece was valid and wrong.
 #[test]
-#[ignore = "sphere boolean: A n B = 7.2828e-21 sr vs B - (T - lobe) = 7.5338e-21 (the octant \
-            split's piece is valid and wrong; both projections are SelfIntersecting)"]
 fn intersection_of_tiny_polygons_has_the_right_area() {
     use arealight::planar::BoolOp;
     let c = v(127.0, -1.0, 65.0).normalize();

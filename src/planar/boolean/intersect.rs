@@ -142,7 +142,7 @@ pub(crate) fn split_within(r: &mut Rings, scale: f64) -> Result<(), GeomError> {
     for pass in 0..MAX_PASSES {
         ins.clear();
         ins_b.clear();
-        edge_boxes(r, &mut boxes);
+        edge_boxes(r, &mut boxes, SNAP_REL * scale);
         let bx: &[EdgeBox] = &boxes;
         let mut test = |i: usize, j: usize| {
             let (box_i, p0, p1) = &bx[i];
@@ -426,8 +426,10 @@ pub(crate) fn split_self_contacts(r: &mut Rings) {
 type EdgeBox = ([f64; 4], DVec2, DVec2);
 
 /// Fills `out` with the edges of `r` (kept in the caller's frame: these buffers are large and
-/// moving them would cost more than filling them).
-fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
+/// moving them would cost more than filling them), each box grown by `pad`, the snapping
+/// distance: a vertex within that distance of an edge is a contact, and beside an edge nearly
+/// parallel to an axis (a box of almost no height) it can lie outside the edge's own box.
+fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>, pad: f64) {
     out.clear();
     let mut start = 0usize;
     for &end in &r.ends {
@@ -437,10 +439,10 @@ fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
             let p1 = r.pts[if i + 1 == end { start } else { i + 1 }];
             out.push((
                 [
-                    p0.x.min(p1.x),
-                    p0.x.max(p1.x),
-                    p0.y.min(p1.y),
-                    p0.y.max(p1.y),
+                    p0.x.min(p1.x) - pad,
+                    p0.x.max(p1.x) + pad,
+                    p0.y.min(p1.y) - pad,
+                    p0.y.max(p1.y) + pad,
                 ],
                 p0,
                 p1,
@@ -475,8 +477,9 @@ fn find(
 ) {
     let mut ba: SmallVec<[EdgeBox; 32]> = SmallVec::new();
     let mut bb: SmallVec<[EdgeBox; 32]> = SmallVec::new();
-    edge_boxes(a, &mut ba);
-    edge_boxes(b, &mut bb);
+    let pad = sqrt(snap2);
+    edge_boxes(a, &mut ba, pad);
+    edge_boxes(b, &mut bb, pad);
     // Plain slices: indexing a SmallVec re-checks whether it spilled on every access.
     let (ba, bb): (&[EdgeBox], &[EdgeBox]) = (&ba, &bb);
 
