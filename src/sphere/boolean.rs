@@ -777,11 +777,14 @@ fn split(
 }
 
 /// How far (in steradians) the octant pieces of [`split`] may miss the exact identities
-/// `sum of pieces = operand` and `merged result = sum of piece results`: rounding and the
-/// clip's horizon snapping (`HORIZON_TOLERANCE` times the edges' lengths) change them by about
-/// `1e-12`, a wrong piece by a good part of its octant; a tenth of the identities' own
-/// `1e-9` (the issue's `1e-10 * 4 pi`).
-const SPLIT_AREA_TOLERANCE: f64 = 1e-10;
+/// `sum of pieces = operand` and `merged result = sum of piece results`: the set identities'
+/// own bound, `1e-10 * 4 pi`. Rounding and the clip's horizon snapping (`HORIZON_TOLERANCE`
+/// times the edges' lengths) change them by about `1e-12` for ordinary edges, but an edge between
+/// nearly antipodal vertices turns by the snapping distance over its lever ([`arc_lever`]): a
+/// triangle with two vertices `1.7e-6` from antipodal has pieces `1.1e-10` to `1.9e-10` off
+/// (`tests/solid_silhouette.rs`, `sphere_union_of_a_near_hemisphere_triangle_and_a_sliver`). A
+/// wrong piece (a sliver read as its hemisphere) misses by a good part of its octant.
+const SPLIT_AREA_TOLERANCE: f64 = 1e-10 * 4.0 * core::f64::consts::PI;
 
 /// Chord length within which [`split`] joins piece endpoints when the silhouette tolerance
 /// fails: far above the rounding of a unit vector through an octant's projection and back (a
