@@ -615,3 +615,53 @@ fn clip_of_a_sliver_along_the_horizon_is_not_the_hemisphere() {
         c.solid_angle()
     );
 }
+
+/// Found by the `sphere_sliver` fuzz target: a polygon of `7.16` sr (more than a hemisphere, so
+/// the operation runs on octant pieces) and its copy with the vertex at the pole moved by
+/// `1.3e-9`. With the octant merge checked only at the identities' bound, `A u B` came back
+/// `1.2e-9` sr too small (below `|A|`) and `|A u B| + |A n B| = |A| + |B|` missed by `1.7e-9`.
+/// Checked: the identities at `1e-10 * 4 pi`, the union at least and the intersection at most
+/// each operand, and `A xor B = (A - B) + (B - A)`.
+#[test]
+fn union_of_a_large_polygon_and_its_copy_with_a_moved_vertex() {
+    use arealight::planar::BoolOp;
+    let rest = [
+        v(
+            -0.7070649442619075,
+            -0.7070649442619075,
+            -0.010877922219413961,
+        ),
+        v(-0.9964877666150213, 0.0837384677827749, 0.0),
+        v(-0.6442445271824221, 0.7178724731461275, -0.263833473036611),
+        v(1.0, 0.0, 0.0),
+        v(0.7071067811865475, -0.7071067811865475, 0.0),
+    ];
+    let ring = |first: DVec3| {
+        let mut r = vec![first];
+        r.extend(rest);
+        SphericalPolygon::new(vec![r]).unwrap()
+    };
+    let a = ring(v(0.0, 0.0, 1.0));
+    let b = ring(v(1.3117409525462145e-9, 0.0, 1.0));
+    let (wa, wb) = (a.solid_angle(), b.solid_angle());
+    let w = |p: &SphericalPolygon, q: &SphericalPolygon, op| {
+        let r = p.boolean(q, op).unwrap_or_else(|e| panic!("{op:?}: {e}"));
+        r.validate().unwrap_or_else(|e| panic!("{op:?}: {e}"));
+        r.solid_angle()
+    };
+    let u = w(&a, &b, BoolOp::Union);
+    let i = w(&a, &b, BoolOp::Intersection);
+    let (d, e) = (w(&a, &b, BoolOp::Difference), w(&b, &a, BoolOp::Difference));
+    let x = w(&a, &b, BoolOp::Xor);
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    assert!((u + i - wa - wb).abs() <= id, "{u} + {i} vs {wa} + {wb}");
+    assert!(
+        u >= wa.max(wb) - 1e-12 && i <= wa.min(wb) + 1e-12,
+        "{u} {i} {wa} {wb}"
+    );
+    assert!(
+        (d + i - wa).abs() <= id && (e + i - wb).abs() <= id,
+        "{d} {e} {i}"
+    );
+    assert!((x - d - e).abs() <= id, "{x} vs {d} + {e}");
+}
