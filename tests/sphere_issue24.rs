@@ -665,3 +665,79 @@ fn union_of_a_large_polygon_and_its_copy_with_a_moved_vertex() {
     );
     assert!((x - d - e).abs() <= id, "{x} vs {d} + {e}");
 }
+
+/// Found by the `sphere_tiny` fuzz target: the outsides of two disjoint pentagons about `1e-6`
+/// rad across. `A u B` is the whole sphere; with the chart run at its own resolution it came
+/// back empty in one order (full in the other), which validation cannot question. Checked in
+/// both orders against `|A| + |B| - |A n B|` at `1e-10 * 4 pi`.
+#[test]
+fn union_of_the_outsides_of_two_tiny_pentagons_is_the_sphere() {
+    use arealight::planar::BoolOp;
+    let a = SphericalPolygon::new(vec![vec![
+        v(
+            -0.025598975915212336,
+            0.9983604200682811,
+            -0.051197305331216705,
+        ),
+        v(
+            -0.02559956108745928,
+            0.9983603902234119,
+            -0.051197594719733196,
+        ),
+        v(
+            -0.02559901567291552,
+            0.9983603846812054,
+            -0.051197975504636006,
+        ),
+        v(
+            -0.02559934395313647,
+            0.9983603594848224,
+            -0.05119830269164734,
+        ),
+        v(
+            -0.0255990009872476,
+            0.9983603666276564,
+            -0.05119833489037246,
+        ),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(
+            -0.025598995289060157,
+            0.9983603787733462,
+            -0.05119810089966002,
+        ),
+        v(
+            -0.025598482135137168,
+            0.9983604360828496,
+            -0.051197239933802804,
+        ),
+        v(
+            -0.025598991870147015,
+            0.9983603860607336,
+            -0.05119796050523121,
+        ),
+        v(
+            -0.025598959120110884,
+            0.9983603900593245,
+            -0.05119789890767521,
+        ),
+        v(
+            -0.025598975345393037,
+            0.9983604212828284,
+            -0.05119728193214436,
+        ),
+    ]])
+    .unwrap();
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        let u = p.boolean(q, BoolOp::Union).unwrap();
+        let i = p.boolean(q, BoolOp::Intersection).unwrap();
+        let want = a.solid_angle() + b.solid_angle() - i.solid_angle();
+        assert!(
+            (u.solid_angle() - want).abs() <= id && u.is_full(),
+            "{} vs {want}",
+            u.solid_angle()
+        );
+    }
+}

@@ -94,21 +94,21 @@ impl SphericalPolygon {
             let sin_r = crate::math::sqrt((1.0 - cos_r * cos_r).max(0.0));
             let weld_tol = weld_tolerance(sin_r);
             // A result that met a near-degeneracy (vertices welded, parts regularized away, rings
-            // touching or within SEPARATION of each other), or whose chart resolves finer than
-            // unit vectors carry, is validated. One that fails validation, or a planar operation
-            // that cannot settle a configuration within rounding, is computed again at the
-            // resolution of unit vectors ([`PLANE_MIN_SCALE`]) where that is coarser, and
-            // otherwise goes to the octant split (other coordinates, simpler pieces).
-            match projected(self, other, op, c, weld_tol, Resolution::Chart) {
+            // touching or within SEPARATION of each other) is validated; one that fails
+            // validation, or a planar operation that cannot settle a configuration within
+            // rounding, goes to the octant split (other coordinates, simpler pieces). A chart
+            // narrower than [`PLANE_MIN_SCALE`] runs at that resolution: at its own, the planar
+            // operation keeps features that unprojection re-decides, and an empty or full result
+            // (which validation cannot question) can be the wrong one of the two.
+            let res = if sin_r < PLANE_MIN_SCALE {
+                Resolution::Floor
+            } else {
+                Resolution::Chart
+            };
+            match projected(self, other, op, c, weld_tol, res) {
                 Ok((r, true)) => return Ok(r),
                 Ok((r, false)) if r.validate().is_ok() => return Ok(r),
                 _ => {}
-            }
-            if sin_r < PLANE_MIN_SCALE
-                && let Ok((r, _)) = projected(self, other, op, c, weld_tol, Resolution::Floor)
-                && r.validate().is_ok()
-            {
-                return Ok(r);
             }
         }
         if let Some(r) = separated(self, other, op) {
@@ -730,10 +730,7 @@ fn split(
                     pa.rings().chain(pb.rings()).flatten().copied().collect();
                 let weld_tol = cap_tolerance(&verts).min(op_tol);
                 let center = DVec3::new(sx, sy, sz);
-                match projected(&pa, &pb, op, center, weld_tol, Resolution::Chart) {
-                    Ok((r, _)) => r,
-                    Err(_) => projected(&pa, &pb, op, center, weld_tol, Resolution::Floor)?.0,
-                }
+                projected(&pa, &pb, op, center, weld_tol, Resolution::Floor)?.0
             }
         };
         sum_r += piece.solid_angle();
