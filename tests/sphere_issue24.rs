@@ -315,12 +315,15 @@ fn intersection_of_the_outsides_of_antipodal_tiny_triangles() {
 
 /// Found by the `sphere_tiny` fuzz target with the bounds: a triangle and a hexagon
 /// about `1e-10` rad across (the low end of the tiny range), the triangle's ring
-/// clockwise (so `A` is everything but it). `A n B` (B less the triangle, `7.5e-21` sr) comes
-/// back as a ring that crosses itself: an output that is not a valid input. Fails today; the
-/// sphere layer's booleans lose validity when the result's vertices, rounded to unit vectors
-/// (`1e-16` absolute), are `1e-6` of the polygon's size apart.
+/// clockwise (so `A` is everything but it). `A n B` (B less the triangle, `7.5e-21` sr) came
+/// back as a ring that crosses itself: an output that is not a valid input. Three of the
+/// hexagon's vertices lie on one line in the integer offsets, so after normalization one of them
+/// is `4e-19` rad (`5e-7` of the size) off the hexagon's own edge. Through the gnomonic chart
+/// and back every vertex is rounded by a few `1e-16` (unit vectors), and the planar operation
+/// worked at the chart's own scale (`1e-24`), keeping that near-contact and re-deciding it by
+/// rounding. The planar operations now resolve at what unit vectors carry, and an operand's own
+/// near-contacts are resolved before them (breaking either makes this test fail again).
 #[test]
-#[ignore = "sphere layer: booleans of polygons 1e-10 rad across can return self-crossing rings"]
 fn intersection_of_tiny_polygons_is_a_valid_polygon() {
     use arealight::planar::BoolOp;
     let c = v(127.0, -1.0, 65.0).normalize();
@@ -347,14 +350,96 @@ fn intersection_of_tiny_polygons_is_a_valid_polygon() {
     }
 }
 
+/// The value of [`intersection_of_tiny_polygons_is_a_valid_polygon`], computed independently.
+/// `A` is the outside of the triangle `T`; `B`'s ring passes its own vertex `P = (-117, -1)`
+/// `4e-19` rad from its edge along `y = -1`, cutting off a clockwise lobe `P, (-1, 10), (-1, -1)`
+/// that is not part of `B`, and `T` (its base on the line `y = -1`) lies partly in that lobe. So
+/// `A n B = B - (T - lobe)`: `B` by a fan of signed Van Oosterom-Strackee triangles, `T n lobe`
+/// by Sutherland-Hodgman of two convex triangles. Exact offsets (shoelace, rational clip):
+/// `|B| = 12670`, `|T| = 414`, `|T n lobe| = 87.317` units of `size^2`, so `A n B = 12343.3`
+/// units (`7.5338e-21` sr). It came back valid with `7.2828e-21` sr (11932 units, another
+/// region): the planar split's edge boxes had no snapping margin, so `P`, `5e-7` units above the
+/// edge's box of no height, was never tested against it; the chart's result kept the edge past
+/// `P` (a self-crossing ring on the sphere) and the octant split's piece was valid and wrong.
+#[test]
+fn intersection_of_tiny_polygons_has_the_right_area() {
+    use arealight::planar::BoolOp;
+    let c = v(127.0, -1.0, 65.0).normalize();
+    let size = 1e-10 / 128.0;
+    let (u, w) = c.any_orthonormal_pair();
+    let ring = |pts: &[(f64, f64)]| -> Vec<DVec3> {
+        pts.iter()
+            .map(|&(x, y)| (c + (u * x + w * y) * size).normalize())
+            .collect()
+    };
+    let ra = ring(&[(11., 45.), (-63., -1.), (-81., -1.)]);
+    let rb = ring(&[
+        (4., -116.),
+        (43., 65.),
+        (-117., -1.),
+        (-1., 10.),
+        (-1., -1.),
+        (-119., -1.),
+    ]);
+    let a = SphericalPolygon::new(vec![ra.clone()]).unwrap();
+    let b = SphericalPolygon::new(vec![rb.clone()]).unwrap();
+    let fan = |r: &[DVec3]| -> f64 {
+        (1..r.len() - 1)
+            .map(|k| triangle_area(r[0], r[k], r[k + 1]))
+            .sum()
+    };
+    let wb = fan(&rb);
+    // Both counter-clockwise.
+    let t = [ra[0], ra[2], ra[1]];
+    let lobe = [rb[2], rb[4], rb[3]];
+    let mut t_in_lobe = t.to_vec();
+    for k in 0..3 {
+        // The normal from the edge's difference vector (the cross product of two unit
+        // vectors `1e-10` apart loses all but six digits).
+        let (p, q) = (lobe[k], lobe[(k + 1) % 3]);
+        t_in_lobe = clip_to_great_circle(&t_in_lobe, p.cross(q - p));
+    }
+    let (wt, wtl) = (convex_area(&t), convex_area(&t_in_lobe));
+    let s2 = size * size;
+    assert!(
+        (wb / s2 - 12670.0).abs() < 0.1 && (wt / s2 - 414.0).abs() < 0.1,
+        "{} {}",
+        wb / s2,
+        wt / s2
+    );
+    assert!((wtl / s2 - 87.317).abs() < 0.01, "{}", wtl / s2);
+    let want = wb - (wt - wtl);
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = [&ra, &rb]
+        .iter()
+        .flat_map(|r| (0..r.len()).map(|k| arc(r[k], r[(k + 1) % r.len()])))
+        .sum();
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        match p.boolean(q, BoolOp::Intersection) {
+            Ok(r) => {
+                r.validate().unwrap_or_else(|e| panic!("{e}: {r:?}"));
+                let got = r.solid_angle();
+                assert!(
+                    (got - want).abs() <= 1e-14 * per,
+                    "A n B = {got:e} vs B - (T - lobe) = {want:e}"
+                );
+            }
+            Err(e) => assert!(e.is_undecidable(), "{e}"),
+        }
+    }
+}
+
 /// Found by the `sphere_sliver` fuzz target once its identities were checked at the issue's
 /// `1e-10 * 4 pi` (they were at `1e-9 * 4 pi`): a triangle larger than a hemisphere with a
-/// nearly antipodal edge (`|a + b| = 0.0137`), and its copy with that edge's vertex moved by
-/// `2.1e-9`. `A - B` comes back empty and `A n B` `1.7e-9` sr short of `A`: the sliver between
-/// the two near-antipodal edges, a lever of `2 / |a + b| = 146` on the move, is lost.
-/// `area(A - B) + area(A n B) = area(A)` misses by `1.4` times the bound. Fails today.
+/// nearly antipodal edge `a -> b` (`|a + b| = 0.0137`), and its copy with `a` moved by `2.1e-9`
+/// to `a'`, which lies `1.2e-11` from the edge `a -> b`. Snapping `a'` onto that edge (within the
+/// operation's `4e-11`) turned the edge about `b` by `1.2e-11 / sin|a b|`, moving its middle by
+/// `8.7e-10` and the region by `1.7e-9` sr: `A - B` came back empty, and
+/// `area(A - B) + area(A n B) = area(A)` missed by `1.4` times the bound. Snapping now bounds how
+/// far the edges move, not the vertex. Checked against the identity and against `A - B`
+/// computed independently: it is `B' - (B' n A')` for the complements `A'`, `B'`, two small
+/// convex triangles, clipped in `f64` (Sutherland-Hodgman by `A'`'s three great circles).
 #[test]
-#[ignore = "sphere layer: set identities near nearly antipodal edges miss 1e-10 * 4 pi"]
 fn difference_identity_next_to_a_nearly_antipodal_edge() {
     use arealight::planar::BoolOp;
     let a = SphericalPolygon::new(vec![vec![
@@ -383,5 +468,315 @@ fn difference_identity_next_to_a_nearly_antipodal_edge() {
     assert!(
         (d + i - wa).abs() <= 1e-10 * 4.0 * std::f64::consts::PI,
         "{d} + {i} vs {wa}"
+    );
+    // The complements, counter-clockwise around their small sides.
+    let ring = |p: &SphericalPolygon| -> Vec<DVec3> { p.rings().next().unwrap().to_vec() };
+    let (ra, rb) = (ring(&a), ring(&b));
+    let a_c: Vec<DVec3> = ra.iter().rev().copied().collect();
+    let b_c: Vec<DVec3> = rb.iter().rev().copied().collect();
+    let mut both = b_c.clone();
+    for k in 0..3 {
+        both = clip_to_great_circle(&both, a_c[k].cross(a_c[(k + 1) % 3]));
+    }
+    let exact = convex_area(&b_c) - convex_area(&both);
+    assert!(exact > 1e-9 && exact < 3e-9, "{exact:e}");
+    // The operation's documented resolution: edges move by at most 1e-11 (weld distance)
+    // times their length; the sliver lost before was 1.7e-9.
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = (0..3)
+        .map(|k| arc(ra[k], ra[(k + 1) % 3]) + arc(rb[k], rb[(k + 1) % 3]))
+        .sum();
+    assert!(
+        (d - exact).abs() <= 1e-11 * per,
+        "A - B = {d:e} vs {exact:e}"
+    );
+    assert!(
+        (i - (wa - exact)).abs() <= 1e-11 * per,
+        "A n B = {i} vs {}",
+        wa - exact
+    );
+}
+
+/// Sutherland-Hodgman: the part of a convex spherical polygon (minor arcs, within a hemisphere)
+/// on the side `n . x >= 0` of a great circle (`n` a unit vector or not). Vertices within
+/// `1e-15` of the circle count as on it (the two triangles share an edge, whose vertices are on
+/// its circle only to rounding), which moves the area by at most that times the perimeter.
+fn clip_to_great_circle(ring: &[DVec3], n: DVec3) -> Vec<DVec3> {
+    let n = n.normalize();
+    let eps = 1e-15;
+    let mut out = Vec::new();
+    for k in 0..ring.len() {
+        let (p, q) = (ring[k], ring[(k + 1) % ring.len()]);
+        let (sp, sq) = (n.dot(p), n.dot(q));
+        if sp >= -eps {
+            out.push(p);
+        }
+        if (sp > eps && sq < -eps) || (sp < -eps && sq > eps) {
+            // The point of the arc on the circle: p sq - q sp is orthogonal to n, and a
+            // positive combination of p and q (on the minor arc, not its antipode) with the
+            // sign of sq.
+            let x = p * sq - q * sp;
+            out.push((if sq > 0.0 { x } else { -x }).normalize());
+        }
+    }
+    out
+}
+
+/// Solid angle of a convex spherical polygon, counter-clockwise: a fan of Van Oosterom-Strackee
+/// triangles from its first vertex.
+fn convex_area(ring: &[DVec3]) -> f64 {
+    (1..ring.len() - 1)
+        .map(|k| triangle_area(ring[0], ring[k], ring[k + 1]))
+        .sum()
+}
+
+/// Found by the `sphere_tiny` fuzz target while the charts of tiny polygons were being moved
+/// to a coarser planar resolution: `A` is a triangle `6.6e-11` rad long and at most `9e-15`
+/// wide (`3e-25` sr), `B` a triangle `1.1e-10` long, both with vertices exactly on the planes
+/// `y = 0` and `z = 0` (through the axis `-x`), `B`'s long edge through `A`'s corner. At the
+/// coarse resolution the planar split did not settle (two crossings within a snapping distance
+/// of each other); the octant split then cut `A` into a piece thinner than the hemisphere clip's
+/// horizon tolerance, which the clip returned as its whole hemisphere, and `A - B` came back as
+/// a hemisphere (`2 pi` sr), valid and silently wrong. Checked: valid results, the identities,
+/// and each value against the operands' Van Oosterom-Strackee areas (`A n B` is a triangle of
+/// about `1e-27` sr, so `A - B` is `A` and `A u B` is `A + B`), within the operation's
+/// resolution in this regime (`1e-14` rad times the perimeters).
+#[test]
+fn boolean_of_tiny_slivers_on_the_coordinate_planes() {
+    use arealight::planar::BoolOp;
+    let ra = [
+        v(-1.0, -7.8125e-13, 0.0),
+        v(-1.0, 0.0, 0.0),
+        v(-1.0, 6.5625e-11, -7.8125e-13),
+    ];
+    let rb = [
+        v(-1.0, -7.8125e-13, -1.3281250000000001e-11),
+        v(-1.0, -7.8125e-13, 9.921875000000001e-11),
+        v(-1.0, 0.0, 7.109375e-11),
+    ];
+    let a = SphericalPolygon::new(vec![ra.to_vec()]).unwrap();
+    let b = SphericalPolygon::new(vec![rb.to_vec()]).unwrap();
+    let (wa, wb) = (
+        triangle_area(ra[0], ra[1], ra[2]),
+        triangle_area(rb[0], rb[1], rb[2]),
+    );
+    assert!(wa > 0.0 && wb > 0.0, "{wa:e} {wb:e}");
+    let arc = |p: DVec3, q: DVec3| p.cross(q).length().atan2(p.dot(q));
+    let per: f64 = (0..3)
+        .map(|k| arc(ra[k], ra[(k + 1) % 3]) + arc(rb[k], rb[(k + 1) % 3]))
+        .sum();
+    let tol = 1e-14 * per;
+    let mut got = Vec::new();
+    for (p, q, op, want) in [
+        (&a, &b, BoolOp::Intersection, 0.0),
+        (&a, &b, BoolOp::Difference, wa),
+        (&b, &a, BoolOp::Difference, wb),
+        (&a, &b, BoolOp::Union, wa + wb),
+        (&a, &b, BoolOp::Xor, wa + wb),
+    ] {
+        let r = p.boolean(q, op).unwrap_or_else(|e| panic!("{op:?}: {e}"));
+        r.validate()
+            .unwrap_or_else(|e| panic!("{op:?}: {e}: {r:?}"));
+        let w = r.solid_angle();
+        assert!((w - want).abs() <= tol, "{op:?}: {w:e} vs {want:e}");
+        got.push(w);
+    }
+    let [i, d, _, u, x] = got[..] else {
+        unreachable!()
+    };
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    assert!((d + i - a.solid_angle()).abs() <= id);
+    assert!((u - (wa + wb - i)).abs() <= id && (x - (u - i)).abs() <= id);
+}
+
+/// The hemisphere clip behind the octant split of [`boolean_of_tiny_slivers_on_the_coordinate_planes`]:
+/// a triangle `6.6e-11` rad long lying in `z <= 0`, two of its vertices within the clip's
+/// `HORIZON_TOLERANCE` (`1e-14`) of the circle `z = 0` (one on it, one `9.2e-15` below), clipped
+/// to `z <= 0`, returns the whole lower hemisphere (`2 pi` sr) instead of itself (`3e-25` sr).
+/// A fault of `src/sphere/clip.rs` (its owner's file, left to it); `boolean` no longer returns
+/// such a piece (its octant split checks that the pieces add up to the operands).
+#[test]
+#[ignore = "sphere clip: a piece thinner than HORIZON_TOLERANCE along the circle is read as the hemisphere"]
+fn clip_of_a_sliver_along_the_horizon_is_not_the_hemisphere() {
+    let t = [
+        v(-1.0, 0.0, 0.0),
+        v(-1.0, 6.5625e-11, -7.8125e-13),
+        v(-1.0, 0.0, -9.191176470588236e-15),
+    ];
+    let p = SphericalPolygon::new(vec![t.to_vec()]).unwrap();
+    let w = triangle_area(t[0], t[1], t[2]);
+    let c = p.clip_to_hemisphere(-DVec3::Z);
+    c.validate().unwrap();
+    // The clip may move the region by HORIZON_TOLERANCE times the edges' lengths.
+    let per = 2.0 * 6.6e-11;
+    assert!(
+        (c.solid_angle() - w).abs() <= 4.0 * 1e-14 * per,
+        "{:e} vs {w:e}",
+        c.solid_angle()
+    );
+}
+
+/// Found by the `sphere_sliver` fuzz target: a polygon of `7.16` sr (more than a hemisphere, so
+/// the operation runs on octant pieces) and its copy with the vertex at the pole moved by
+/// `1.3e-9`. With the octant merge checked only at the identities' bound, `A u B` came back
+/// `1.2e-9` sr too small (below `|A|`) and `|A u B| + |A n B| = |A| + |B|` missed by `1.7e-9`.
+/// Checked: the identities at `1e-10 * 4 pi`, the union at least and the intersection at most
+/// each operand, and `A xor B = (A - B) + (B - A)`.
+#[test]
+fn union_of_a_large_polygon_and_its_copy_with_a_moved_vertex() {
+    use arealight::planar::BoolOp;
+    let rest = [
+        v(
+            -0.7070649442619075,
+            -0.7070649442619075,
+            -0.010877922219413961,
+        ),
+        v(-0.9964877666150213, 0.0837384677827749, 0.0),
+        v(-0.6442445271824221, 0.7178724731461275, -0.263833473036611),
+        v(1.0, 0.0, 0.0),
+        v(0.7071067811865475, -0.7071067811865475, 0.0),
+    ];
+    let ring = |first: DVec3| {
+        let mut r = vec![first];
+        r.extend(rest);
+        SphericalPolygon::new(vec![r]).unwrap()
+    };
+    let a = ring(v(0.0, 0.0, 1.0));
+    let b = ring(v(1.3117409525462145e-9, 0.0, 1.0));
+    let (wa, wb) = (a.solid_angle(), b.solid_angle());
+    let w = |p: &SphericalPolygon, q: &SphericalPolygon, op| {
+        let r = p.boolean(q, op).unwrap_or_else(|e| panic!("{op:?}: {e}"));
+        r.validate().unwrap_or_else(|e| panic!("{op:?}: {e}"));
+        r.solid_angle()
+    };
+    let u = w(&a, &b, BoolOp::Union);
+    let i = w(&a, &b, BoolOp::Intersection);
+    let (d, e) = (w(&a, &b, BoolOp::Difference), w(&b, &a, BoolOp::Difference));
+    let x = w(&a, &b, BoolOp::Xor);
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    assert!((u + i - wa - wb).abs() <= id, "{u} + {i} vs {wa} + {wb}");
+    assert!(
+        u >= wa.max(wb) - 1e-12 && i <= wa.min(wb) + 1e-12,
+        "{u} {i} {wa} {wb}"
+    );
+    assert!(
+        (d + i - wa).abs() <= id && (e + i - wb).abs() <= id,
+        "{d} {e} {i}"
+    );
+    assert!((x - d - e).abs() <= id, "{x} vs {d} + {e}");
+}
+
+/// Found by the `sphere_tiny` fuzz target: the outsides of two disjoint pentagons about `1e-6`
+/// rad across. `A u B` is the whole sphere; with the chart run at its own resolution it came
+/// back empty in one order (full in the other), which validation cannot question. Checked in
+/// both orders against `|A| + |B| - |A n B|` at `1e-10 * 4 pi`.
+#[test]
+fn union_of_the_outsides_of_two_tiny_pentagons_is_the_sphere() {
+    use arealight::planar::BoolOp;
+    let a = SphericalPolygon::new(vec![vec![
+        v(
+            -0.025598975915212336,
+            0.9983604200682811,
+            -0.051197305331216705,
+        ),
+        v(
+            -0.02559956108745928,
+            0.9983603902234119,
+            -0.051197594719733196,
+        ),
+        v(
+            -0.02559901567291552,
+            0.9983603846812054,
+            -0.051197975504636006,
+        ),
+        v(
+            -0.02559934395313647,
+            0.9983603594848224,
+            -0.05119830269164734,
+        ),
+        v(
+            -0.0255990009872476,
+            0.9983603666276564,
+            -0.05119833489037246,
+        ),
+    ]])
+    .unwrap();
+    let b = SphericalPolygon::new(vec![vec![
+        v(
+            -0.025598995289060157,
+            0.9983603787733462,
+            -0.05119810089966002,
+        ),
+        v(
+            -0.025598482135137168,
+            0.9983604360828496,
+            -0.051197239933802804,
+        ),
+        v(
+            -0.025598991870147015,
+            0.9983603860607336,
+            -0.05119796050523121,
+        ),
+        v(
+            -0.025598959120110884,
+            0.9983603900593245,
+            -0.05119789890767521,
+        ),
+        v(
+            -0.025598975345393037,
+            0.9983604212828284,
+            -0.05119728193214436,
+        ),
+    ]])
+    .unwrap();
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        let u = p.boolean(q, BoolOp::Union).unwrap();
+        let i = p.boolean(q, BoolOp::Intersection).unwrap();
+        let want = a.solid_angle() + b.solid_angle() - i.solid_angle();
+        assert!(
+            (u.solid_angle() - want).abs() <= id && u.is_full(),
+            "{} vs {want}",
+            u.solid_angle()
+        );
+    }
+}
+
+/// Found by the `sphere_sliver` fuzz target at cc8fc38 (115 499 runs): a pentagon with nearly
+/// antipodal vertices and its copy with `(-1, 0, 0)` moved by `2.2e-14`. `A xor B` (at most the
+/// move times the perimeter, about `1e-13` sr) came back as the full sphere. Not yet fixed.
+#[test]
+#[ignore = "sphere boolean: A xor B = 12.566370614359172 (full sphere) vs A u B - A n B = 0"]
+fn xor_of_a_pentagon_and_its_copy_moved_by_2e_14_is_tiny() {
+    use arealight::planar::BoolOp;
+    let ring = |z: f64| {
+        SphericalPolygon::new(vec![vec![
+            v(
+                -0.015380975347800066,
+                -0.015380975347800066,
+                -0.9997633976070043,
+            ),
+            v(-1.0, 0.0, z),
+            v(
+                0.9901220151569631,
+                0.012693871989191833,
+                -0.13963259188111019,
+            ),
+            v(
+                -0.015380975347800066,
+                -0.9997633976070043,
+                -0.015380975347800066,
+            ),
+            v(0.0, 0.0, 1.0),
+        ]])
+        .unwrap()
+    };
+    let (a, b) = (ring(0.0), ring(2.1717847555504614e-14));
+    let x = a.boolean(&b, BoolOp::Xor).unwrap();
+    x.validate().unwrap();
+    assert!(
+        x.solid_angle() <= 1e-10 * 4.0 * std::f64::consts::PI,
+        "{}",
+        x.solid_angle()
     );
 }

@@ -190,7 +190,7 @@ impl Shape {
     ///   contradict each other), as for [`boolean`](super::boolean); never for well-separated or
     ///   exactly degenerate input such as shared edges and vertices.
     pub fn with_fill_rule(contours: Vec<Vec<DVec2>>, rule: FillRule) -> Result<Shape, GeomError> {
-        Shape::fill(contours, rule, true)
+        Shape::fill(contours, rule, true, 0.0)
     }
 
     /// [`Shape::with_fill_rule`] without first checking whether small input is already simple:
@@ -200,13 +200,27 @@ impl Shape {
         contours: Vec<Vec<DVec2>>,
         rule: FillRule,
     ) -> Result<Shape, GeomError> {
-        Shape::fill(contours, rule, false)
+        Shape::fill(contours, rule, false, 0.0)
+    }
+
+    /// [`Shape::with_fill_rule_resolving`] at a coordinate scale of at least `min_scale` (as
+    /// [`boolean_at_scale`](super::boolean::boolean_at_scale)): vertices within
+    /// [`SNAP_REL`]` * min_scale` of each other are welded and of edges put on them (a ring
+    /// passing that close to its own vertex touches itself there), loops thinner than
+    /// [`SLIVER_REL`](super::SLIVER_REL)` * min_scale` dropped.
+    pub(crate) fn with_fill_rule_resolving_at_scale(
+        contours: Vec<Vec<DVec2>>,
+        rule: FillRule,
+        min_scale: f64,
+    ) -> Result<Shape, GeomError> {
+        Shape::fill(contours, rule, false, min_scale)
     }
 
     fn fill(
         contours: Vec<Vec<DVec2>>,
         rule: FillRule,
         try_simple: bool,
+        min_scale: f64,
     ) -> Result<Shape, GeomError> {
         check_coordinates(&contours, 0)?;
         let mut rings: Vec<Vec<DVec2>> = Vec::with_capacity(contours.len());
@@ -225,7 +239,7 @@ impl Shape {
         let scale = rings
             .iter()
             .flatten()
-            .fold(0.0f64, |m, p| m.max(p.x.abs()).max(p.y.abs()));
+            .fold(min_scale, |m, p| m.max(p.x.abs()).max(p.y.abs()));
         let n: usize = rings.iter().map(Vec::len).sum();
         if try_simple
             && n <= SIMPLE_MAX

@@ -96,6 +96,7 @@ pub(crate) mod predicates;
 mod shape;
 mod triangulate;
 
+pub(crate) use boolean::boolean_at_scale;
 pub use boolean::intersect::SNAP_REL;
 pub use boolean::trace::SLIVER_REL;
 pub use boolean::{BoolOp, Workspace, boolean, boolean_with};

@@ -163,6 +163,47 @@ pub(crate) fn has_self_contacts(contours: &[Contour]) -> bool {
     false
 }
 
+/// Whether a vertex lies within `snap` of an edge of the shape that does not end at it (of its
+/// own contour or another), beside the edge (its projection strictly inside), without lying
+/// exactly on it.
+///
+/// [`boolean`](super::boolean) resolves such near-contacts between its two operands (the vertex
+/// is put on the edge) but takes each operand's own as given: exact predicates decide them, and
+/// a crossing computed next to one bends a split edge past the vertex by rounding. Callers
+/// whose shapes carry that rounding (projections) check this and resolve such shapes under a
+/// fill rule at the same resolution. `O(n^2)` over all vertex-edge pairs, pruned by bounding
+/// boxes grown by `snap`.
+pub(crate) fn has_near_self_contacts(contours: &[Contour], snap: f64) -> bool {
+    for c in contours {
+        let n = c.pts.len();
+        for i in 0..n {
+            let (p0, p1) = (c.pts[i], c.pts[if i + 1 == n { 0 } else { i + 1 }]);
+            let (lo, hi) = (
+                p0.min(p1) - DVec2::splat(snap),
+                p0.max(p1) + DVec2::splat(snap),
+            );
+            let d = p1 - p0;
+            let len = d.length();
+            for d2 in contours {
+                for &q in &d2.pts {
+                    if q.x < lo.x || q.x > hi.x || q.y < lo.y || q.y > hi.y || q == p0 || q == p1 {
+                        continue;
+                    }
+                    let o = orient(p0, p1, q);
+                    if o == 0.0 || !(o.abs() <= snap * len) {
+                        continue;
+                    }
+                    let t = (q - p0).dot(d);
+                    if t > 0.0 && t < d.length_squared() {
+                        return true;
+                    }
+                }
+            }
+        }
+    }
+    false
+}
+
 impl PartialEq for Shape {
     /// Shapes are equal when their contours are (same points, same starting points, same
     /// order); the cached facts follow from the contours.
@@ -358,6 +399,16 @@ impl Shape {
             }
         }
         Ok(())
+    }
+
+    /// Whether every feature of the shape is wider than `snap`: no two vertices within it of
+    /// each other and no vertex within it of an edge it is not on ([`has_near_self_contacts`]).
+    pub(crate) fn is_clear_at(&self, snap: f64) -> bool {
+        let sep2 = self
+            .facts
+            .sep2
+            .unwrap_or_else(|| min_separation2(&self.contours));
+        sep2 > snap * snap && !has_near_self_contacts(&self.contours, snap)
     }
 
     /// Wraps contours produced by the boolean pipeline, which establishes the invariants itself.

@@ -5,7 +5,9 @@ use core::f64::consts::PI;
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::predicates::{AXES, arcs_intersect, normalize_any, orient, triangle_solid_angle};
+use super::predicates::{
+    AXES, arc_lever, arcs_intersect, normalize_any, orient, triangle_solid_angle,
+};
 use crate::GeomError;
 use alloc::vec::Vec;
 
@@ -739,7 +741,9 @@ pub(crate) fn folds_back(p: DVec3, x: DVec3, q: DVec3) -> bool {
 /// The result of an operation, built from rings that may hold what validation rejects (the
 /// operations are exact up to rounding, and rounding can leave features below the resolution
 /// validation demands): consecutive vertices closer than `merge` (the operation's weld
-/// distance, so that the next operation does not weld them itself) become one, vertices where a
+/// distance, so that the next operation does not weld them itself) become one where that moves
+/// the following edge by at most `merge` ([`arc_lever`]; always within
+/// [`COINCIDENT_TOLERANCE`]), vertices where a
 /// ring folds back ([`folds_back`]) are removed (this cuts a spike or fills a notch narrower
 /// than `1e-12` rad), and rings left with fewer than three vertices or thinner than
 /// [`is_sliver`] are dropped. The region moves by at most those edges, wedges and slivers. When
@@ -770,7 +774,11 @@ pub(crate) fn regularized(
             }
             let fold = (0..m).find(|&i| {
                 let (p, x, q) = (r[(i + m - 1) % m], r[i], r[(i + 1) % m]);
-                p == q || (x - p).length() <= merge || folds_back(p, x, q)
+                // Removing `x` moves its edge to `q` by up to `|x - p|` times its lever: only
+                // where that stays within `merge` (coincident vertices always go).
+                let d = (x - p).length();
+                let short = d <= COINCIDENT_TOLERANCE || d * arc_lever(x, q) <= merge;
+                p == q || short || folds_back(p, x, q)
             });
             match fold {
                 Some(i) => {

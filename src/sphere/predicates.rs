@@ -134,6 +134,23 @@ pub(crate) fn normalize_any(p: DVec3) -> Option<DVec3> {
     (p / m).try_normalize()
 }
 
+/// How far the minor arc between unit vectors `p` and `q` moves, at most, per unit of distance
+/// one of its ends moves: `1` for arcs up to a quarter circle, `1 / sin L` for longer ones.
+///
+/// An end moved by `d` across the great circle turns the arc about the other end; at arc
+/// length `s` from that fixed end the arc moves by `d sin s / sin L`, which peaks at the moved
+/// end for `L <= pi / 2` and at `s = pi / 2` beyond. An edge between nearly antipodal vertices
+/// (`sin L` about `|p + q|`) is a long lever: a vertex moved by `1e-11` moves its middle by
+/// `1e-11 / |p + q|`, and the region by that over a length of about `pi`.
+#[inline]
+pub(crate) fn arc_lever(p: DVec3, q: DVec3) -> f64 {
+    if p.dot(q) >= 0.0 {
+        1.0
+    } else {
+        1.0 / p.cross(q).length()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -72,29 +72,49 @@ pub(crate) fn split(a: &mut Rings, b: &mut Rings, scale: f64) -> Result<(), Geom
     let mut ins_a = Inserts::new();
     let mut ins_b = Inserts::new();
     let mut by_x = SnapIndex::default();
-    for pass in 0..MAX_PASSES {
+    let mut all_pairs = true;
+    for _ in 0..MAX_PASSES {
         ins_a.clear();
         ins_b.clear();
         find(
-            a,
-            b,
-            &dirty_a,
-            &dirty_b,
-            pass == 0,
-            snap2,
-            &mut by_x,
-            &mut ins_a,
-            &mut ins_b,
+            a, b, &dirty_a, &dirty_b, all_pairs, snap2, &mut by_x, &mut ins_a, &mut ins_b,
         );
         if ins_a.is_empty() && ins_b.is_empty() {
             return Ok(());
         }
+        // A crossing snaps to the vertices that exist when it is found, not to the other
+        // crossings of its pass: two crossings within the snapping distance of each other (two
+        // edges crossing a third where they nearly meet) would each be inserted next to the
+        // other, pass after pass, into the edges that end at the other. Welding makes them one
+        // point; the rebuilt rings are tested again in full.
+        let close = new_points_close(&ins_a, &ins_b, snap2);
         apply(a, &mut ins_a, &mut dirty_a);
         apply(b, &mut ins_b, &mut dirty_b);
+        all_pairs = close && weld(a, b, scale) == Weld::Moved;
+        if all_pairs {
+            by_x = SnapIndex::default();
+        }
     }
     Err(GeomError::Undecidable(
         "edge intersections did not settle; the operands have long nearly-overlapping edges",
     ))
+}
+
+/// Whether two distinct points computed in one pass (bent insertions) lie within the snapping
+/// distance of each other. Passes insert a few points, so all pairs are compared.
+fn new_points_close(ins_a: &Inserts, ins_b: &Inserts, snap2: f64) -> bool {
+    let bent = |x: &&Insert| x.bent;
+    let pts: SmallVec<[DVec2; 16]> = ins_a
+        .iter()
+        .chain(ins_b.iter())
+        .filter(bent)
+        .map(|x| x.p)
+        .collect();
+    pts.iter().enumerate().any(|(i, &p)| {
+        pts[i + 1..]
+            .iter()
+            .any(|&q| p != q && (p - q).length_squared() <= snap2)
+    })
 }
 
 /// Splits the rings of one ring soup at every contact among all its edges, within a ring and
@@ -122,7 +142,7 @@ pub(crate) fn split_within(r: &mut Rings, scale: f64) -> Result<(), GeomError> {
     for pass in 0..MAX_PASSES {
         ins.clear();
         ins_b.clear();
-        edge_boxes(r, &mut boxes);
+        edge_boxes(r, &mut boxes, SNAP_REL * scale);
         let bx: &[EdgeBox] = &boxes;
         let mut test = |i: usize, j: usize| {
             let (box_i, p0, p1) = &bx[i];
@@ -406,8 +426,10 @@ pub(crate) fn split_self_contacts(r: &mut Rings) {
 type EdgeBox = ([f64; 4], DVec2, DVec2);
 
 /// Fills `out` with the edges of `r` (kept in the caller's frame: these buffers are large and
-/// moving them would cost more than filling them).
-fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
+/// moving them would cost more than filling them), each box grown by `pad`, the snapping
+/// distance: a vertex within that distance of an edge is a contact, and beside an edge nearly
+/// parallel to an axis (a box of almost no height) it can lie outside the edge's own box.
+fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>, pad: f64) {
     out.clear();
     let mut start = 0usize;
     for &end in &r.ends {
@@ -417,10 +439,10 @@ fn edge_boxes(r: &Rings, out: &mut SmallVec<[EdgeBox; 32]>) {
             let p1 = r.pts[if i + 1 == end { start } else { i + 1 }];
             out.push((
                 [
-                    p0.x.min(p1.x),
-                    p0.x.max(p1.x),
-                    p0.y.min(p1.y),
-                    p0.y.max(p1.y),
+                    p0.x.min(p1.x) - pad,
+                    p0.x.max(p1.x) + pad,
+                    p0.y.min(p1.y) - pad,
+                    p0.y.max(p1.y) + pad,
                 ],
                 p0,
                 p1,
@@ -455,8 +477,9 @@ fn find(
 ) {
     let mut ba: SmallVec<[EdgeBox; 32]> = SmallVec::new();
     let mut bb: SmallVec<[EdgeBox; 32]> = SmallVec::new();
-    edge_boxes(a, &mut ba);
-    edge_boxes(b, &mut bb);
+    let pad = sqrt(snap2);
+    edge_boxes(a, &mut ba, pad);
+    edge_boxes(b, &mut bb, pad);
     // Plain slices: indexing a SmallVec re-checks whether it spilled on every access.
     let (ba, bb): (&[EdgeBox], &[EdgeBox]) = (&ba, &bb);
 

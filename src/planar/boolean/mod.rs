@@ -261,7 +261,30 @@ pub fn boolean_with(
     b: &Shape,
     op: BoolOp,
 ) -> Result<Shape, GeomError> {
-    run(ws, a, b, op, Path::Auto).map(|r| r.unwrap_or_default())
+    run(ws, a, b, op, Path::Auto, 0.0).map(|r| r.unwrap_or_default())
+}
+
+/// [`boolean`] with the coordinate scale that sets its tolerances taken as at least
+/// `min_scale`: vertices closer than [`SNAP_REL`](crate::planar::SNAP_REL)` * min_scale` are
+/// welded, vertices that close to the other operand's edges put on them, and loops thinner than
+/// [`SLIVER_REL`](crate::planar::SLIVER_REL)` * min_scale` dropped, even when every coordinate
+/// is much smaller. Coordinates keep their full precision; only the resolution is coarser.
+///
+/// For callers whose shapes stand for points stored with an absolute precision coarser than the
+/// shapes' own coordinates allow: the sphere layer's gnomonic charts of regions `1e-10` rad
+/// across have coordinates near `1e-10`, whose relative tolerances (`1e-24`) keep features that
+/// the unit vectors the result is mapped back to (rounded to about `1e-16`) cannot carry.
+///
+/// # Errors
+///
+/// As [`boolean`].
+pub(crate) fn boolean_at_scale(
+    a: &Shape,
+    b: &Shape,
+    op: BoolOp,
+    min_scale: f64,
+) -> Result<Shape, GeomError> {
+    run(&mut Workspace::new(), a, b, op, Path::Auto, min_scale).map(|r| r.unwrap_or_default())
 }
 
 /// Which pipeline [`run`] may use (tests compare them).
@@ -281,14 +304,16 @@ fn run(
     b: &Shape,
     op: BoolOp,
     path: Path,
+    min_scale: f64,
 ) -> Result<Option<Shape>, GeomError> {
     // Trivial cases first: they need no geometry and keep chains of operations cheap.
     if a.is_empty() || b.is_empty() {
         let s = if a.is_empty() { b } else { a };
+        let scale = s.facts.bbox_scale().max(min_scale);
         let passes = match op {
             BoolOp::Intersection => true,
-            BoolOp::Difference => a.is_empty() || settled(a, s.facts.bbox_scale()),
-            BoolOp::Union | BoolOp::Xor => settled(s, s.facts.bbox_scale()),
+            BoolOp::Difference => a.is_empty() || settled(a, scale),
+            BoolOp::Union | BoolOp::Xor => settled(s, scale),
         };
         if passes {
             return Ok(Some(match op {
@@ -300,7 +325,7 @@ fn run(
         if path == Path::FastOnly {
             return Ok(None);
         }
-        return robust(ws, a, b, op, s.facts.bbox_scale()).map(Some);
+        return robust(ws, a, b, op, scale).map(Some);
     }
     let (fa, fb) = (&a.facts, &b.facts);
     let (box_a, box_b) = (
@@ -313,7 +338,7 @@ fn run(
             hi: fb.hi,
         },
     );
-    let scale = box_a.scale().max(box_b.scale());
+    let scale = box_a.scale().max(box_b.scale()).max(min_scale);
     if box_a.disjoint(&box_b) {
         let passes = match op {
             BoolOp::Intersection => true,
@@ -408,7 +433,7 @@ fn robust(
 /// As [`boolean`].
 #[doc(hidden)]
 pub fn boolean_robust(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomError> {
-    run(&mut Workspace::new(), a, b, op, Path::RobustOnly).map(|r| r.unwrap_or_default())
+    run(&mut Workspace::new(), a, b, op, Path::RobustOnly, 0.0).map(|r| r.unwrap_or_default())
 }
 
 /// [`boolean`] through the generic-position fast path only: `Ok(None)` when the operands are
@@ -419,7 +444,7 @@ pub fn boolean_robust(a: &Shape, b: &Shape, op: BoolOp) -> Result<Shape, GeomErr
 /// As [`boolean`].
 #[doc(hidden)]
 pub fn boolean_fast(a: &Shape, b: &Shape, op: BoolOp) -> Result<Option<Shape>, GeomError> {
-    run(&mut Workspace::new(), a, b, op, Path::FastOnly)
+    run(&mut Workspace::new(), a, b, op, Path::FastOnly, 0.0)
 }
 
 /// Both operands after the intersection phase (split at every contact) and the labelling phase:
