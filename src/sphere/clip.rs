@@ -812,15 +812,20 @@ fn single_chain_gap(chain: &Chain, scratch: &[DVec3], frame: &Frame) -> (Joins, 
         matches!(x.feature, Feature::Vertex(_)) || matches!(e.feature, Feature::Vertex(_));
     let loop_sign = || {
         // The loop through the vertices as given (before the snap), whose crossing points it
-        // approximates far better than their projections do.
-        let given = |c: &Crossing| match c.feature {
-            Feature::Vertex(p) => p,
-            Feature::Edge { .. } => c.point,
-        };
+        // approximates far better than their projections do: at a snapped end, the input's
+        // vertex next to the chain itself, not the start of its run of steep edges (a run
+        // snaps to one point, and a chain whose entry and exit snap there would otherwise close
+        // on that point with no area, leaving the decision to rounding).
         let mut ring: Verts = scratch[chain.start..chain.end].iter().copied().collect();
-        ring[0] = given(e);
+        ring[0] = match e.feature {
+            Feature::Vertex(_) => chain.before,
+            Feature::Edge { .. } => e.point,
+        };
         let last = ring.len() - 1;
-        ring[last] = given(x);
+        ring[last] = match x.feature {
+            Feature::Vertex(_) => chain.after,
+            Feature::Edge { .. } => x.point,
+        };
         let (area, err) = ring_small_area_err(&ring);
         if area.abs() > 4.0 * err {
             area.signum() as i8
