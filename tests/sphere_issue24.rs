@@ -756,9 +756,14 @@ fn union_of_the_outsides_of_two_tiny_pentagons_is_the_sphere() {
 
 /// Found by the `sphere_sliver` fuzz target at cc8fc38 (115 499 runs): a pentagon with nearly
 /// antipodal vertices and its copy with `(-1, 0, 0)` moved by `2.2e-14`. `A xor B` (at most the
-/// move times the perimeter, about `1e-13` sr) came back as the full sphere. Not yet fixed.
+/// move times the perimeter, about `1e-13` sr) came back as the full sphere, and so did `B - A`:
+/// no cap holds the operands, so the octant split solves them, and its only nonempty piece was a
+/// `2e-29` sr triangle at `(-1, 0, 0)` whose three edges all lie within the clip's horizon
+/// tolerance of the cut `y = 0`. They cancelled as cut edges, and a merge with no edge left was
+/// read as the full sphere without checking the pieces' area. Checked against the operands'
+/// own areas through the identities `|A xor B| = |A| + |B| - 2 |A n B|` and
+/// `|A - B| = |A| - |A n B|`, at the documented bound.
 #[test]
-#[ignore = "sphere boolean: A xor B = 12.566370614359172 (full sphere) vs A u B - A n B = 0"]
 fn xor_of_a_pentagon_and_its_copy_moved_by_2e_14_is_tiny() {
     use arealight::planar::BoolOp;
     let ring = |z: f64| {
@@ -784,11 +789,29 @@ fn xor_of_a_pentagon_and_its_copy_moved_by_2e_14_is_tiny() {
         .unwrap()
     };
     let (a, b) = (ring(0.0), ring(2.1717847555504614e-14));
-    let x = a.boolean(&b, BoolOp::Xor).unwrap();
-    x.validate().unwrap();
-    assert!(
-        x.solid_angle() <= 1e-10 * 4.0 * std::f64::consts::PI,
-        "{}",
-        x.solid_angle()
-    );
+    let id = 1e-10 * 4.0 * std::f64::consts::PI;
+    for (p, q) in [(&a, &b), (&b, &a)] {
+        let i = p.boolean(q, BoolOp::Intersection).unwrap().solid_angle();
+        // Independently of the operation: moving one vertex by `d = 2.2e-14` sweeps its two
+        // edges (at most 3.2 rad together, one 172 degrees long, so turned by at most
+        // `d / sin 8 deg`) over less than `1e-12` sr, so `A n B` is within that of `A`.
+        assert!(
+            (i - p.solid_angle()).abs() <= 1e-12,
+            "{i} vs {}",
+            p.solid_angle()
+        );
+        for (op, want) in [
+            (BoolOp::Xor, p.solid_angle() + q.solid_angle() - 2.0 * i),
+            (BoolOp::Difference, p.solid_angle() - i),
+            (BoolOp::Union, p.solid_angle() + q.solid_angle() - i),
+        ] {
+            let r = p.boolean(q, op).unwrap();
+            r.validate().unwrap();
+            assert!(
+                (r.solid_angle() - want).abs() <= id,
+                "{op:?}: {} vs {want}",
+                r.solid_angle()
+            );
+        }
+    }
 }

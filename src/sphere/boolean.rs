@@ -753,8 +753,22 @@ fn split(
     }
     let edges = cancel_cut_edges(edges)?;
     if edges.is_empty() {
-        // Every piece boundary lay on a cut and cancelled: the pieces tile the whole sphere.
-        return Ok(SphericalPolygon::full());
+        // Every piece boundary lay on a cut (within the clip's horizon tolerance) and cancelled.
+        // Either the pieces tile the whole sphere, or every piece is a sliver lying along a cut
+        // (a vertex moved `2e-14` off the plane `z = 0` leaves `A xor B` as one triangle of
+        // `2e-29` sr whose edges all count as cut edges): which one, only their area tells.
+        // Both answers are within the merge's area bound of the pieces; anything between is a
+        // merge that lost real boundary.
+        return if !off(sum_r, 4.0 * PI) {
+            Ok(SphericalPolygon::full())
+        } else if !off(sum_r, 0.0) {
+            Ok(SphericalPolygon::empty())
+        } else {
+            Err(GeomError::Undecidable(
+                "the octant pieces of the result cancelled along the cuts but do not tile the \
+                 sphere; their boundaries lie within rounding of the coordinate planes",
+            ))
+        };
     }
     let fits = |r: &SphericalPolygon| r.validate().is_ok() && !off(r.solid_angle(), sum_r);
     match order_directed_edges(&edges) {
