@@ -39,6 +39,7 @@ use glam::DVec3;
 use smallvec::SmallVec;
 
 use super::cull::Shaft;
+use super::union::Closed;
 use crate::math::sqrt;
 use crate::solid::facing::FacingAt;
 use crate::solid::{Bvh, TriangleMesh};
@@ -148,36 +149,12 @@ impl MeshContours {
         if !mesh.is_closed() {
             return None;
         }
-        let nt = mesh.triangle_count();
-        // Components: union-find over the faces through the edges.
-        let mut parent: Vec<u32> = (0..nt as u32).collect();
-        fn root(parent: &mut [u32], mut i: u32) -> u32 {
-            while parent[i as usize] != i {
-                parent[i as usize] = parent[parent[i as usize] as usize];
-                i = parent[i as usize];
-            }
-            i
-        }
-        for e in mesh.edges() {
-            let f1 = e.twin()?;
-            let (a, b) = (root(&mut parent, e.f0), root(&mut parent, f1));
-            parent[a.max(b) as usize] = a.min(b);
-        }
-        let mut id = vec![u32::MAX; nt];
-        let mut comp_of = Vec::with_capacity(nt);
-        let mut boxes: Vec<(DVec3, DVec3)> = Vec::new();
-        for t in 0..nt {
-            let r = root(&mut parent, t as u32) as usize;
-            let [a, b, c] = mesh.triangle(t);
-            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
-            if id[r] == u32::MAX {
-                id[r] = boxes.len() as u32;
-                boxes.push((lo, hi));
-            }
-            let k = id[r] as usize;
-            boxes[k] = (boxes[k].0.min(lo), boxes[k].1.max(hi));
-            comp_of.push(k as u32);
-        }
+        // Components and their boxes: those of the union path, which the query's declining
+        // rule (a point inside a component's box) must agree with.
+        let Closed {
+            component: comp_of,
+            boxes,
+        } = Closed::new(mesh);
         // Edges grouped by component (counting sort).
         let nc = boxes.len();
         let mut first = vec![0u32; nc + 1];

@@ -140,9 +140,9 @@ pub(crate) struct BlockerAccel {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Closed {
     /// Component of each triangle.
-    component: Vec<u32>,
+    pub(super) component: Vec<u32>,
     /// Bounding box of each component.
-    boxes: Vec<(DVec3, DVec3)>,
+    pub(super) boxes: Vec<(DVec3, DVec3)>,
 }
 
 impl BlockerAccel {
@@ -166,7 +166,8 @@ impl BlockerAccel {
 }
 
 impl Closed {
-    fn new(mesh: &TriangleMesh) -> Self {
+    /// The components (union-find over the faces through their shared edges) and their boxes.
+    pub(super) fn new(mesh: &TriangleMesh) -> Self {
         let n = mesh.triangle_count();
         let mut parent: Vec<u32> = (0..n as u32).collect();
         fn root(parent: &mut [u32], mut i: u32) -> u32 {
