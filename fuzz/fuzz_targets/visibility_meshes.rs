@@ -18,14 +18,15 @@
 //!   paths give regions or `GeomError::Undecidable`, never another error or a panic; a
 //!   give-up on one side while the other answers is accepted (it is reported as such);
 //! - every solid angle is finite and non-negative (to 1e-10 sr) and at most the light's
-//!   unoccluded solid angle plus 1e-10 sr;
+//!   unoccluded solid angle plus the tolerance below;
 //! - where they answer, the fast path's and the default path's visible solid angles equal the
 //!   per-triangle path's to 1e-10 sr (the tolerance of `tests/visibility_scale.rs`,
-//!   `fast_path_agrees_with_per_triangle`);
+//!   `fast_path_agrees_with_per_triangle`), plus, within about 1e-4 of a light, the rounding
+//!   any evaluation inherits from forming directions there (see [`conditioning`]);
 //! - the shaded value of a white diffuse material (`(1 / pi)` times the clamped-cosine integral
 //!   over the region times the radiance, so within `1e-10 / pi` of the reference's where the
-//!   regions agree to 1e-10 sr) is finite, non-negative and within 1e-10 of the per-triangle
-//!   path's.
+//!   regions agree to 1e-10 sr) is finite, non-negative and within the same tolerance of the
+//!   per-triangle path's.
 //!
 //! Run: `RUSTC_BOOTSTRAP=1 cargo fuzz run visibility_meshes -- -max_total_time=600` (from the
 //! crate root).
@@ -239,6 +240,29 @@ fn solid_angle(pieces: &[SphericalPolygon]) -> f64 {
     pieces.iter().map(SphericalPolygon::solid_angle).sum()
 }
 
+/// The extra tolerance near a light. Within `h` of the light, the elevations of its edges above
+/// the point carry a relative rounding of about `eps |d| / h` from forming `d = v - x` alone
+/// (whatever the algorithm), so solid angles of the light's region are only determined to about
+/// `2 pi eps R / h` there (seen: 1.6e-8 sr at 3.7e-9 above a quad's edge, against a 60-digit
+/// evaluation; `fast_path_near_a_quad_lights_plane` in `tests/visibility_scale.rs`). `h` is a
+/// lower bound on the distance to every light triangle (its plane, or its bounding ball), `R`
+/// the farthest vertex; a factor 8 over that estimate.
+fn conditioning(light: &TriangleMesh, x: DVec3) -> f64 {
+    let (mut h, mut r) = (f64::INFINITY, 0.0f64);
+    for t in 0..light.triangle_count() {
+        let [a, b, c] = light.triangle(t);
+        let m = (a + b + c) / 3.0;
+        let rad = (a - m).length().max((b - m).length()).max((c - m).length());
+        let plane = light.triangle_normal(t).dot(x - a).abs();
+        h = h.min(plane.max((x - m).length() - rad));
+        r = r
+            .max((a - x).length())
+            .max((b - x).length())
+            .max((c - x).length());
+    }
+    8.0 * f64::EPSILON * std::f64::consts::TAU * r / h.max(1e-300)
+}
+
 fuzz_target!(|case: Case| {
     let mut lights: Vec<TriangleMesh> = Vec::new();
     if let Some((c, a, b, t)) = case.quad {
@@ -371,6 +395,7 @@ fuzz_target!(|case: Case| {
                     x.x, x.y, x.z, n.x, n.y, n.z, v.x, v.y, v.z
                 )
             };
+            let tol = TOL + conditioning(lmesh, x);
             let lit = match scene.visibility().unoccluded_region(l, &frame) {
                 Ok(r) => solid_angle(&r),
                 Err(e) => {
@@ -412,27 +437,31 @@ fuzz_target!(|case: Case| {
             ] {
                 if let Some(sa) = sa {
                     assert!(
-                        sa.is_finite() && sa >= -TOL && sa <= lit + TOL,
+                        sa.is_finite() && sa >= -TOL && sa <= lit + tol,
                         "{name}: visible {sa}, unoccluded {lit}\n{}",
                         describe()
                     );
                 }
             }
-            if let Some(r) = reference_sa {
+            if let Some(rs) = reference_sa {
                 for (name, sa) in [("fast", fast), ("default", default)] {
                     if let Some(sa) = sa {
                         assert!(
-                            (sa - r).abs() <= TOL,
-                            "{name} {sa}, per triangle {r} (difference {:e}), unoccluded \
-                             {lit}\n{}",
-                            sa - r,
+                            (sa - rs).abs() <= tol,
+                            "{name} {sa}, per triangle {rs} (difference {:e}, tolerance {tol:e}), \
+                             unoccluded {lit}\n{}",
+                            sa - rs,
                             describe()
                         );
                     }
                 }
             }
         }
-        // The shaded value over all lights, where both answer.
+        // The shaded value over all lights, where both answer (white diffuse: at most the
+        // solid angle's error over pi per light).
+        let shade_tol = objects[..scene.lights().len()]
+            .iter()
+            .fold(TOL, |t, m| t + conditioning(m, x));
         let (n, v) = (DVec3::Z, DVec3::new(0.3, 0.0, 1.0));
         let (a, b) = (
             scene.shade(x, n, v, &white),
@@ -449,7 +478,7 @@ fuzz_target!(|case: Case| {
         }
         if let (Ok(a), Ok(b)) = (a, b) {
             assert!(
-                (a - b).abs().max_element() <= TOL,
+                (a - b).abs().max_element() <= shade_tol,
                 "shade {a} per triangle {b} at DVec3::new({:?}, {:?}, {:?})",
                 x.x,
                 x.y,
