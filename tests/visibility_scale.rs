@@ -876,7 +876,7 @@ fn fast_path_near_a_quad_lights_plane() {
             .visible_pieces(0, &frame, true, &mut pieces)
             .unwrap()
     );
-    let exact = 2.739_660_726_561_060_1;
+    let exact = 2.739_660_726_561_06;
     let fast = chain_solid_angle(pieces.rings());
     let lit = solid_angle(&scene.visibility().unoccluded_region(0, &frame).unwrap());
     let slow = solid_angle(&reference.visible_region(0, &frame).unwrap());
