@@ -28,8 +28,9 @@
 //!   regions agree to 1e-10 sr) is finite, non-negative and within the same tolerance of the
 //!   per-triangle path's.
 //!
-//! Run: `RUSTC_BOOTSTRAP=1 cargo fuzz run visibility_meshes -- -max_total_time=600` (from the
-//! crate root).
+//! Run: `RUSTC_BOOTSTRAP=1 cargo fuzz run visibility_meshes -- -max_total_time=600
+//! -len_control=0 -max_len=1024` (from the crate root). Without the last two flags libFuzzer
+//! keeps to inputs too short to build a mesh for most of a run.
 #![no_main]
 
 use arealight::glam::DVec3;
