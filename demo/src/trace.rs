@@ -2,6 +2,17 @@
 //! scene-file examples (a few hundred triangles; no acceleration structure needed).
 
 use arealight::glam::DVec3;
+use arealight::shade::Material;
+
+/// What a camera ray sees first.
+pub enum Hit {
+    /// Nothing (the background).
+    Nothing,
+    /// A light's emitting side: its radiance.
+    Emitter(DVec3),
+    /// A shaded surface: point, normal, view, material.
+    Surface(DVec3, DVec3, DVec3, Material),
+}
 
 /// A pinhole camera looking from `eye` at `target`, `up` roughly up, vertical field of view
 /// `fov_deg`.

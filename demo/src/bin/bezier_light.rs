@@ -24,6 +24,7 @@ use arealight::shade::{
 };
 use std::time::Instant;
 
+use arealight_demo::trace::Hit;
 use arealight_demo::{image, trace};
 
 /// A 2D outline segment: a line to a point, or a cubic with two handles to a point.
@@ -129,12 +130,6 @@ fn world(flatten_angle: f64) -> World {
             Material::new(DVec3::new(0.2, 0.5, 0.7), DVec3::splat(0.04), 0.3).expect("ball"),
         ],
     }
-}
-
-enum Hit {
-    Nothing,
-    Emitter(DVec3),
-    Surface(DVec3, DVec3, DVec3, Material),
 }
 
 fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {

@@ -21,6 +21,7 @@ use arealight::shade::{
 };
 use std::time::Instant;
 
+use arealight_demo::trace::Hit;
 use arealight_demo::{image, trace};
 
 /// `mesh` scaled by `s`, rotated by `rot` and moved to `at`.
@@ -86,12 +87,6 @@ fn world() -> World {
             Material::new(DVec3::new(0.2, 0.5, 0.7), DVec3::splat(0.04), 0.2).expect("material"),
         ],
     }
-}
-
-enum Hit {
-    Nothing,
-    Emitter(DVec3),
-    Surface(DVec3, DVec3, DVec3, Material),
 }
 
 fn trace(w: &World, o: DVec3, d: DVec3) -> Hit {

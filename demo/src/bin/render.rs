@@ -60,7 +60,7 @@ use arealight::shade::{Material, MonteCarlo, RatioEstimator, ReferenceBrdf, Scen
 use arealight::visibility::{PluckerContext, PluckerVisibility};
 use arealight_demo::image::{to_bytes, write_png};
 use arealight_demo::progress::Progress;
-use arealight_demo::trace::{Camera, ray_triangle};
+use arealight_demo::trace::{Camera, Hit, ray_triangle};
 use arealight_demo::{args_or_exit, run_or_exit};
 use rayon::prelude::*;
 use std::cell::RefCell;
@@ -148,15 +148,6 @@ fn parse_args() -> Result<Args, String> {
         return Err("resolution must be between 1 and 8192".into());
     }
     Ok(a)
-}
-
-/// What a camera ray sees first.
-enum Hit {
-    Nothing,
-    /// A light's emitting side: its radiance.
-    Emitter(DVec3),
-    /// A shaded surface: point, normal, view, material.
-    Surface(DVec3, DVec3, DVec3, Material),
 }
 
 /// Nearest hit of the camera ray among lights, occluders and the ground.
