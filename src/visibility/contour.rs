@@ -144,17 +144,11 @@ pub(crate) enum Cull<'a> {
 }
 
 impl MeshContours {
-    /// The precomputation for a closed mesh; `None` for a mesh that is not closed.
-    pub(crate) fn new(mesh: &TriangleMesh) -> Option<Self> {
-        if !mesh.is_closed() {
-            return None;
-        }
-        // Components and their boxes: those of the union path, which the query's declining
-        // rule (a point inside a component's box) must agree with.
-        let Closed {
-            component: comp_of,
-            boxes,
-        } = Closed::new(mesh);
+    /// The precomputation for a closed mesh, given its components and their boxes (`closed`,
+    /// those of the union path, which the query's declining rule, a point inside a component's
+    /// box, must agree with).
+    pub(crate) fn new(mesh: &TriangleMesh, closed: &Closed) -> Self {
+        let (comp_of, boxes) = (&closed.component, &closed.boxes);
         // Edges grouped by component (counting sort).
         let nc = boxes.len();
         let mut first = vec![0u32; nc + 1];
@@ -191,13 +185,13 @@ impl MeshContours {
                 }
             })
             .collect();
-        let comp_bvh = (nc > COMPONENT_BVH_MIN).then(|| Bvh::over_boxes(&boxes));
-        Some(MeshContours {
+        let comp_bvh = (nc > COMPONENT_BVH_MIN).then(|| Bvh::over_boxes(boxes));
+        MeshContours {
             comps,
             comp_bvh,
             edges,
             nodes,
-        })
+        }
     }
 
     /// Heap bytes held (edges, nodes, components and their hierarchy) plus the struct.

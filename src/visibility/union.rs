@@ -152,11 +152,7 @@ impl BlockerAccel {
         let mesh = body.mesh();
         let bvh = (mesh.triangle_count() >= bvh_min).then(|| Bvh::build(mesh));
         let closed = (matches!(body, Body::Mesh(_)) && mesh.is_closed()).then(|| Closed::new(mesh));
-        let contours = if matches!(body, Body::Mesh(_)) {
-            MeshContours::new(mesh)
-        } else {
-            None
-        };
+        let contours = closed.as_ref().map(|c| MeshContours::new(mesh, c));
         BlockerAccel {
             bvh,
             closed,
