@@ -1556,6 +1556,13 @@ pub(super) struct ConvexFaces {
     /// range of `vertices` holding the loop's vertex indices in order, empty where it declines.
     loops: Vec<(u16, u8)>,
     vertices: Vec<u8>,
+    /// Without a table of contours and with at most 64 edges: per plane `g`, the edges (bit `e`
+    /// for `edges[e]`) whose plane `g0` is `g`, and those whose plane `g1` is `g`. An edge is on
+    /// the contour exactly where one of its two planes is in front, so the contour's edges are
+    /// the bits where the union of the front planes' first sets and that of their second sets
+    /// differ ([`contour_by_bits`]): a few operations per front plane instead of a pass over
+    /// every edge.
+    plane_edges: Vec<[u64; 2]>,
 }
 
 /// Polyhedra with at most this many distinct face planes (a box has six; a polyhedron with eight
@@ -1613,6 +1620,14 @@ impl ConvexFaces {
                 vertices.extend_from_slice(&order[..n]);
             }
         }
+        let mut plane_edges = Vec::new();
+        if loops.is_empty() && edges.len() <= 64 {
+            plane_edges.resize(normals.len(), [0u64; 2]);
+            for (e, &[_, _, g0, g1]) in edges.iter().enumerate() {
+                plane_edges[g0 as usize][0] |= 1u64 << e;
+                plane_edges[g1 as usize][1] |= 1u64 << e;
+            }
+        }
         Some(ConvexFaces {
             normals,
             offsets,
@@ -1620,6 +1635,7 @@ impl ConvexFaces {
             masks,
             loops,
             vertices,
+            plane_edges,
         })
     }
 }
@@ -1649,7 +1665,12 @@ fn convex_blocker(
         return false;
     }
     let mut order = [0u8; INLINE_VERTICES];
-    let order: &[u8] = if faces.loops.is_empty() {
+    let order: &[u8] = if !faces.plane_edges.is_empty() {
+        match contour_by_bits(front, faces, &mut order) {
+            Some(count) => &order[..count],
+            None => return false,
+        }
+    } else if faces.loops.is_empty() {
         match contour_loop(front, &faces.edges, &faces.masks, &mut order) {
             Some(count) => &order[..count],
             None => return false,
@@ -1737,6 +1758,61 @@ fn contour_loop(
     }
     if count < 3 {
         return None;
+    }
+    order[0] = start;
+    let mut at = next[start as usize];
+    for slot in order.iter_mut().take(count).skip(1) {
+        if at == NONE || at == start {
+            return None;
+        }
+        *slot = at;
+        at = next[at as usize];
+    }
+    (at == start).then_some(count)
+}
+
+/// [`contour_loop`] from a table's per-plane edge sets ([`ConvexFaces::plane_edges`]): the same
+/// contour edges, oriented alike (`b -> a` where the edge's plane `g0` is in front) and met in the
+/// same order (increasing edge index), so the same loop from the same first vertex, or `None`
+/// exactly where that declines.
+fn contour_by_bits(
+    front: u64,
+    faces: &ConvexFaces,
+    order: &mut [u8; INLINE_VERTICES],
+) -> Option<usize> {
+    const NONE: u8 = u8::MAX;
+    let (mut first, mut second) = (0u64, 0u64);
+    let mut f = front;
+    while f != 0 {
+        let [e0, e1] = faces.plane_edges[f.trailing_zeros() as usize];
+        first |= e0;
+        second |= e1;
+        f &= f - 1;
+    }
+    // An edge's two planes differ, so it is on the contour where exactly one is in front.
+    let mut contour = first ^ second;
+    let count = contour.count_ones() as usize;
+    if count < 3 {
+        return None;
+    }
+    let mut next = [NONE; INLINE_VERTICES];
+    let mut start = NONE;
+    while contour != 0 {
+        let e = contour.trailing_zeros();
+        let [a, b, _, _] = faces.edges[e as usize];
+        let (a, b) = if (first >> e) & 1 == 1 {
+            (b, a)
+        } else {
+            (a, b)
+        };
+        if next[a as usize] != NONE {
+            return None;
+        }
+        next[a as usize] = b;
+        if start == NONE {
+            start = a;
+        }
+        contour &= contour - 1;
     }
     order[0] = start;
     let mut at = next[start as usize];
@@ -1844,7 +1920,10 @@ mod tests {
 
     use glam::DVec3;
 
-    use super::{ConvexFaces, Pieces, convex_blocker, convex_planes};
+    use super::{
+        ConvexFaces, INLINE_VERTICES, Pieces, contour_by_bits, contour_loop, convex_blocker,
+        convex_planes,
+    };
     use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
     use crate::visibility::ClipVisibility;
 
@@ -1962,6 +2041,50 @@ mod tests {
         assert!(
             tables >= 12 && compared > 8_000 && accepted > compared / 2 && accepted < compared,
             "{tables} tables, {compared} compared, {accepted} accepted"
+        );
+    }
+
+    #[test]
+    fn contour_by_bits_matches_contour_loop() {
+        let mut rng = Rng(31);
+        let (mut tables, mut loops) = (0, 0);
+        for p in polyhedra(&mut rng) {
+            let Some(faces) = ConvexFaces::of(&p) else {
+                continue;
+            };
+            if faces.plane_edges.is_empty() {
+                continue;
+            }
+            tables += 1;
+            let planes = faces.normals.len();
+            for k in 0..4000u64 {
+                // Every set of front planes for the first ones, then random sets, and the sets
+                // that real points see (the planes facing a random direction).
+                let front = if k < 256 {
+                    k & ((1u64 << planes.min(8)) - 1)
+                } else if k % 2 == 0 {
+                    (rng.next().to_bits() ^ (rng.next().to_bits() << 11)) & ((1u64 << planes) - 1)
+                } else {
+                    let d = rng.vec(-1.0, 1.0);
+                    let mut f = 0u64;
+                    for (g, n) in faces.normals.iter().enumerate() {
+                        f |= u64::from(n.dot(d) > 0.0) << g;
+                    }
+                    f
+                };
+                let (mut a, mut b) = ([0u8; INLINE_VERTICES], [0u8; INLINE_VERTICES]);
+                let fast = contour_by_bits(front, &faces, &mut a);
+                let general = contour_loop(front, &faces.edges, &faces.masks, &mut b);
+                assert_eq!(fast, general, "front {front:b}");
+                if let Some(n) = fast {
+                    loops += 1;
+                    assert_eq!(a[..n], b[..n], "front {front:b}");
+                }
+            }
+        }
+        assert!(
+            tables >= 12 && loops > 10_000,
+            "{tables} tables, {loops} loops"
         );
     }
 
