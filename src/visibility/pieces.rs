@@ -1689,26 +1689,23 @@ fn convex_blocker(
     let verts = p.vertices();
     let Pieces { kv, planes, .. } = out;
     kv.clear();
-    kv.extend(
-        order
-            .iter()
-            .map(|&i| frame.to_local(verts[i as usize]) * inv),
-    );
+    for &i in order {
+        kv.push(frame.to_local(verts[i as usize]) * inv);
+    }
     // Planes, turns and spacing, edge by edge: `convex_planes`' loop, with the spacing test of
-    // `small_silhouette_dirs` (on the same pairs of directions, the same decisions).
+    // `small_silhouette_dirs` (on the same pairs of directions, the same decisions). The turn
+    // at the end of each edge is taken from the edge's plane first ([`turns_left_by_plane`]),
+    // `convex_planes`' test deciding where that does not accept.
     let kv: &[DVec3] = kv;
     planes.clear();
-    let mut cur = kv[0];
-    let mut cur1 = norm1(cur);
-    let mut d_in = cur - kv[count - 1];
+    let (mut cur, mut next) = (kv[0], kv[1]);
+    let (mut cur1, mut next1) = (norm1(cur), norm1(next));
     for k in 0..count {
         let k1 = if k + 1 == count { 0 } else { k + 1 };
-        let next = kv[k1];
-        let next1 = norm1(next);
+        let k2 = if k1 + 1 == count { 0 } else { k1 + 1 };
+        let after = kv[k2];
+        let after1 = norm1(after);
         let d_out = next - cur;
-        if !turns_left(d_in, d_out, cur) {
-            return false;
-        }
         // `edge_plane(cur, next)` bit for bit (see `convex_planes`).
         let n = (cur + next).cross(d_out);
         let n1 = norm1(n);
@@ -1717,8 +1714,13 @@ fn convex_blocker(
         {
             return false;
         }
+        if !turns_left_by_plane(n, cur1 + next1, after, after1)
+            && !turns_left(d_out, after - next, next)
+        {
+            return false;
+        }
         planes.push(n / n1);
-        (cur, cur1, d_in) = (next, next1, d_out);
+        (cur, cur1, next, next1) = (next, next1, after, after1);
     }
     true
 }
@@ -1833,6 +1835,23 @@ fn contour_by_bits(
 fn turns_left(d_in: DVec3, d_out: DVec3, cur: DVec3) -> bool {
     let turn = d_in.cross(d_out).dot(cur);
     turn > 0.0 || turn > -MARGIN * norm1(d_in) * norm1(d_out) * norm1(cur)
+}
+
+/// A quick accept of [`turns_left`] at the end `b` of the silhouette edge `a -> b`, from the
+/// edge's computed plane normal `n = (a + b) x (b - a)` (`s = |a|_1 + |b|_1`) and the next
+/// vertex `c` (`c1 = |c|_1`): where it holds, `det(a, b, c) > 0` exactly, so the turn is to the
+/// left and [`turns_left`], whose bound covers its own rounding, accepts it too (the same
+/// decision, one dot product instead of a cross product and a dot product).
+///
+/// Exactly `(a + b) x (b - a) = 2 a x b`, so `N . c = 2 det(a, b, c)` for the exact normal `N`.
+/// The computed `n` is off from `N` by at most `8 eps s^2` in 1-norm ([`spaced_by_plane`]), which
+/// moves `n . c` by at most `8 eps s^2 c1`; the dot product's own rounding is at most
+/// `3 eps |n|_1 c1 (1 + eps)`, with `|n|_1 <= s^2 (1 + 8 eps)` (each product of a cross product's
+/// 1-norm pairs components of different indices once). Both together are below `12 eps s^2 c1`,
+/// well inside [`MARGIN`] (`64 eps`) times the same product.
+#[inline(always)]
+fn turns_left_by_plane(n: DVec3, s: f64, c: DVec3, c1: f64) -> bool {
+    n.dot(c) > MARGIN * s * s * c1
 }
 
 /// A quick accept of the spacing test of [`spaced_ids`] for consecutive silhouette directions
@@ -2041,6 +2060,56 @@ mod tests {
         assert!(
             tables >= 12 && compared > 8_000 && accepted > compared / 2 && accepted < compared,
             "{tables} tables, {compared} compared, {accepted} accepted"
+        );
+    }
+
+    /// Points within the facing tolerance of a face plane, where a face seen nearly edge-on is
+    /// left out of the silhouette and the silhouette turns right by a sliver (or runs straight,
+    /// in the plane): the table walk's turn decisions (a quick accept from the edge's plane,
+    /// then the general test) against [`convex_planes`]', which decides every turn by the
+    /// general test.
+    #[test]
+    fn turn_decisions_match_near_face_planes() {
+        let mut rng = Rng(23);
+        let (mut compared, mut accepted, mut declined) = (0, 0, 0);
+        for p in polyhedra(&mut rng) {
+            let Some(faces) = ConvexFaces::of(&p) else {
+                continue;
+            };
+            let mesh = p.mesh();
+            let scale = mesh.bounding_sphere().radius + mesh.bounding_sphere().center.length();
+            for k in 0..400 {
+                let f = k % mesh.triangle_count();
+                let t = mesh.triangle(f);
+                let on = t[0]
+                    + (t[1] - t[0]) * rng.range(-2.0, 3.0)
+                    + (t[2] - t[0]) * rng.range(-2.0, 3.0);
+                let delta = [0.0, 1e-15, -1e-15, 1e-13, -1e-13, 2e-12, -2e-12, 6e-12][k % 8];
+                let x = on + mesh.normals()[f] * (delta * scale);
+                let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
+                let Ok(frame) = frame else { continue };
+                let (mut a, mut b) = (Pieces::new(), Pieces::new());
+                let fast = convex_blocker(&p, &faces, &frame, &mut a);
+                let general = convex_planes(&p, &frame, &mut b);
+                assert_eq!(fast, general, "{x}");
+                compared += 1;
+                if fast {
+                    accepted += 1;
+                    let bits = |v: &[DVec3]| -> Vec<u64> {
+                        v.iter()
+                            .flat_map(|d| d.to_array().map(f64::to_bits))
+                            .collect()
+                    };
+                    assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
+                    assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
+                } else {
+                    declined += 1;
+                }
+            }
+        }
+        assert!(
+            compared > 10_000 && accepted > compared / 4 && declined > compared / 20,
+            "{compared} compared, {accepted} accepted, {declined} declined"
         );
     }
 
