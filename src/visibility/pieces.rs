@@ -541,20 +541,24 @@ impl Pieces {
         for &end in &region.ends {
             let end = end as usize;
             let ring = (start as u32, end as u32);
-            let Some(first) = first_plane_out(pts[start], planes) else {
+            // Each vertex's 1-norm serves its classification and the crossings of both its
+            // edges.
+            let first1 = norm1(pts[start]);
+            let Some(first) = first_plane_out(pts[start], first1, planes) else {
                 return false;
             };
             inside |= u64::from(first == u32::MAX) << start;
-            let mut prev = first;
+            let (mut prev, mut prev1) = (first, first1);
             for b in start + 1..=end {
-                let (b, out) = if b == end {
-                    (start, first)
+                let (b, out, b1) = if b == end {
+                    (start, first, first1)
                 } else {
-                    let Some(out) = first_plane_out(pts[b], planes) else {
+                    let b1 = norm1(pts[b]);
+                    let Some(out) = first_plane_out(pts[b], b1, planes) else {
                         return false;
                     };
                     inside |= u64::from(out == u32::MAX) << b;
-                    (b, out)
+                    (b, out, b1)
                 };
                 let a = if b == start { end - 1 } else { b - 1 };
                 // Every side of both ends before the first plane either end is outside of is
@@ -564,6 +568,7 @@ impl Pieces {
                         pts,
                         planes,
                         (a, b),
+                        (prev1, b1),
                         ring,
                         prev.min(out) as usize,
                         &mut self.crossings,
@@ -571,7 +576,7 @@ impl Pieces {
                 {
                     return false;
                 }
-                prev = out;
+                (prev, prev1) = (out, b1);
             }
             start = end;
         }
@@ -867,12 +872,12 @@ impl Pieces {
     }
 }
 
-/// The first of `planes` on whose negative side `v` lies, `u32::MAX` if none (`v` inside `K`);
-/// `None` where a side up to that plane is within its rounding bound (see
+/// The first of `planes` on whose negative side `v` (of 1-norm `v1`) lies, `u32::MAX` if none
+/// (`v` inside `K`); `None` where a side up to that plane is within its rounding bound (see
 /// [`Pieces::trace_difference`]).
 #[inline(always)]
-fn first_plane_out(v: DVec3, planes: &[DVec3]) -> Option<u32> {
-    let bound = MARGIN * norm1(v);
+fn first_plane_out(v: DVec3, v1: f64, planes: &[DVec3]) -> Option<u32> {
+    let bound = MARGIN * v1;
     for (j, &n) in planes.iter().enumerate() {
         let s = n.dot(v);
         // Clearly positive (the common case, one comparison), else the checks in order.
@@ -890,7 +895,7 @@ fn first_plane_out(v: DVec3, planes: &[DVec3]) -> Option<u32> {
 }
 
 /// Adds to `out` the crossings of the ring edge `a -> b` (indices into `pts`, the ring's range
-/// `ring`) with `K`'s boundary, by Cyrus–Beck: the edge's part inside `K` is `[t_in, t_out]`,
+/// `ring`; the ends' 1-norms `a1`, `b1`) with `K`'s boundary, by Cyrus–Beck: the edge's part inside `K` is `[t_in, t_out]`,
 /// `t_in` the largest parameter at which it enters a half-space and `t_out` the smallest at which
 /// it leaves one. `false` where a side, the plane of the entry or exit, or whether the part is
 /// empty, is within rounding. The planes before `from` are skipped: the caller knows both ends
@@ -899,12 +904,12 @@ fn edge_crossings(
     pts: &[DVec3],
     planes: &[DVec3],
     (a, b): (usize, usize),
+    (a1, b1): (f64, f64),
     ring: (u32, u32),
     from: usize,
     out: &mut SmallVec<[Crossing; 16]>,
 ) -> bool {
     let (pa, pb) = (pts[a], pts[b]);
-    let (a1, b1) = (norm1(pa), norm1(pb));
     // Entry and exit: parameter, error bound, plane; and the runners-up's nearest bound.
     let (mut t_in, mut e_in, mut j_in, mut second_in) = (0.0, 0.0, usize::MAX, f64::NEG_INFINITY);
     let (mut t_out, mut e_out, mut j_out, mut second_out) = (1.0, 0.0, usize::MAX, f64::INFINITY);
