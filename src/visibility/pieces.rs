@@ -29,7 +29,8 @@
 //! 000 Alg. 2, thesis 003 section 4.2), `K = n_j H_j`, one half-space `H_j` per contour edge; a
 //! mesh triangle covers the cone of its three edges. The contour of a small polyhedron comes
 //! from a [`ConvexFaces`] table built once per scene (facing tests per plane, and for a box-like
-//! body the contour of every set of front planes), the same loop the per-point chaining finds. `R - K` is computed in one of two ways:
+//! body the contour of every set of front planes, for others each plane's edges as bit sets),
+//! the same loop the per-point chaining finds. `R - K` is computed in one of two ways:
 //!
 //! - **Boundary tracing** (Greiner and Hormann 1998, the difference), while the rings are simple
 //!   and disjoint (an outer boundary and its holes, or the light's one ring): the crossings of
