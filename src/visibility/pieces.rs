@@ -896,11 +896,12 @@ fn first_plane_out(v: DVec3, v1: f64, planes: &[DVec3]) -> Option<u32> {
 }
 
 /// Adds to `out` the crossings of the ring edge `a -> b` (indices into `pts`, the ring's range
-/// `ring`; the ends' 1-norms `a1`, `b1`) with `K`'s boundary, by Cyrus–Beck: the edge's part inside `K` is `[t_in, t_out]`,
-/// `t_in` the largest parameter at which it enters a half-space and `t_out` the smallest at which
-/// it leaves one. `false` where a side, the plane of the entry or exit, or whether the part is
-/// empty, is within rounding. The planes before `from` are skipped: the caller knows both ends
-/// clearly inside them (a plane with both sides positive changes nothing here).
+/// `ring`; the ends' 1-norms `a1`, `b1`) with `K`'s boundary, by Cyrus–Beck: the edge's part
+/// inside `K` is `[t_in, t_out]`, `t_in` the largest parameter at which it enters a half-space
+/// and `t_out` the smallest at which it leaves one. `false` where a side, the plane of the entry
+/// or exit, or whether the part is empty, is within rounding. The planes before `from` are
+/// skipped: the caller knows both ends clearly inside them (a plane with both sides positive
+/// changes nothing here).
 fn edge_crossings(
     pts: &[DVec3],
     planes: &[DVec3],
