@@ -29,7 +29,8 @@
 //! 000 Alg. 2, thesis 003 section 4.2), `K = n_j H_j`, one half-space `H_j` per contour edge; a
 //! mesh triangle covers the cone of its three edges. The contour of a small polyhedron comes
 //! from a [`ConvexFaces`] table built once per scene (facing tests per plane, and for a box-like
-//! body the contour of every set of front planes), the same loop the per-point chaining finds. `R - K` is computed in one of two ways:
+//! body the contour of every set of front planes, for others each plane's edges as bit sets),
+//! the same loop the per-point chaining finds. `R - K` is computed in one of two ways:
 //!
 //! - **Boundary tracing** (Greiner and Hormann 1998, the difference), while the rings are simple
 //!   and disjoint (an outer boundary and its holes, or the light's one ring): the crossings of
@@ -541,20 +542,24 @@ impl Pieces {
         for &end in &region.ends {
             let end = end as usize;
             let ring = (start as u32, end as u32);
-            let Some(first) = first_plane_out(pts[start], planes) else {
+            // Each vertex's 1-norm serves its classification and the crossings of both its
+            // edges.
+            let first1 = norm1(pts[start]);
+            let Some(first) = first_plane_out(pts[start], first1, planes) else {
                 return false;
             };
             inside |= u64::from(first == u32::MAX) << start;
-            let mut prev = first;
+            let (mut prev, mut prev1) = (first, first1);
             for b in start + 1..=end {
-                let (b, out) = if b == end {
-                    (start, first)
+                let (b, out, b1) = if b == end {
+                    (start, first, first1)
                 } else {
-                    let Some(out) = first_plane_out(pts[b], planes) else {
+                    let b1 = norm1(pts[b]);
+                    let Some(out) = first_plane_out(pts[b], b1, planes) else {
                         return false;
                     };
                     inside |= u64::from(out == u32::MAX) << b;
-                    (b, out)
+                    (b, out, b1)
                 };
                 let a = if b == start { end - 1 } else { b - 1 };
                 // Every side of both ends before the first plane either end is outside of is
@@ -564,6 +569,7 @@ impl Pieces {
                         pts,
                         planes,
                         (a, b),
+                        (prev1, b1),
                         ring,
                         prev.min(out) as usize,
                         &mut self.crossings,
@@ -571,7 +577,7 @@ impl Pieces {
                 {
                     return false;
                 }
-                prev = out;
+                (prev, prev1) = (out, b1);
             }
             start = end;
         }
@@ -867,12 +873,12 @@ impl Pieces {
     }
 }
 
-/// The first of `planes` on whose negative side `v` lies, `u32::MAX` if none (`v` inside `K`);
-/// `None` where a side up to that plane is within its rounding bound (see
+/// The first of `planes` on whose negative side `v` (of 1-norm `v1`) lies, `u32::MAX` if none
+/// (`v` inside `K`); `None` where a side up to that plane is within its rounding bound (see
 /// [`Pieces::trace_difference`]).
 #[inline(always)]
-fn first_plane_out(v: DVec3, planes: &[DVec3]) -> Option<u32> {
-    let bound = MARGIN * norm1(v);
+fn first_plane_out(v: DVec3, v1: f64, planes: &[DVec3]) -> Option<u32> {
+    let bound = MARGIN * v1;
     for (j, &n) in planes.iter().enumerate() {
         let s = n.dot(v);
         // Clearly positive (the common case, one comparison), else the checks in order.
@@ -890,21 +896,22 @@ fn first_plane_out(v: DVec3, planes: &[DVec3]) -> Option<u32> {
 }
 
 /// Adds to `out` the crossings of the ring edge `a -> b` (indices into `pts`, the ring's range
-/// `ring`) with `K`'s boundary, by Cyrus–Beck: the edge's part inside `K` is `[t_in, t_out]`,
-/// `t_in` the largest parameter at which it enters a half-space and `t_out` the smallest at which
-/// it leaves one. `false` where a side, the plane of the entry or exit, or whether the part is
-/// empty, is within rounding. The planes before `from` are skipped: the caller knows both ends
-/// clearly inside them (a plane with both sides positive changes nothing here).
+/// `ring`; the ends' 1-norms `a1`, `b1`) with `K`'s boundary, by Cyrus–Beck: the edge's part
+/// inside `K` is `[t_in, t_out]`, `t_in` the largest parameter at which it enters a half-space
+/// and `t_out` the smallest at which it leaves one. `false` where a side, the plane of the entry
+/// or exit, or whether the part is empty, is within rounding. The planes before `from` are
+/// skipped: the caller knows both ends clearly inside them (a plane with both sides positive
+/// changes nothing here).
 fn edge_crossings(
     pts: &[DVec3],
     planes: &[DVec3],
     (a, b): (usize, usize),
+    (a1, b1): (f64, f64),
     ring: (u32, u32),
     from: usize,
     out: &mut SmallVec<[Crossing; 16]>,
 ) -> bool {
     let (pa, pb) = (pts[a], pts[b]);
-    let (a1, b1) = (norm1(pa), norm1(pb));
     // Entry and exit: parameter, error bound, plane; and the runners-up's nearest bound.
     let (mut t_in, mut e_in, mut j_in, mut second_in) = (0.0, 0.0, usize::MAX, f64::NEG_INFINITY);
     let (mut t_out, mut e_out, mut j_out, mut second_out) = (1.0, 0.0, usize::MAX, f64::INFINITY);
@@ -1556,6 +1563,13 @@ pub(super) struct ConvexFaces {
     /// range of `vertices` holding the loop's vertex indices in order, empty where it declines.
     loops: Vec<(u16, u8)>,
     vertices: Vec<u8>,
+    /// Without a table of contours and with at most 64 edges: per plane `g`, the edges (bit `e`
+    /// for `edges[e]`) whose plane `g0` is `g`, and those whose plane `g1` is `g`. An edge is on
+    /// the contour exactly where one of its two planes is in front, so the contour's edges are
+    /// the bits where the union of the front planes' first sets and that of their second sets
+    /// differ ([`contour_by_bits`]): a few operations per front plane instead of a pass over
+    /// every edge.
+    plane_edges: Vec<[u64; 2]>,
 }
 
 /// Polyhedra with at most this many distinct face planes (a box has six; a polyhedron with eight
@@ -1613,6 +1627,14 @@ impl ConvexFaces {
                 vertices.extend_from_slice(&order[..n]);
             }
         }
+        let mut plane_edges = Vec::new();
+        if loops.is_empty() && edges.len() <= 64 {
+            plane_edges.resize(normals.len(), [0u64; 2]);
+            for (e, &[_, _, g0, g1]) in edges.iter().enumerate() {
+                plane_edges[g0 as usize][0] |= 1u64 << e;
+                plane_edges[g1 as usize][1] |= 1u64 << e;
+            }
+        }
         Some(ConvexFaces {
             normals,
             offsets,
@@ -1620,6 +1642,7 @@ impl ConvexFaces {
             masks,
             loops,
             vertices,
+            plane_edges,
         })
     }
 }
@@ -1649,7 +1672,12 @@ fn convex_blocker(
         return false;
     }
     let mut order = [0u8; INLINE_VERTICES];
-    let order: &[u8] = if faces.loops.is_empty() {
+    let order: &[u8] = if !faces.plane_edges.is_empty() {
+        match contour_by_bits(front, faces, &mut order) {
+            Some(count) => &order[..count],
+            None => return false,
+        }
+    } else if faces.loops.is_empty() {
         match contour_loop(front, &faces.edges, &faces.masks, &mut order) {
             Some(count) => &order[..count],
             None => return false,
@@ -1668,26 +1696,23 @@ fn convex_blocker(
     let verts = p.vertices();
     let Pieces { kv, planes, .. } = out;
     kv.clear();
-    kv.extend(
-        order
-            .iter()
-            .map(|&i| frame.to_local(verts[i as usize]) * inv),
-    );
+    for &i in order {
+        kv.push(frame.to_local(verts[i as usize]) * inv);
+    }
     // Planes, turns and spacing, edge by edge: `convex_planes`' loop, with the spacing test of
-    // `small_silhouette_dirs` (on the same pairs of directions, the same decisions).
+    // `small_silhouette_dirs` (on the same pairs of directions, the same decisions). The turn
+    // at the end of each edge is taken from the edge's plane first ([`turns_left_by_plane`]),
+    // `convex_planes`' test deciding where that does not accept.
     let kv: &[DVec3] = kv;
     planes.clear();
-    let mut cur = kv[0];
-    let mut cur1 = norm1(cur);
-    let mut d_in = cur - kv[count - 1];
+    let (mut cur, mut next) = (kv[0], kv[1]);
+    let (mut cur1, mut next1) = (norm1(cur), norm1(next));
     for k in 0..count {
         let k1 = if k + 1 == count { 0 } else { k + 1 };
-        let next = kv[k1];
-        let next1 = norm1(next);
+        let k2 = if k1 + 1 == count { 0 } else { k1 + 1 };
+        let after = kv[k2];
+        let after1 = norm1(after);
         let d_out = next - cur;
-        if !turns_left(d_in, d_out, cur) {
-            return false;
-        }
         // `edge_plane(cur, next)` bit for bit (see `convex_planes`).
         let n = (cur + next).cross(d_out);
         let n1 = norm1(n);
@@ -1696,8 +1721,13 @@ fn convex_blocker(
         {
             return false;
         }
+        if !turns_left_by_plane(n, cur1 + next1, after, after1)
+            && !turns_left(d_out, after - next, next)
+        {
+            return false;
+        }
         planes.push(n / n1);
-        (cur, cur1, d_in) = (next, next1, d_out);
+        (cur, cur1, next, next1) = (next, next1, after, after1);
     }
     true
 }
@@ -1750,6 +1780,61 @@ fn contour_loop(
     (at == start).then_some(count)
 }
 
+/// [`contour_loop`] from a table's per-plane edge sets ([`ConvexFaces::plane_edges`]): the same
+/// contour edges, oriented alike (`b -> a` where the edge's plane `g0` is in front) and met in the
+/// same order (increasing edge index), so the same loop from the same first vertex, or `None`
+/// exactly where that declines.
+fn contour_by_bits(
+    front: u64,
+    faces: &ConvexFaces,
+    order: &mut [u8; INLINE_VERTICES],
+) -> Option<usize> {
+    const NONE: u8 = u8::MAX;
+    let (mut first, mut second) = (0u64, 0u64);
+    let mut f = front;
+    while f != 0 {
+        let [e0, e1] = faces.plane_edges[f.trailing_zeros() as usize];
+        first |= e0;
+        second |= e1;
+        f &= f - 1;
+    }
+    // An edge's two planes differ, so it is on the contour where exactly one is in front.
+    let mut contour = first ^ second;
+    let count = contour.count_ones() as usize;
+    if count < 3 {
+        return None;
+    }
+    let mut next = [NONE; INLINE_VERTICES];
+    let mut start = NONE;
+    while contour != 0 {
+        let e = contour.trailing_zeros();
+        let [a, b, _, _] = faces.edges[e as usize];
+        let (a, b) = if (first >> e) & 1 == 1 {
+            (b, a)
+        } else {
+            (a, b)
+        };
+        if next[a as usize] != NONE {
+            return None;
+        }
+        next[a as usize] = b;
+        if start == NONE {
+            start = a;
+        }
+        contour &= contour - 1;
+    }
+    order[0] = start;
+    let mut at = next[start as usize];
+    for slot in order.iter_mut().take(count).skip(1) {
+        if at == NONE || at == start {
+            return None;
+        }
+        *slot = at;
+        at = next[at as usize];
+    }
+    (at == start).then_some(count)
+}
+
 /// The silhouette's turn at `cur` from the edge with difference `d_in` to the one with `d_out`
 /// is to the left or straight within its rounding bound (see [`convex_planes`]): `left_turn`'s
 /// operations.
@@ -1757,6 +1842,23 @@ fn contour_loop(
 fn turns_left(d_in: DVec3, d_out: DVec3, cur: DVec3) -> bool {
     let turn = d_in.cross(d_out).dot(cur);
     turn > 0.0 || turn > -MARGIN * norm1(d_in) * norm1(d_out) * norm1(cur)
+}
+
+/// A quick accept of [`turns_left`] at the end `b` of the silhouette edge `a -> b`, from the
+/// edge's computed plane normal `n = (a + b) x (b - a)` (`s = |a|_1 + |b|_1`) and the next
+/// vertex `c` (`c1 = |c|_1`): where it holds, `det(a, b, c) > 0` exactly, so the turn is to the
+/// left and [`turns_left`], whose bound covers its own rounding, accepts it too (the same
+/// decision, one dot product instead of a cross product and a dot product).
+///
+/// Exactly `(a + b) x (b - a) = 2 a x b`, so `N . c = 2 det(a, b, c)` for the exact normal `N`.
+/// The computed `n` is off from `N` by at most `8 eps s^2` in 1-norm ([`spaced_by_plane`]), which
+/// moves `n . c` by at most `8 eps s^2 c1`; the dot product's own rounding is at most
+/// `3 eps |n|_1 c1 (1 + eps)`, with `|n|_1 <= s^2 (1 + 8 eps)` (each product of a cross product's
+/// 1-norm pairs components of different indices once). Both together are below `12 eps s^2 c1`,
+/// well inside [`MARGIN`] (`64 eps`) times the same product.
+#[inline(always)]
+fn turns_left_by_plane(n: DVec3, s: f64, c: DVec3, c1: f64) -> bool {
+    n.dot(c) > MARGIN * s * s * c1
 }
 
 /// A quick accept of the spacing test of [`spaced_ids`] for consecutive silhouette directions
@@ -1844,7 +1946,10 @@ mod tests {
 
     use glam::DVec3;
 
-    use super::{ConvexFaces, Pieces, convex_blocker, convex_planes};
+    use super::{
+        ConvexFaces, INLINE_VERTICES, Pieces, contour_by_bits, contour_loop, convex_blocker,
+        convex_planes,
+    };
     use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
     use crate::visibility::ClipVisibility;
 
@@ -1962,6 +2067,100 @@ mod tests {
         assert!(
             tables >= 12 && compared > 8_000 && accepted > compared / 2 && accepted < compared,
             "{tables} tables, {compared} compared, {accepted} accepted"
+        );
+    }
+
+    /// Points within the facing tolerance of a face plane, where a face seen nearly edge-on is
+    /// left out of the silhouette and the silhouette turns right by a sliver (or runs straight,
+    /// in the plane): the table walk's turn decisions (a quick accept from the edge's plane,
+    /// then the general test) against [`convex_planes`]', which decides every turn by the
+    /// general test.
+    #[test]
+    fn turn_decisions_match_near_face_planes() {
+        let mut rng = Rng(23);
+        let (mut compared, mut accepted, mut declined) = (0, 0, 0);
+        for p in polyhedra(&mut rng) {
+            let Some(faces) = ConvexFaces::of(&p) else {
+                continue;
+            };
+            let mesh = p.mesh();
+            let scale = mesh.bounding_sphere().radius + mesh.bounding_sphere().center.length();
+            for k in 0..400 {
+                let f = k % mesh.triangle_count();
+                let t = mesh.triangle(f);
+                let on = t[0]
+                    + (t[1] - t[0]) * rng.range(-2.0, 3.0)
+                    + (t[2] - t[0]) * rng.range(-2.0, 3.0);
+                let delta = [0.0, 1e-15, -1e-15, 1e-13, -1e-13, 2e-12, -2e-12, 6e-12][k % 8];
+                let x = on + mesh.normals()[f] * (delta * scale);
+                let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
+                let Ok(frame) = frame else { continue };
+                let (mut a, mut b) = (Pieces::new(), Pieces::new());
+                let fast = convex_blocker(&p, &faces, &frame, &mut a);
+                let general = convex_planes(&p, &frame, &mut b);
+                assert_eq!(fast, general, "{x}");
+                compared += 1;
+                if fast {
+                    accepted += 1;
+                    let bits = |v: &[DVec3]| -> Vec<u64> {
+                        v.iter()
+                            .flat_map(|d| d.to_array().map(f64::to_bits))
+                            .collect()
+                    };
+                    assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
+                    assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
+                } else {
+                    declined += 1;
+                }
+            }
+        }
+        assert!(
+            compared > 10_000 && accepted > compared / 4 && declined > compared / 20,
+            "{compared} compared, {accepted} accepted, {declined} declined"
+        );
+    }
+
+    #[test]
+    fn contour_by_bits_matches_contour_loop() {
+        let mut rng = Rng(31);
+        let (mut tables, mut loops) = (0, 0);
+        for p in polyhedra(&mut rng) {
+            let Some(faces) = ConvexFaces::of(&p) else {
+                continue;
+            };
+            if faces.plane_edges.is_empty() {
+                continue;
+            }
+            tables += 1;
+            let planes = faces.normals.len();
+            for k in 0..4000u64 {
+                // Every set of front planes for the first ones, then random sets, and the sets
+                // that real points see (the planes facing a random direction).
+                let front = if k < 256 {
+                    k & ((1u64 << planes.min(8)) - 1)
+                } else if k % 2 == 0 {
+                    (rng.next().to_bits() ^ (rng.next().to_bits() << 11)) & ((1u64 << planes) - 1)
+                } else {
+                    let d = rng.vec(-1.0, 1.0);
+                    let mut f = 0u64;
+                    for (g, n) in faces.normals.iter().enumerate() {
+                        f |= u64::from(n.dot(d) > 0.0) << g;
+                    }
+                    f
+                };
+                let (mut a, mut b) = ([0u8; INLINE_VERTICES], [0u8; INLINE_VERTICES]);
+                let fast = contour_by_bits(front, &faces, &mut a);
+                let general = contour_loop(front, &faces.edges, &faces.masks, &mut b);
+                assert_eq!(fast, general, "front {front:b}");
+                if let Some(n) = fast {
+                    loops += 1;
+                    assert_eq!(a[..n], b[..n], "front {front:b}");
+                }
+            }
+        }
+        assert!(
+            tables >= 12 && loops > 10_000,
+            "{tables} tables, {loops} loops"
         );
     }
 
