@@ -416,11 +416,8 @@ impl Tree {
         let (ha, hb) = self.occluders[occ as usize].edge(edge);
         let reach = self.reach;
         let bounded = |o: Orienter| (o, o.reach_bound(reach));
-        let from_light: SmallVec<[(Orienter, f64); 8]> = self
-            .light
-            .iter()
-            .map(|&a| bounded(Orienter::new(ha, hb, a)))
-            .collect();
+        // Built on the first occluder that needs it (most nodes never try the light's test).
+        let mut from_light: SmallVec<[(Orienter, f64); 8]> = SmallVec::new();
         let from_cell: SmallVec<[(Orienter, f64); 4]> = self
             .cell
             .iter()
@@ -432,6 +429,13 @@ impl Tree {
             let o = self.work[i];
             let side = match self.orientation(o, &from_cell, false) {
                 Sign::Zero if self.try_light() => {
+                    if from_light.is_empty() {
+                        from_light.extend(
+                            self.light
+                                .iter()
+                                .map(|&a| bounded(Orienter::new(ha, hb, a))),
+                        );
+                    }
                     let side = self.orientation(o, &from_light, true);
                     self.light_hits += u32::from(side != Sign::Zero);
                     side
