@@ -324,7 +324,8 @@ fn scale(c: &mut Criterion) {
 /// target/release/deps/plucker-<hash>` (the scene is built either way; callgrind's
 /// `--toggle-collect` is not needed: subtract the count of the variant `none`). With
 /// `PLUCKER_BUDGET=<bytes>` the context of the `plucker_reuse` and `plucker_reset` variants has
-/// that budget.
+/// that budget; with `PLUCKER_CELL_SCALE=<factor>` its cells are that factor times the scene's
+/// (the tile size against the occluders per tree, BENCHMARKS.md).
 fn one_pass(spec: &str) {
     let parts: Vec<&str> = spec.split('/').collect();
     let [scene, variant, index] = parts[..] else {
@@ -338,7 +339,12 @@ fn one_pass(spec: &str) {
     };
     let clip = case.scene.visibility();
     let pl = PluckerVisibility::from_clip(clip.clone());
-    let mut ctx = PluckerContext::new(case.cell)
+    // PLUCKER_CELL_SCALE=<factor>: cells that factor times the scene's.
+    let scale: f64 = std::env::var("PLUCKER_CELL_SCALE")
+        .ok()
+        .and_then(|b| b.parse().ok())
+        .unwrap_or(1.0);
+    let mut ctx = PluckerContext::new(case.cell * scale)
         .unwrap()
         .with_reuse(variant != "plucker_reset");
     // PLUCKER_BUDGET=<bytes>: the context's budget (what the memory cap does).

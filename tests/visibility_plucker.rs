@@ -928,3 +928,63 @@ fn points_on_a_rough_terrain_see_what_the_rays_see() {
     assert!(tally.failures.is_empty(), "{}", tally.failures.join("\n"));
     assert!(tally.compared >= 1150, "{tally:?}");
 }
+
+#[test]
+fn a_crowded_tile_splits_into_sub_cells_and_keeps_the_answer() {
+    // A sieve of 2500 small disjoint triangles halfway between the ground and a 1 x 1 quad
+    // light (pitch 0.06): the shaft from a ground cell of side 1 holds more than 256 of them,
+    // so its tile splits once into cells of side 1/2, whose shafts hold fewer. The regions
+    // agree with the clipping backend (1e-9 of the unoccluded value), and the trees used are
+    // those of a context whose cells have side 1/2 from the start (same grid, same occluders).
+    let (pitch, size, n) = (0.06, 0.025, 50);
+    let mut verts = Vec::new();
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let c = DVec3::new(
+                (i as f64 - n as f64 / 2.0) * pitch,
+                (j as f64 - n as f64 / 2.0) * pitch,
+                1.5 + 0.01 * ((i * 7 + j * 3) % 5) as f64,
+            );
+            let k = verts.len() as u32;
+            verts.extend([c, c + DVec3::X * size, c + DVec3::new(0.3, 1.0, 0.1) * size]);
+            tris.push([k, k + 1, k + 2]);
+        }
+    }
+    let sieve = TriangleMesh::new(verts, tris).unwrap();
+    let scene = Scene::new(
+        vec![light(
+            quad(DVec3::new(0.2, 0.1, 3.0), 0.5, true),
+            DVec3::ONE,
+        )],
+        vec![Body::Mesh(sieve)],
+    )
+    .unwrap();
+    let clip = scene.visibility();
+    let pl = PluckerVisibility::from_clip(clip.clone());
+    let mut ctx = PluckerContext::new(1.0).unwrap();
+    let mut halves = PluckerContext::new(0.5).unwrap();
+    let mut rng = Rng::new(41);
+    let mut worst: f64 = 0.0;
+    for _ in 0..24 {
+        let x = DVec3::new(rng.range(0.02, 0.98), rng.range(0.02, 0.98), 0.0);
+        let f = ShadingFrame::new(x, DVec3::Z, DVec3::Z).unwrap();
+        let m_inv = lookup(f.view().z, 0.2).unwrap().m_inv;
+        let c = measures(&clip.visible_region(0, &f).unwrap(), m_inv);
+        let r = measures(&pl.visible_region_in(&mut ctx, 0, &f).unwrap(), m_inv);
+        let hv = measures(&pl.visible_region_in(&mut halves, 0, &f).unwrap(), m_inv);
+        let full = measures(&pl.unoccluded_region(0, &f).unwrap(), m_inv);
+        for i in 0..3 {
+            worst = worst.max((c[i] - r[i]).abs() / full[i].max(1e-300));
+            assert!((r[i] - hv[i]).abs() <= 1e-12 * full[i].max(1e-300));
+        }
+    }
+    let (s, h) = (ctx.stats(), halves.stats());
+    eprintln!("cells of 1: {s:?}\ncells of 1/2: {h:?}, worst {worst:.1e}");
+    assert!(worst <= 1e-9, "{worst}");
+    assert!(s.tiles_split >= 1 && h.tiles_split == 0, "{s:?}\n{h:?}");
+    assert!(h.max_tree_occluders > 0);
+    assert_eq!(s.max_tree_occluders, h.max_tree_occluders);
+    // Every tree the context kept is a sub-cell's: one per split tile and sub-cell used.
+    assert_eq!(s.trees_built - s.tiles_split, h.trees_built);
+}

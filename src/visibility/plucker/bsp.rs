@@ -22,6 +22,17 @@ use super::line::{Orienter, Sign};
 /// Most vertices of a clipped occluder: a triangle cut by two planes.
 pub(crate) const MAX_OCCLUDER_VERTICES: usize = 5;
 
+/// Tries of the light's test before its rate of decisions counts ([`Tree::try_light`]).
+const LIGHT_WARMUP: u32 = 256;
+
+/// The light's test keeps being tried on every mixed occluder while at least one try in this
+/// many decides ([`Tree::try_light`]).
+const LIGHT_RATE: u32 = 32;
+
+/// Otherwise it is tried on one mixed occluder in this many, so that a tree whose later nodes
+/// need it more finds out ([`Tree::try_light`]).
+const LIGHT_SAMPLE: u32 = 64;
+
 /// The index of the one invisible leaf every chain ends in (invisible leaves never change, so
 /// they are shared).
 pub(crate) const INVISIBLE: u32 = 0;
@@ -144,6 +155,11 @@ pub(crate) struct Tree {
     /// ([`Orienter::reach_bound`]).
     reach: f64,
     peak_bytes: usize,
+    /// How often the light's vertex-to-vertex test was tried after the tile's came out mixed,
+    /// how often it decided, and how often it was skipped ([`Tree::try_light`]).
+    light_tries: u32,
+    light_hits: u32,
+    light_skips: u32,
     pub(crate) counters: TreeCounters,
 }
 
@@ -206,6 +222,9 @@ impl Tree {
             rng: seed | 1,
             reach: 0.0,
             peak_bytes: 0,
+            light_tries: 0,
+            light_hits: 0,
+            light_skips: 0,
             counters: TreeCounters::default(),
         };
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
@@ -397,11 +416,8 @@ impl Tree {
         let (ha, hb) = self.occluders[occ as usize].edge(edge);
         let reach = self.reach;
         let bounded = |o: Orienter| (o, o.reach_bound(reach));
-        let from_light: SmallVec<[(Orienter, f64); 8]> = self
-            .light
-            .iter()
-            .map(|&a| bounded(Orienter::new(ha, hb, a)))
-            .collect();
+        // Built on the first occluder that needs it (most nodes never try the light's test).
+        let mut from_light: SmallVec<[(Orienter, f64); 8]> = SmallVec::new();
         let from_cell: SmallVec<[(Orienter, f64); 4]> = self
             .cell
             .iter()
@@ -412,7 +428,18 @@ impl Tree {
         while i < q {
             let o = self.work[i];
             let side = match self.orientation(o, &from_cell, false) {
-                Sign::Zero => self.orientation(o, &from_light, true),
+                Sign::Zero if self.try_light() => {
+                    if from_light.is_empty() {
+                        from_light.extend(
+                            self.light
+                                .iter()
+                                .map(|&a| bounded(Orienter::new(ha, hb, a))),
+                        );
+                    }
+                    let side = self.orientation(o, &from_light, true);
+                    self.light_hits += u32::from(side != Sign::Zero);
+                    side
+                }
                 strict => strict,
             };
             match side {
@@ -438,6 +465,28 @@ impl Tree {
         self.work.truncate(lo);
         self.note_size();
         self.compact();
+    }
+
+    /// Whether to try the light's vertex-to-vertex test on an occluder the tile's test found
+    /// mixed. Either answer is exact (a mixed occluder goes to both children); the light's
+    /// test only makes lists shorter when it decides, and it costs as much as the tile's. Where
+    /// it almost never decides (seen from a tile much smaller than the light, occluders that
+    /// straddle a node's plane from the tile mostly straddle it from the light too: 0.5% of
+    /// the tries on the terrain of `benches/plucker.rs` at 100K triangles), it is tried on one
+    /// mixed occluder in [`LIGHT_SAMPLE`] only: after [`LIGHT_WARMUP`] tries, while fewer than
+    /// one in [`LIGHT_RATE`] decided. The counters are the tree's, kept across
+    /// [`Tree::reset`], and deterministic, so a tree's growth does not depend on the timing.
+    fn try_light(&mut self) -> bool {
+        let useful = self.light_tries < LIGHT_WARMUP
+            || self.light_hits.saturating_mul(LIGHT_RATE) >= self.light_tries;
+        if useful || self.light_skips >= LIGHT_SAMPLE {
+            self.light_tries = self.light_tries.saturating_add(1);
+            self.light_skips = 0;
+            true
+        } else {
+            self.light_skips += 1;
+            false
+        }
     }
 
     /// Adds the ids `work[lo..hi]` to what node `n` holds: an invisible class ignores them, a
@@ -586,5 +635,54 @@ impl Tree {
             (false, true) => Sign::Negative,
             _ => Sign::Zero,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tree() -> Tree {
+        let light = [
+            DVec3::new(0.0, 0.0, 2.0),
+            DVec3::new(1.0, 0.0, 2.0),
+            DVec3::new(0.0, 1.0, 2.0),
+        ];
+        let occ = Occluder::new(
+            &[
+                DVec3::new(0.2, 0.2, 1.0),
+                DVec3::new(0.4, 0.2, 1.0),
+                DVec3::new(0.2, 0.4, 1.0),
+            ],
+            Crossing::Positive,
+        );
+        Tree::new(&[DVec3::ZERO], &light, alloc::vec![occ], 3)
+    }
+
+    #[test]
+    fn the_light_test_is_sampled_only_where_it_rarely_decides() {
+        // Never deciding: tried on every mixed occluder for the warm-up, then on one in
+        // LIGHT_SAMPLE + 1 (the skips between tries), and the schedule survives a reset.
+        let mut t = tree();
+        for k in 0..LIGHT_WARMUP {
+            assert!(t.try_light(), "warm-up try {k}");
+        }
+        t.reset();
+        let tried: Vec<u32> = (0..3 * (LIGHT_SAMPLE + 1))
+            .filter(|_| t.try_light())
+            .collect();
+        assert_eq!(tried.len(), 3, "{tried:?}");
+        // Deciding one time in LIGHT_RATE keeps it on every occluder.
+        let mut t = tree();
+        for k in 0..10 * LIGHT_WARMUP {
+            assert!(t.try_light(), "try {k}");
+            t.light_hits += u32::from(k % LIGHT_RATE == 0);
+        }
+        // Rarer than that, it is sampled again.
+        for _ in 0..LIGHT_WARMUP {
+            t.try_light();
+        }
+        let tried = (0..2 * LIGHT_SAMPLE).filter(|_| t.try_light()).count();
+        assert!(tried <= 2, "{tried}");
     }
 }
