@@ -180,6 +180,34 @@ impl Overlay {
         }
     }
 
+    /// The winding number about `q` of the rings of family `fam` from ring `first` on (a ray
+    /// along `+x`, half-open in `y` as in [`Overlay::ray`]); `None` where the ray passes within
+    /// rounding of a vertex or edge.
+    pub(crate) fn winding(&self, first: usize, fam: u8, q: DVec2) -> Option<i32> {
+        let mut w = 0;
+        for r in first..self.ends.len() {
+            if self.family[r] != fam {
+                continue;
+            }
+            let start = if r == 0 { 0 } else { self.ends[r - 1] as usize };
+            let ring = &self.pts[start..self.ends[r] as usize];
+            for (k, a) in ring.iter().enumerate() {
+                let (p0, p1) = (a.p, ring[(k + 1) % ring.len()].p);
+                if (p0.y > q.y) == (p1.y > q.y) || (p0.x < q.x && p1.x < q.x) {
+                    continue;
+                }
+                let (o, b) = orient(p0, p1, q);
+                if o.abs() <= b {
+                    return None;
+                }
+                if (o > 0.0) == (p1.y > p0.y) {
+                    w += if o > 0.0 { 1 } else { -1 };
+                }
+            }
+        }
+        Some(w)
+    }
+
     #[inline(always)]
     fn succ(&self, k: usize) -> usize {
         let r = self.ring_of[k] as usize;
