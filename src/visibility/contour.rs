@@ -48,6 +48,10 @@ use crate::solid::{Bvh, TriangleMesh};
 /// tested edge by edge (a box has 18 edges).
 const TREE_MIN_EDGES: usize = 48;
 
+/// Weight of the normals' axes against the positions' (in units of the component's size) when
+/// the facing hierarchy chooses the axis of a split.
+const NORMAL_WEIGHT: f64 = 0.25;
+
 /// Most edges in a leaf of the facing hierarchy.
 const LEAF_EDGES: usize = 6;
 
@@ -413,10 +417,18 @@ fn build_tree(
     nodes: &mut Vec<FacingNode>,
 ) {
     let verts = mesh.vertices();
+    let normals = mesh.normals();
     let mid = |e: &[u32; 4]| 0.5 * (verts[e[0] as usize] + verts[e[1] as usize]);
+    // The mean normal of an edge's two faces: splitting on it keeps the normal cones of the
+    // children narrow, which is what classifies a node from a point far away (the spread term
+    // of `FacingNode`), where a split on position alone keeps whole cross-sections of a tube
+    // (every normal direction) in one node down to small nodes.
+    let nrm = |e: &[u32; 4]| normals[e[2] as usize] + normals[e[3] as usize];
     // Depth first (first child first); `open` holds the inner nodes whose subtrees are not
     // complete yet, with the number of their children still to be finished.
     let mut stack: Vec<(usize, usize)> = vec![(0, edges.len())];
+    // The component's size (the root's), the scale of the normals' axes.
+    let mut root_size = 0.0;
     let mut open: Vec<(usize, u8)> = Vec::new();
     while let Some((first, end)) = stack.pop() {
         let node = nodes.len();
@@ -442,21 +454,40 @@ fn build_tree(
             continue;
         }
         open.push((node, 2));
-        // Median split along the longest axis of the edges' midpoints.
-        let (lo, hi) = range.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), e| (lo.min(mid(e)), hi.max(mid(e))),
+        // Median split along the longest of six axes: the edges' midpoints, and their mean
+        // normals (components in [-1, 1]) scaled by the component's size and `NORMAL_WEIGHT`.
+        let (lo, hi, nlo, nhi) = range.iter().fold(
+            (
+                DVec3::splat(f64::INFINITY),
+                DVec3::splat(f64::NEG_INFINITY),
+                DVec3::splat(f64::INFINITY),
+                DVec3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi, nlo, nhi), e| {
+                let (p, n) = (mid(e), 0.5 * nrm(e));
+                (lo.min(p), hi.max(p), nlo.min(n), nhi.max(n))
+            },
         );
         let ext = hi - lo;
-        let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        if root_size == 0.0 {
+            root_size = ext.length();
+        }
+        let next = nhi - nlo;
+        let by_normal = next.max_element() * NORMAL_WEIGHT * root_size > ext.max_element();
+        let e = if by_normal { next } else { ext };
+        let axis = if e.x >= e.y && e.x >= e.z {
             0
-        } else if ext.y >= ext.z {
+        } else if e.y >= e.z {
             1
         } else {
             2
         };
         let m = range.len() / 2;
-        range.select_nth_unstable_by(m, |a, b| mid(a)[axis].total_cmp(&mid(b)[axis]));
+        if by_normal {
+            range.select_nth_unstable_by(m, |a, b| nrm(a)[axis].total_cmp(&nrm(b)[axis]));
+        } else {
+            range.select_nth_unstable_by(m, |a, b| mid(a)[axis].total_cmp(&mid(b)[axis]));
+        }
         stack.push((first + m, end));
         stack.push((first, first + m));
     }
