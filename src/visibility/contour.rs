@@ -572,45 +572,43 @@ pub(crate) fn chain_rings(
     let bits = (2 * n).next_power_of_two().trailing_zeros().max(1);
     let mask = (1usize << bits) - 1;
     let slot_of = |v: u32| (v.wrapping_mul(0x9E37_79B9) >> (32 - bits)) as usize;
-    let (table, link, next) = (&mut s.table, &mut s.link, &mut s.next);
-    table.clear();
-    table.resize(mask + 1, [u32::MAX; 2]);
-    link.clear();
-    link.resize(n, u32::MAX);
+    // One buffer: `next` and `link` per edge, then the table's slots as pairs.
+    let work = &mut s.work;
+    work.clear();
+    work.resize(2 * n + 2 * (mask + 1), u32::MAX);
+    let (next, rest) = work.split_at_mut(n);
+    let (link, table) = rest.split_at_mut(n);
     for (k, &(a, _)) in edges.iter().enumerate() {
         if a == u32::MAX {
             return false;
         }
         let mut h = slot_of(a);
         loop {
-            let t = &mut table[h];
-            if t[0] == u32::MAX {
-                *t = [a, k as u32];
+            if table[2 * h] == u32::MAX {
+                table[2 * h] = a;
+                table[2 * h + 1] = k as u32;
                 break;
             }
-            if t[0] == a {
-                link[k] = t[1];
-                t[1] = k as u32;
+            if table[2 * h] == a {
+                link[k] = table[2 * h + 1];
+                table[2 * h + 1] = k as u32;
                 break;
             }
             h = (h + 1) & mask;
         }
     }
-    let first_out = |table: &[[u32; 2]], v: u32| {
+    let first_out = |table: &[u32], v: u32| {
         let mut h = slot_of(v);
         loop {
-            let t = table[h];
-            if t[0] == v {
-                return t[1];
+            if table[2 * h] == v {
+                return table[2 * h + 1];
             }
-            if t[0] == u32::MAX {
+            if table[2 * h] == u32::MAX {
                 return u32::MAX;
             }
             h = (h + 1) & mask;
         }
     };
-    next.clear();
-    next.resize(n, u32::MAX);
     // Single successors; vertices left by several edges are paired by angle.
     for k in 0..n {
         let head = first_out(table, edges[k].1);
@@ -624,8 +622,8 @@ pub(crate) fn chain_rings(
             next[k] = head;
         }
     }
-    for t in 0..table.len() {
-        let [v, head] = table[t];
+    for t in 0..=mask {
+        let (v, head) = (table[2 * t], table[2 * t + 1]);
         if v == u32::MAX || link[head as usize] == u32::MAX {
             continue;
         }
@@ -699,9 +697,7 @@ pub(crate) fn chain_rings(
 /// Scratch storage of [`chain_rings`] (reused across calls).
 #[derive(Debug, Clone, Default)]
 pub(crate) struct ChainScratch {
-    table: Vec<[u32; 2]>,
-    link: Vec<u32>,
-    next: Vec<u32>,
+    work: Vec<u32>,
     ring: Vec<u32>,
 }
 
@@ -709,9 +705,7 @@ impl ChainScratch {
     /// Storage for about `n` contour edges.
     pub(crate) fn with_capacity(n: usize) -> Self {
         ChainScratch {
-            table: Vec::with_capacity(2 * n),
-            link: Vec::with_capacity(n),
-            next: Vec::with_capacity(n),
+            work: Vec::with_capacity(6 * n),
             ring: Vec::with_capacity(n),
         }
     }
