@@ -905,8 +905,8 @@ fn fast_path_near_a_quad_lights_plane() {
 /// its tube). At least half of the points must be answered by the overlay.
 #[test]
 fn cone_culled_contours_agree_with_per_triangle() {
-    let quad = TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.1, DVec3::X * 0.1)
-        .unwrap();
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.1, DVec3::X * 0.1).unwrap();
     let light = Light::new(quad, DVec3::ONE).unwrap();
     let sphere = placed(
         &bumpy_sphere(3, 0.1, 5).unwrap(),
@@ -962,5 +962,8 @@ fn cone_culled_contours_agree_with_per_triangle() {
         failures.len(),
         failures.join("\n")
     );
-    assert!(2 * by_overlay >= compared && compared >= 60, "{by_overlay} of {compared}");
+    assert!(
+        2 * by_overlay >= compared && compared >= 60,
+        "{by_overlay} of {compared}"
+    );
 }

@@ -19,7 +19,14 @@
 //!   an axis and the range of the planes' offsets from the node's centre, the normal cones of
 //!   Sander et al., *Silhouette clipping*, SIGGRAPH 2000, section 4, with the offsets anchored
 //!   at the node): a node whose faces are all front faces, or none, holds no contour edge and is
-//!   skipped with its subtree.
+//!   skipped with its subtree. Nodes are stored depth first with the end of each subtree, so
+//!   the walk needs no stack; splits take the longer of the edges' midpoints and their mean
+//!   normals (scaled by the component's size), so that the cones of normals stay narrow in
+//!   meshes such as tori, whose nodes would otherwise hold whole cross-sections of the tube;
+//! - with [`Cull::Cone`], nodes whose boxes lie outside a cone through the point (the light's
+//!   box in the chart) are skipped as well: the contour found is then the part in that cone,
+//!   as open chains and closed rings ([`chain_rings`]); `visibility/mesh_pieces.rs` restores
+//!   the winding the rest contributes inside the cone.
 //!
 //! A query declines where the point lies inside the box of a component it takes: outside it,
 //! the component lies in an open half-space away from the point (beyond a face plane of the
@@ -384,13 +391,15 @@ impl Walk<'_> {
             let mut mixed = n.classify(self.x, tol) == NodeFacing::Mixed;
             // The cone is tested at inner nodes only: at a leaf the test would cost about what
             // its edges' facing tests cost.
-            if mixed && i >= inside_until && n.count == 0 {
-                if let Some(cone) = &self.cone {
-                    match cone.classify(n, self.x) {
-                        ConeSide::Outside => mixed = false,
-                        ConeSide::Inside => inside_until = n.start,
-                        ConeSide::Both => {}
-                    }
+            if mixed
+                && i >= inside_until
+                && n.count == 0
+                && let Some(cone) = &self.cone
+            {
+                match cone.classify(n, self.x) {
+                    ConeSide::Outside => mixed = false,
+                    ConeSide::Inside => inside_until = n.start,
+                    ConeSide::Both => {}
                 }
             }
             if n.count > 0 {
@@ -647,8 +656,9 @@ pub(crate) fn chain_rings(
                 link[k as usize] = 1;
             }
         }
-        for start in 0..n {
-            if link[start] == 1 {
+        // `link` now marks the edges with a predecessor: chains start at the others.
+        for (start, &has_pred) in link.iter().enumerate() {
+            if has_pred == 1 {
                 continue;
             }
             ring.clear();

@@ -13,6 +13,19 @@
 //! whole (their contours are closed by themselves); convex and small open mesh blockers are
 //! subtracted afterwards by the boundary tracing of `visibility/pieces.rs`.
 //!
+//! A blocker of one component with a facing hierarchy and a bounding-volume hierarchy goes
+//! further: only the part of its contour that may lie in the cone through the chart's box is
+//! found ([`Cull::Cone`]), and chained into closed rings and open chains whose ends lie outside
+//! the cone. Each open chain is closed through the direction opposite the box's centre (two
+//! arcs of great circles through that centre, beyond the chain's ends: outside the box). Inside
+//! the box these rings then wind as the whole contour does up to one integer, the winding of
+//! the left-out edges and closing arcs, a closed path outside the box: that integer is found at
+//! one direction of the box as the count of front faces a ray from the point crosses there
+//! (through the mesh's hierarchy, every decision certified) less the rings' winding there, and
+//! put back as that many copies of the box's boundary (bridges: counted by the overlay's rays,
+//! never kept). The shaft idea of Haines and Wallace (*Shaft culling for efficient ray-cast
+//! radiosity*, 1991) applied to contour edges, with the topology restored by one ray.
+//!
 //! It declines (the caller takes the general path) where the light is wider than one chart, a
 //! mesh light's contour reaches the horizon, the point lies in the box of a component of the
 //! mesh light or of a blocker component in the shaft, the region before the overlay is not a set of simple rings, or the overlay declines
@@ -499,7 +512,8 @@ fn front_cover(mesh: &TriangleMesh, bvh: Option<&Bvh>, x: DVec3, d: DVec3) -> Op
 /// Whether the ray from `x` along `d` may meet the box `[lo, hi]` (widened by `1e-9` of its
 /// size and position, beyond the rounding of the slab test).
 fn ray_meets_box(x: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> bool {
-    let m = 1e-9 * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element() + x.abs().max_element());
+    let m = 1e-9
+        * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element() + x.abs().max_element());
     let (lo, hi) = (lo - DVec3::splat(m), hi + DVec3::splat(m));
     let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
     for i in 0..3 {

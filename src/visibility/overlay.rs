@@ -297,7 +297,8 @@ impl Overlay {
             self.bbox
                 .push([a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y)]);
             if !self.pts[k].bridge {
-                self.order.push(u128::from(order_bits(a.x.min(b.x))) << 32 | k as u128);
+                self.order
+                    .push(u128::from(order_bits(a.x.min(b.x))) << 32 | k as u128);
             }
         }
         self.order.sort_unstable();
