@@ -895,3 +895,75 @@ fn fast_path_near_a_quad_lights_plane() {
         );
     }
 }
+
+/// The fast path's cone culling of a one-component closed mesh (only the contour inside the
+/// light's chart box is chained; the winding it leaves out is restored from a count of front
+/// faces along one ray) against the per-triangle path, where that count is the whole answer:
+/// a small quad light seen from ground points through a large bumpy sphere (the light wholly
+/// behind it, with no contour edge in the box, partly, or beside it), and through a large
+/// torus (the light in its hole: two silhouettes around the box, winding 0 inside; or behind
+/// its tube). At least half of the points must be answered by the overlay.
+#[test]
+fn cone_culled_contours_agree_with_per_triangle() {
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.1, DVec3::X * 0.1).unwrap();
+    let light = Light::new(quad, DVec3::ONE).unwrap();
+    let sphere = placed(
+        &bumpy_sphere(3, 0.1, 5).unwrap(),
+        1.0,
+        0.3,
+        DVec3::new(0.0, 0.0, 1.5),
+        false,
+    );
+    let ring = placed(
+        &torus(1.0, 0.3, 32, 12).unwrap(),
+        1.0,
+        0.0,
+        DVec3::new(0.0, 0.0, 1.5),
+        false,
+    );
+    let mut rng = Rng::new(0xC0_4E);
+    let (mut compared, mut by_overlay) = (0usize, 0usize);
+    let mut failures = Vec::new();
+    let mut pieces = Pieces::new();
+    for (name, mesh, reach) in [("bumpy sphere", &sphere, 3.5), ("torus", &ring, 4.5)] {
+        let scene = Scene::new(vec![light.clone()], vec![mesh.clone().into()]).unwrap();
+        let reference = scene.clone().with_method(Method::PerTriangle);
+        for _ in 0..40 {
+            let x = DVec3::new(rng.range(-reach, reach), rng.range(-reach, reach), 0.0);
+            let v = view_above(&mut rng, DVec3::Z, 0.2);
+            let Ok(frame) = ShadingFrame::new(x, DVec3::Z, v) else {
+                continue;
+            };
+            let before = pieces.overlays();
+            if !scene
+                .visibility()
+                .visible_pieces(0, &frame, true, &mut pieces)
+                .unwrap()
+            {
+                continue;
+            }
+            let a = chain_solid_angle(pieces.rings());
+            let Ok(r) = reference.visible_region(0, &frame) else {
+                continue;
+            };
+            let b = solid_angle(&r);
+            compared += 1;
+            by_overlay += usize::from(pieces.overlays() > before);
+            if (a - b).abs() > 1e-10 {
+                failures.push(format!("{name}, point {x}: fast {a}, per triangle {b}"));
+            }
+        }
+    }
+    println!("{compared} points compared, {by_overlay} by the overlay");
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    assert!(
+        2 * by_overlay >= compared && compared >= 60,
+        "{by_overlay} of {compared}"
+    );
+}

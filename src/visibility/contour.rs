@@ -19,7 +19,14 @@
 //!   an axis and the range of the planes' offsets from the node's centre, the normal cones of
 //!   Sander et al., *Silhouette clipping*, SIGGRAPH 2000, section 4, with the offsets anchored
 //!   at the node): a node whose faces are all front faces, or none, holds no contour edge and is
-//!   skipped with its subtree.
+//!   skipped with its subtree. Nodes are stored depth first with the end of each subtree, so
+//!   the walk needs no stack; splits take the longer of the edges' midpoints and their mean
+//!   normals (scaled by the component's size), so that the cones of normals stay narrow in
+//!   meshes such as tori, whose nodes would otherwise hold whole cross-sections of the tube;
+//! - with [`Cull::Cone`], nodes whose boxes lie outside a cone through the point (the light's
+//!   box in the chart) are skipped as well: the contour found is then the part in that cone,
+//!   as open chains and closed rings ([`chain_rings`]); `visibility/mesh_pieces.rs` restores
+//!   the winding the rest contributes inside the cone.
 //!
 //! A query declines where the point lies inside the box of a component it takes: outside it,
 //! the component lies in an open half-space away from the point (beyond a face plane of the
@@ -47,6 +54,10 @@ use crate::solid::{Bvh, TriangleMesh};
 /// Components with at least this many edges get a hierarchy of facing bounds; smaller ones are
 /// tested edge by edge (a box has 18 edges).
 const TREE_MIN_EDGES: usize = 48;
+
+/// Weight of the normals' axes against the positions' (in units of the component's size) when
+/// the facing hierarchy chooses the axis of a split.
+const NORMAL_WEIGHT: f64 = 0.25;
 
 /// Most edges in a leaf of the facing hierarchy.
 const LEAF_EDGES: usize = 6;
@@ -96,11 +107,14 @@ struct Component {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct FacingNode {
     center: DVec3,
+    /// Half the extent of the box of its faces about `center`.
+    half: DVec3,
     axis: DVec3,
     spread: f64,
     q_lo: f64,
     q_hi: f64,
-    /// A leaf's first edge; an inner node's second child (its first is the next node).
+    /// A leaf's first edge; for an inner node, the end of its subtree (its first child is the
+    /// next node, and its subtree's nodes are consecutive).
     start: u32,
     /// A leaf's edge count; 0 for an inner node.
     count: u32,
@@ -141,6 +155,12 @@ pub(crate) enum Cull<'a> {
     /// Those whose boxes may meet the shaft; the query declines when the point lies inside the
     /// box of one of them.
     Shaft(&'a Shaft),
+    /// As [`Cull::Shaft`], and within a component with a facing hierarchy only the nodes whose
+    /// boxes may meet the cone through the point bounded by the given planes (unit normals
+    /// through the point, the cone on their positive sides): the edges left out lie outside
+    /// that cone beyond rounding, and the contour is then a set of chains, closed or open
+    /// (ending outside the cone), see [`chain_rings`].
+    Cone(&'a Shaft, &'a [DVec3; 4]),
 }
 
 impl MeshContours {
@@ -222,6 +242,10 @@ impl MeshContours {
             edges: &self.edges,
             nodes: &self.nodes,
             x,
+            cone: match cull {
+                Cull::Cone(_, planes) => Some(Cone::new(planes)),
+                _ => None,
+            },
         };
         match cull {
             Cull::All => {
@@ -233,7 +257,7 @@ impl MeshContours {
                 }
                 true
             }
-            Cull::Shaft(shaft) => {
+            Cull::Shaft(shaft) | Cull::Cone(shaft, _) => {
                 let mut ok = true;
                 let mut take = |c: &Component| {
                     if ok && shaft.may_meet_box(c.lo, c.hi) {
@@ -265,6 +289,58 @@ fn outside_box(lo: DVec3, hi: DVec3, x: DVec3) -> bool {
     x.cmplt(lo - DVec3::splat(m)).any() || x.cmpgt(hi + DVec3::splat(m)).any()
 }
 
+/// The cone of [`Cull::Cone`]: the planes' unit normals and their absolute values.
+struct Cone {
+    planes: [DVec3; 4],
+    abs: [DVec3; 4],
+}
+
+/// Where a node's box lies against a [`Cone`].
+enum ConeSide {
+    Outside,
+    Inside,
+    Both,
+}
+
+impl Cone {
+    fn new(planes: &[DVec3; 4]) -> Self {
+        Cone {
+            planes: *planes,
+            abs: planes.map(DVec3::abs),
+        }
+    }
+
+    /// The box of node `n` against the cone through `x`, beyond rounding (`1e-9` of the box's
+    /// size and distance): outside where it lies on the negative side of a plane, inside where
+    /// it lies on the positive side of all four.
+    #[inline]
+    fn classify(&self, n: &FacingNode, x: DVec3) -> ConeSide {
+        let y = n.center - x;
+        let m = 1e-9 * (y.abs().max_element() + n.half.max_element() + x.abs().max_element());
+        let mut inside = true;
+        for (p, a) in self.planes.iter().zip(&self.abs) {
+            let (mid, r) = (p.dot(y), a.dot(n.half));
+            if mid + r < -m {
+                return ConeSide::Outside;
+            }
+            inside &= mid - r > m;
+        }
+        if inside {
+            ConeSide::Inside
+        } else {
+            ConeSide::Both
+        }
+    }
+}
+
+impl MeshContours {
+    /// Whether the mesh is one component with a facing hierarchy: the case where
+    /// [`Cull::Cone`] leaves edges out (a contour of open chains).
+    pub(crate) fn single_tree(&self) -> bool {
+        self.comps.len() == 1 && self.comps[0].root != NO_TREE
+    }
+}
+
 /// One contour query's view of the mesh.
 struct Walk<'a> {
     at: FacingAt,
@@ -273,6 +349,7 @@ struct Walk<'a> {
     edges: &'a [[u32; 4]],
     nodes: &'a [FacingNode],
     x: DVec3,
+    cone: Option<Cone>,
 }
 
 impl Walk<'_> {
@@ -298,18 +375,42 @@ impl Walk<'_> {
             return;
         }
         let tol = self.at.tol();
-        let mut stack: SmallVec<[u32; 64]> = SmallVec::new();
-        stack.push(c.root);
-        while let Some(i) = stack.pop() {
+        // Depth first without a stack: a node's first child is the next node, and an inner
+        // node's `start` is the end of its subtree, where a skipped subtree resumes.
+        let root = &self.nodes[c.root as usize];
+        let end = if root.count > 0 {
+            c.root + 1
+        } else {
+            root.start
+        };
+        let mut i = c.root;
+        // Nodes before this one lie inside the cone (or there is none): no test.
+        let mut inside_until = if self.cone.is_some() { 0 } else { end };
+        while i < end {
             let n = &self.nodes[i as usize];
-            if n.classify(self.x, tol) != NodeFacing::Mixed {
-                continue;
+            let mut mixed = n.classify(self.x, tol) == NodeFacing::Mixed;
+            // The cone is tested at inner nodes only: at a leaf the test would cost about what
+            // its edges' facing tests cost.
+            if mixed
+                && i >= inside_until
+                && n.count == 0
+                && let Some(cone) = &self.cone
+            {
+                match cone.classify(n, self.x) {
+                    ConeSide::Outside => mixed = false,
+                    ConeSide::Inside => inside_until = n.start,
+                    ConeSide::Both => {}
+                }
             }
             if n.count > 0 {
-                self.edges(n.start as usize..(n.start + n.count) as usize, out);
+                if mixed {
+                    self.edges(n.start as usize..(n.start + n.count) as usize, out);
+                }
+                i += 1;
+            } else if mixed {
+                i += 1;
             } else {
-                stack.push(n.start);
-                stack.push(i + 1);
+                i = n.start;
             }
         }
     }
@@ -325,14 +426,21 @@ fn build_tree(
     nodes: &mut Vec<FacingNode>,
 ) {
     let verts = mesh.vertices();
+    let normals = mesh.normals();
     let mid = |e: &[u32; 4]| 0.5 * (verts[e[0] as usize] + verts[e[1] as usize]);
-    // (parent awaiting its second child, first, end), relative to `edges`.
-    let mut stack: Vec<(Option<usize>, usize, usize)> = vec![(None, 0, edges.len())];
-    while let Some((parent, first, end)) = stack.pop() {
+    // The mean normal of an edge's two faces: splitting on it keeps the normal cones of the
+    // children narrow, which is what classifies a node from a point far away (the spread term
+    // of `FacingNode`), where a split on position alone keeps whole cross-sections of a tube
+    // (every normal direction) in one node down to small nodes.
+    let nrm = |e: &[u32; 4]| normals[e[2] as usize] + normals[e[3] as usize];
+    // Depth first (first child first); `open` holds the inner nodes whose subtrees are not
+    // complete yet, with the number of their children still to be finished.
+    let mut stack: Vec<(usize, usize)> = vec![(0, edges.len())];
+    // The component's size (the root's), the scale of the normals' axes.
+    let mut root_size = 0.0;
+    let mut open: Vec<(usize, u8)> = Vec::new();
+    while let Some((first, end)) = stack.pop() {
         let node = nodes.len();
-        if let Some(p) = parent {
-            nodes[p].start = node as u32;
-        }
         let range = &mut edges[first..end];
         let leaf = range.len() <= LEAF_EDGES;
         nodes.push(facing_bounds(
@@ -342,25 +450,55 @@ fn build_tree(
             leaf,
         ));
         if leaf {
+            // Subtrees completed by this leaf: their ends are the next node.
+            while let Some(top) = open.last_mut() {
+                top.1 -= 1;
+                if top.1 > 0 {
+                    break;
+                }
+                let p = top.0;
+                open.pop();
+                nodes[p].start = nodes.len() as u32;
+            }
             continue;
         }
-        // Median split along the longest axis of the edges' midpoints.
-        let (lo, hi) = range.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), e| (lo.min(mid(e)), hi.max(mid(e))),
+        open.push((node, 2));
+        // Median split along the longest of six axes: the edges' midpoints, and their mean
+        // normals (components in [-1, 1]) scaled by the component's size and `NORMAL_WEIGHT`.
+        let (lo, hi, nlo, nhi) = range.iter().fold(
+            (
+                DVec3::splat(f64::INFINITY),
+                DVec3::splat(f64::NEG_INFINITY),
+                DVec3::splat(f64::INFINITY),
+                DVec3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi, nlo, nhi), e| {
+                let (p, n) = (mid(e), 0.5 * nrm(e));
+                (lo.min(p), hi.max(p), nlo.min(n), nhi.max(n))
+            },
         );
         let ext = hi - lo;
-        let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        if root_size == 0.0 {
+            root_size = ext.length();
+        }
+        let next = nhi - nlo;
+        let by_normal = next.max_element() * NORMAL_WEIGHT * root_size > ext.max_element();
+        let e = if by_normal { next } else { ext };
+        let axis = if e.x >= e.y && e.x >= e.z {
             0
-        } else if ext.y >= ext.z {
+        } else if e.y >= e.z {
             1
         } else {
             2
         };
         let m = range.len() / 2;
-        range.select_nth_unstable_by(m, |a, b| mid(a)[axis].total_cmp(&mid(b)[axis]));
-        stack.push((Some(node), first + m, end));
-        stack.push((None, first, first + m));
+        if by_normal {
+            range.select_nth_unstable_by(m, |a, b| nrm(a)[axis].total_cmp(&nrm(b)[axis]));
+        } else {
+            range.select_nth_unstable_by(m, |a, b| mid(a)[axis].total_cmp(&mid(b)[axis]));
+        }
+        stack.push((first + m, end));
+        stack.push((first, first + m));
     }
 }
 
@@ -397,6 +535,7 @@ fn facing_bounds(mesh: &TriangleMesh, edges: &[[u32; 4]], start: u32, leaf: bool
     let pad = 1e-9 * scale;
     FacingNode {
         center,
+        half: 0.5 * (hi - lo),
         axis,
         spread: spread * (1.0 + 1e-9) + 1e-12,
         q_lo: q_lo - pad,
@@ -417,49 +556,136 @@ fn facing_bounds(mesh: &TriangleMesh, edges: &[[u32; 4]], start: u32, leaf: bool
 /// which keeps the rings' crossings those of their edges' interiors for the overlay; the chain,
 /// and so its winding numbers, is the same whatever the pairing. `false` where the pairing
 /// cannot be decided within rounding or the walk does not close.
+///
+/// With `open` (a contour of [`Cull::Cone`], some of its edges left out), a chain may also end
+/// where no edge leaves its last vertex: such chains are passed to `emit` first, with their
+/// last vertex and `true`; closed rings get `false`. A vertex where the kept edges do not
+/// balance and more than one edge arrives or leaves declines (`false`).
 pub(crate) fn chain_rings(
-    edges: &mut [(u32, u32)],
+    edges: &[(u32, u32)],
     dir: impl Fn(u32) -> DVec3,
-    next: &mut Vec<u32>,
-    ring: &mut Vec<u32>,
-    mut emit: impl FnMut(&[u32]),
+    open: bool,
+    s: &mut ChainScratch,
+    mut emit: impl FnMut(&[u32], bool),
 ) -> bool {
-    edges.sort_unstable();
     let n = edges.len();
-    next.clear();
-    next.resize(n, u32::MAX);
-    // Edges out of each vertex are consecutive after sorting.
-    let mut i = 0;
-    while i < n {
-        let v = edges[i].0;
-        let mut j = i + 1;
-        while j < n && edges[j].0 == v {
-            j += 1;
-        }
-        if j - i > 1 && !pair_at(edges, i..j, &dir, next) {
+    if n == 0 {
+        return true;
+    }
+    if n >= (u32::MAX / 4) as usize {
+        return false;
+    }
+    // The edges leaving each vertex as a linked list (`link`) from the vertex's slot in an
+    // open-addressed table (`[vertex, first edge]`, at most half full): linear in the edges,
+    // where a sort of them is `n log n`.
+    let bits = (2 * n).next_power_of_two().trailing_zeros().max(1);
+    let mask = (1usize << bits) - 1;
+    let slot_of = |v: u32| (v.wrapping_mul(0x9E37_79B9) >> (32 - bits)) as usize;
+    // One buffer: `next` and `link` per edge, then the table's slots as pairs.
+    let work = &mut s.work;
+    work.clear();
+    work.resize(2 * n + 2 * (mask + 1), u32::MAX);
+    let (next, rest) = work.split_at_mut(n);
+    let (link, table) = rest.split_at_mut(n);
+    for (k, &(a, _)) in edges.iter().enumerate() {
+        if a == u32::MAX {
             return false;
         }
-        i = j;
-    }
-    // Single successors.
-    for k in 0..n {
-        let b = edges[k].1;
-        let from = edges.partition_point(|e| e.0 < b);
-        if from < n && edges[from].0 == b && (from + 1 == n || edges[from + 1].0 != b) {
-            if next[k] != u32::MAX {
-                return false;
+        let mut h = slot_of(a);
+        loop {
+            if table[2 * h] == u32::MAX {
+                table[2 * h] = a;
+                table[2 * h + 1] = k as u32;
+                break;
             }
-            next[k] = from as u32;
+            if table[2 * h] == a {
+                link[k] = table[2 * h + 1];
+                table[2 * h + 1] = k as u32;
+                break;
+            }
+            h = (h + 1) & mask;
         }
     }
-    // Walk.
+    let first_out = |table: &[u32], v: u32| {
+        let mut h = slot_of(v);
+        loop {
+            if table[2 * h] == v {
+                return table[2 * h + 1];
+            }
+            if table[2 * h] == u32::MAX {
+                return u32::MAX;
+            }
+            h = (h + 1) & mask;
+        }
+    };
+    // Single successors; vertices left by several edges are paired by angle.
+    for k in 0..n {
+        let head = first_out(table, edges[k].1);
+        if head == u32::MAX {
+            if open {
+                continue;
+            }
+            return false;
+        }
+        if link[head as usize] == u32::MAX {
+            next[k] = head;
+        }
+    }
+    for t in 0..=mask {
+        let (v, head) = (table[2 * t], table[2 * t + 1]);
+        if v == u32::MAX || link[head as usize] == u32::MAX {
+            continue;
+        }
+        let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
+        let mut k = head;
+        while k != u32::MAX {
+            outs.push(k as usize);
+            k = link[k as usize];
+        }
+        if !pair_at(edges, v, &outs, &dir, next) {
+            return false;
+        }
+    }
+    // Walk: open chains from their first edges (those that no edge leads to), then the rings.
+    let ring = &mut s.ring;
     let mut used = 0usize;
-    for s in 0..n {
-        if next[s] == u32::MAX - 1 {
+    if open {
+        link.fill(0);
+        for &k in next.iter() {
+            if k != u32::MAX {
+                link[k as usize] = 1;
+            }
+        }
+        // `link` now marks the edges with a predecessor: chains start at the others.
+        for (start, &has_pred) in link.iter().enumerate() {
+            if has_pred == 1 {
+                continue;
+            }
+            ring.clear();
+            let mut k = start;
+            loop {
+                let nk = next[k];
+                if nk == u32::MAX - 1 {
+                    return false;
+                }
+                ring.push(edges[k].0);
+                next[k] = u32::MAX - 1;
+                used += 1;
+                if nk == u32::MAX {
+                    ring.push(edges[k].1);
+                    break;
+                }
+                k = nk as usize;
+            }
+            emit(ring, true);
+        }
+    }
+    for start in 0..n {
+        if next[start] == u32::MAX - 1 {
             continue;
         }
         ring.clear();
-        let mut k = s;
+        let mut k = start;
         loop {
             let nk = next[k];
             if nk >= u32::MAX - 1 {
@@ -469,27 +695,44 @@ pub(crate) fn chain_rings(
             next[k] = u32::MAX - 1;
             used += 1;
             k = nk as usize;
-            if k == s {
+            if k == start {
                 break;
             }
         }
-        emit(ring);
+        emit(ring, false);
     }
     used == n
 }
 
-/// Pairs the edges arriving at vertex `v = edges[outs.start].0` with the edges `outs` leaving
-/// it (see [`chain_rings`]), writing `next[arriving] = leaving`.
+/// Scratch storage of [`chain_rings`] (reused across calls).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ChainScratch {
+    work: Vec<u32>,
+    ring: Vec<u32>,
+}
+
+impl ChainScratch {
+    /// Storage for about `n` contour edges.
+    pub(crate) fn with_capacity(n: usize) -> Self {
+        ChainScratch {
+            work: Vec::with_capacity(6 * n),
+            ring: Vec::with_capacity(n),
+        }
+    }
+}
+
+/// Pairs the edges arriving at vertex `v` with the edges `outs` leaving it (see
+/// [`chain_rings`]), writing `next[arriving] = leaving`.
 fn pair_at(
     edges: &[(u32, u32)],
-    outs: core::ops::Range<usize>,
+    v: u32,
+    outs: &[usize],
     dir: &impl Fn(u32) -> DVec3,
     next: &mut [u32],
 ) -> bool {
-    let v = edges[outs.start].0;
     // (edge index, other end's direction, +1 leaving / -1 arriving).
     let mut around: SmallVec<[(usize, DVec3, i32); 8]> = SmallVec::new();
-    for k in outs.clone() {
+    for &k in outs {
         around.push((k, dir(edges[k].1), 1));
     }
     for (k, e) in edges.iter().enumerate() {

@@ -13,6 +13,19 @@
 //! whole (their contours are closed by themselves); convex and small open mesh blockers are
 //! subtracted afterwards by the boundary tracing of `visibility/pieces.rs`.
 //!
+//! A blocker of one component with a facing hierarchy and a bounding-volume hierarchy goes
+//! further: only the part of its contour that may lie in the cone through the chart's box is
+//! found ([`Cull::Cone`]), and chained into closed rings and open chains whose ends lie outside
+//! the cone. Each open chain is closed through the direction opposite the box's centre (two
+//! arcs of great circles through that centre, beyond the chain's ends: outside the box). Inside
+//! the box these rings then wind as the whole contour does up to one integer, the winding of
+//! the left-out edges and closing arcs, a closed path outside the box: that integer is found at
+//! one direction of the box as the count of front faces a ray from the point crosses there
+//! (through the mesh's hierarchy, every decision certified) less the rings' winding there, and
+//! put back as that many copies of the box's boundary (bridges: counted by the overlay's rays,
+//! never kept). The shaft idea of Haines and Wallace (*Shaft culling for efficient ray-cast
+//! radiosity*, 1991) applied to contour edges, with the topology restored by one ray.
+//!
 //! It declines (the caller takes the general path) where the light is wider than one chart, a
 //! mesh light's contour reaches the horizon, the point lies in the box of a component of the
 //! mesh light or of a blocker component in the shaft, the region before the overlay is not a set of simple rings, or the overlay declines
@@ -23,11 +36,12 @@ use alloc::vec::Vec;
 
 use glam::{DVec2, DVec3};
 
-use super::contour::{Cull, chain_rings};
+use super::contour::{ChainScratch, Cull, chain_rings};
 use super::cull::Shaft;
 use super::overlay::{BLOCKER, LIGHT, Overlay, RingPoint};
 use super::{Blocker, ClipVisibility, Pieces};
-use crate::solid::{Body, ShadingFrame};
+use crate::solid::facing::FacingAt;
+use crate::solid::{Body, Bvh, ShadingFrame, TriangleMesh};
 
 /// Smallest cosine between the chart's centre and a direction of the light (about 78 degrees),
 /// as for the one-pass union's chart (`visibility/union.rs`).
@@ -46,8 +60,7 @@ const FRESH_IDS: u64 = 1 << 63;
 pub(crate) struct MeshScratch {
     overlay: Overlay,
     edges: Vec<(u32, u32)>,
-    next: Vec<u32>,
-    ring: Vec<u32>,
+    chain: ChainScratch,
     buf: Vec<RingPoint>,
     cut: Vec<RingPoint>,
 }
@@ -62,8 +75,7 @@ impl MeshScratch {
         MeshScratch {
             overlay: Overlay::with_capacity(SCRATCH_VERTICES),
             edges: Vec::with_capacity(SCRATCH_VERTICES),
-            next: Vec::with_capacity(SCRATCH_VERTICES),
-            ring: Vec::with_capacity(SCRATCH_VERTICES),
+            chain: ChainScratch::with_capacity(SCRATCH_VERTICES),
             buf: Vec::with_capacity(SCRATCH_VERTICES / 4),
             cut: Vec::with_capacity(SCRATCH_VERTICES / 4),
         }
@@ -165,11 +177,11 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             let ov = &mut s.overlay;
             let mut fits = true;
             let ok = chain_rings(
-                &mut s.edges,
+                &s.edges,
                 |i| frame.to_local(verts[i as usize]),
-                &mut s.next,
-                &mut s.ring,
-                |ring| {
+                false,
+                &mut s.chain,
+                |ring, _| {
                     let start = ov.pts.len();
                     // Reversed: the front faces run their contour clockwise seen from outside.
                     for &i in ring.iter().rev() {
@@ -233,24 +245,35 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
             let far = (bound.center - x).length() + bound.radius;
             let shaft = Shaft::from_cone(x, frame.normal(), &sides, frame.dir_to_world(c), far);
+            // The box's centre in the chart, and the direction opposite it: where the open
+            // chains of a cone-culled contour are closed, outside the box.
+            let mid = 0.5 * (lo + hi);
+            let away = -(c + u * mid.x + v * mid.y);
             for &b in meshes {
                 let Some(mc) = self.contours(b) else {
                     return false;
                 };
                 let mesh = self.blocker(b).0.mesh();
+                let bvh = self.bvh(b).filter(|_| mc.single_tree());
+                let cull = if bvh.is_some() {
+                    Cull::Cone(&shaft, &sides)
+                } else {
+                    Cull::Shaft(&shaft)
+                };
                 s.edges.clear();
-                if !mc.contour(mesh, x, Cull::Shaft(&shaft), &mut s.edges) {
+                if !mc.contour(mesh, x, cull, &mut s.edges) {
                     return false;
                 }
                 let verts = mesh.vertices();
                 let base = (self.slot(b) as u64 + 1) << 32;
+                let first_ring = s.overlay.ends.len();
                 let (ov, buf, cut) = (&mut s.overlay, &mut s.buf, &mut s.cut);
                 let ok = chain_rings(
-                    &mut s.edges,
+                    &s.edges,
                     |i| frame.to_local(verts[i as usize]),
-                    &mut s.next,
-                    &mut s.ring,
-                    |ring| {
+                    bvh.is_some(),
+                    &mut s.chain,
+                    |ring, open| {
                         buf.clear();
                         for &i in ring.iter().rev() {
                             buf.push(RingPoint {
@@ -259,6 +282,23 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                                 id: base | u64::from(i),
                                 bridge: false,
                             });
+                        }
+                        if open {
+                            // From the chain's end (outside the box) to the direction opposite
+                            // the box's centre and back to its start: both arcs lie on great
+                            // circles through the centre, on the far side of the chain's ends,
+                            // so they stay outside the box, and its clipping leaves the chain's
+                            // pieces in the box as they are.
+                            if let Some(last) = buf.last_mut() {
+                                last.bridge = true;
+                            }
+                            buf.push(RingPoint {
+                                p: DVec2::ZERO,
+                                d: away,
+                                id: fresh,
+                                bridge: true,
+                            });
+                            fresh += 1;
                         }
                         if clip_to_planes(buf, cut, &planes, &mut fresh) {
                             let start = ov.pts.len();
@@ -274,6 +314,55 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 );
                 if !ok {
                     return false;
+                }
+                if let Some(bvh) = bvh {
+                    // The chains agree with the contour inside the box up to a closed path
+                    // outside it (the left-out edges and the closing arcs), which adds the same
+                    // winding everywhere in the box: that constant is the front faces' count
+                    // over one direction of the box (a ray) less the chains' winding there,
+                    // and is put back as that many copies of the box's boundary.
+                    let mut k = None;
+                    // Directions near the corners first, with the mesh's bounding sphere only:
+                    // often one of them misses it, and the count there is 0.
+                    let candidates = [
+                        (false, [0.02, 0.02]),
+                        (false, [0.98, 0.02]),
+                        (false, [0.98, 0.98]),
+                        (false, [0.02, 0.98]),
+                        (true, [0.5, 0.5]),
+                        (true, [0.37, 0.61]),
+                        (true, [0.71, 0.29]),
+                    ];
+                    for (full, f) in candidates {
+                        let q = lo + (hi - lo) * DVec2::from(f);
+                        let d = frame.dir_to_world(c + u * q.x + v * q.y);
+                        let Some(wf) = front_cover(mesh, full.then_some(bvh), x, d) else {
+                            continue;
+                        };
+                        if let Some(wc) = s.overlay.winding(first_ring, BLOCKER, q) {
+                            k = Some(wf - wc);
+                            break;
+                        }
+                    }
+                    let Some(k) = k else {
+                        return false;
+                    };
+                    for _ in 0..k.unsigned_abs() {
+                        let ov = &mut s.overlay;
+                        let start = ov.pts.len();
+                        let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+                        for j in 0..4 {
+                            let p = corners[if k > 0 { j } else { 3 - j }];
+                            ov.pts.push(RingPoint {
+                                p,
+                                d: c + u * p.x + v * p.y,
+                                id: fresh,
+                                bridge: true,
+                            });
+                            fresh += 1;
+                        }
+                        ov.close(start, BLOCKER);
+                    }
                 }
             }
         }
@@ -370,4 +459,79 @@ fn cut(a: DVec3, sa: f64, b: DVec3, sb: f64) -> DVec3 {
     }
     let (wa, wb) = (sb.abs(), sa.abs());
     (a * wa + b * wb) / (wa + wb)
+}
+
+/// The number of front faces of `mesh` (by [`FacingAt::front`] from `x`) that the ray from `x`
+/// along `d` (world) passes through inside, found through the mesh's hierarchy `bvh`; `None`
+/// where the ray passes within rounding of a front face's edge, or (without `bvh`) where it
+/// meets the mesh's bounding sphere.
+fn front_cover(mesh: &TriangleMesh, bvh: Option<&Bvh>, x: DVec3, d: DVec3) -> Option<i32> {
+    // A ray that misses the mesh's bounding sphere (beyond rounding) meets no face.
+    let bs = mesh.bounding_sphere();
+    let y = bs.center - x;
+    let along = y.dot(d) / d.length_squared();
+    let miss = if along <= 0.0 {
+        y.length_squared()
+    } else {
+        (y - d * along).length_squared()
+    };
+    if miss > bs.radius * bs.radius * (1.0 + 1e-9) + 1e-9 * y.length_squared() {
+        return Some(0);
+    }
+    let bvh = bvh?;
+    let at = FacingAt::new(mesh, x);
+    let (verts, tris) = (mesh.vertices(), mesh.triangles());
+    let (normals, offsets) = (mesh.normals(), mesh.offsets());
+    let dn = norm1(d);
+    let (mut count, mut ok) = (0i32, true);
+    bvh.for_each(
+        |lo, hi| ray_meets_box(x, d, lo, hi),
+        |t| {
+            let f = t as usize;
+            if !ok || !at.front(normals[f], offsets[f]) {
+                return;
+            }
+            let [a, b, c] = tris[f].map(|i| verts[i as usize] - x);
+            // A front face runs clockwise seen from `x`'s side: the ray is inside where all
+            // three `det(p, q, d)` of its edges are negative.
+            let mut inside = true;
+            for (p, q) in [(a, b), (b, c), (c, a)] {
+                let s = p.cross(q).dot(d);
+                if s.abs() <= 1e-12 * norm1(p) * norm1(q) * dn {
+                    ok = false;
+                    return;
+                }
+                inside &= s < 0.0;
+            }
+            count += i32::from(inside);
+        },
+    );
+    ok.then_some(count)
+}
+
+/// Whether the ray from `x` along `d` may meet the box `[lo, hi]` (widened by `1e-9` of its
+/// size and position, beyond the rounding of the slab test).
+fn ray_meets_box(x: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> bool {
+    let m = 1e-9
+        * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element() + x.abs().max_element());
+    let (lo, hi) = (lo - DVec3::splat(m), hi + DVec3::splat(m));
+    let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
+    for i in 0..3 {
+        if d[i] == 0.0 {
+            if x[i] < lo[i] || x[i] > hi[i] {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((lo[i] - x[i]) / d[i], (hi[i] - x[i]) / d[i]);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    t0 <= t1
+}
+
+/// `|v|_1`.
+#[inline]
+fn norm1(v: DVec3) -> f64 {
+    v.x.abs() + v.y.abs() + v.z.abs()
 }

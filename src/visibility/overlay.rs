@@ -100,7 +100,9 @@ pub(crate) struct Overlay {
     /// Per vertex: its ring.
     ring_of: Vec<u32>,
     bbox: Vec<[f64; 4]>,
-    order: Vec<u32>,
+    /// Non-bridge edges by the left end of their boxes: the key's order-preserving bits above,
+    /// the edge below (integers sort faster than floating-point keys through the index).
+    order: Vec<u128>,
     active: Vec<u32>,
     cross: Vec<Cross>,
     /// Per edge `e`: its crossings are `slots[xstart[e]..xstart[e + 1]]`, along it.
@@ -130,6 +132,13 @@ const ORIENT_ERR: f64 = 1e-15;
 fn orient(a: DVec2, b: DVec2, c: DVec2) -> (f64, f64) {
     let (l, r) = ((a.x - c.x) * (b.y - c.y), (a.y - c.y) * (b.x - c.x));
     (l - r, ORIENT_ERR * (l.abs() + r.abs()))
+}
+
+/// Bits of `v` whose unsigned order is `f64::total_cmp`'s.
+#[inline(always)]
+fn order_bits(v: f64) -> u64 {
+    let b = v.to_bits();
+    if b >> 63 == 1 { !b } else { b | 1 << 63 }
 }
 
 /// The sign of `v` as `-1` or `1` (`v` is not zero).
@@ -178,6 +187,34 @@ impl Overlay {
         } else {
             self.pts.truncate(start);
         }
+    }
+
+    /// The winding number about `q` of the rings of family `fam` from ring `first` on (a ray
+    /// along `+x`, half-open in `y` as in [`Overlay::ray`]); `None` where the ray passes within
+    /// rounding of a vertex or edge.
+    pub(crate) fn winding(&self, first: usize, fam: u8, q: DVec2) -> Option<i32> {
+        let mut w = 0;
+        for r in first..self.ends.len() {
+            if self.family[r] != fam {
+                continue;
+            }
+            let start = if r == 0 { 0 } else { self.ends[r - 1] as usize };
+            let ring = &self.pts[start..self.ends[r] as usize];
+            for (k, a) in ring.iter().enumerate() {
+                let (p0, p1) = (a.p, ring[(k + 1) % ring.len()].p);
+                if (p0.y > q.y) == (p1.y > q.y) || (p0.x < q.x && p1.x < q.x) {
+                    continue;
+                }
+                let (o, b) = orient(p0, p1, q);
+                if o.abs() <= b {
+                    return None;
+                }
+                if (o > 0.0) == (p1.y > p0.y) {
+                    w += if o > 0.0 { 1 } else { -1 };
+                }
+            }
+        }
+        Some(w)
     }
 
     #[inline(always)]
@@ -260,16 +297,15 @@ impl Overlay {
             self.bbox
                 .push([a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y)]);
             if !self.pts[k].bridge {
-                self.order.push(k as u32);
+                self.order
+                    .push(u128::from(order_bits(a.x.min(b.x))) << 32 | k as u128);
             }
         }
-        let bbox = &self.bbox;
-        self.order
-            .sort_unstable_by(|&a, &b| bbox[a as usize][0].total_cmp(&bbox[b as usize][0]));
+        self.order.sort_unstable();
         self.active.clear();
         self.cross.clear();
         for i in 0..self.order.len() {
-            let e = self.order[i] as usize;
+            let e = (self.order[i] & u128::from(u32::MAX)) as usize;
             let be = self.bbox[e];
             let bbox = &self.bbox;
             self.active.retain(|&f| bbox[f as usize][1] >= be[0]);
