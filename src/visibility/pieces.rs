@@ -2019,6 +2019,27 @@ mod tests {
         out
     }
 
+    /// The table walk ([`convex_blocker`]) and the general walk ([`convex_planes`]) at one
+    /// frame: the same decision and, where both accept, the same directions and planes bit for
+    /// bit. Returns whether they accepted.
+    fn walks_agree(p: &ConvexPolyhedron, faces: &ConvexFaces, frame: &ShadingFrame) -> bool {
+        let (mut a, mut b) = (Pieces::new(), Pieces::new());
+        let fast = convex_blocker(p, faces, frame, &mut a);
+        let general = convex_planes(p, frame, &mut b);
+        let x = frame.origin();
+        assert_eq!(fast, general, "{x}");
+        if fast {
+            let bits = |v: &[DVec3]| -> Vec<u64> {
+                v.iter()
+                    .flat_map(|d| d.to_array().map(f64::to_bits))
+                    .collect()
+            };
+            assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
+            assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
+        }
+        fast
+    }
+
     #[test]
     fn table_walk_matches_convex_planes() {
         let mut rng = Rng(15);
@@ -2047,21 +2068,8 @@ mod tests {
                 };
                 let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
                 let Ok(frame) = frame else { continue };
-                let (mut a, mut b) = (Pieces::new(), Pieces::new());
-                let fast = convex_blocker(&p, &faces, &frame, &mut a);
-                let general = convex_planes(&p, &frame, &mut b);
-                assert_eq!(fast, general, "{x}");
                 compared += 1;
-                if fast {
-                    accepted += 1;
-                    let bits = |v: &[DVec3]| -> Vec<u64> {
-                        v.iter()
-                            .flat_map(|d| d.to_array().map(f64::to_bits))
-                            .collect()
-                    };
-                    assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
-                    assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
-                }
+                accepted += usize::from(walks_agree(&p, &faces, &frame));
             }
         }
         assert!(
@@ -2095,20 +2103,9 @@ mod tests {
                 let x = on + mesh.normals()[f] * (delta * scale);
                 let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
                 let Ok(frame) = frame else { continue };
-                let (mut a, mut b) = (Pieces::new(), Pieces::new());
-                let fast = convex_blocker(&p, &faces, &frame, &mut a);
-                let general = convex_planes(&p, &frame, &mut b);
-                assert_eq!(fast, general, "{x}");
                 compared += 1;
-                if fast {
+                if walks_agree(&p, &faces, &frame) {
                     accepted += 1;
-                    let bits = |v: &[DVec3]| -> Vec<u64> {
-                        v.iter()
-                            .flat_map(|d| d.to_array().map(f64::to_bits))
-                            .collect()
-                    };
-                    assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
-                    assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
                 } else {
                     declined += 1;
                 }
