@@ -12,6 +12,9 @@
 //! - the tile plane: the part of a line behind `x` lies below the tangent plane, the part between
 //!   `x` and the light above it, so keeping the blockers' parts above the plane makes "the line
 //!   stabs a kept blocker" equivalent to "a blocker lies on the segment from `x` to the light";
+//!   the edges this cut makes lie in the tile plane and are marked, so that the query decides
+//!   their side by the plane itself, not by their rounded cut points (`query.rs`, "Edges on
+//!   the tile plane");
 //! - the shaft: the convex hull of the tile and the light polygon holds every such segment, so a
 //!   triangle outside one of its supporting planes can hide nothing (seed 002 Alg. 2 line 7).
 //!
