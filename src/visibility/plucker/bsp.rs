@@ -58,19 +58,32 @@ pub(crate) struct Occluder {
     verts: [DVec3; MAX_OCCLUDER_VERTICES],
     len: u8,
     crossing: Crossing,
+    /// Bit `i`: edge `i` lies on the tile plane (it was made by the cut to the tile plane's
+    /// upper side, `tile.rs`), so the query decides its side without its computed points
+    /// ([`Occluder::on_tile`]).
+    on_tile: u8,
 }
 
 impl Occluder {
     /// The occluder with vertices `v` (3 to [`MAX_OCCLUDER_VERTICES`], in order) crossed by the
-    /// query lines as `crossing` says.
-    pub(crate) fn new(v: &[DVec3], crossing: Crossing) -> Occluder {
+    /// query lines as `crossing` says, with the edges of the mask `on_tile` on the tile plane.
+    pub(crate) fn new(v: &[DVec3], crossing: Crossing, on_tile: u8) -> Occluder {
         let mut verts = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
         verts[..v.len()].copy_from_slice(v);
         Occluder {
             verts,
             len: v.len() as u8,
             crossing,
+            on_tile,
         }
+    }
+
+    /// Whether edge `i` lies on the tile plane: the plane through a point of the tile and the
+    /// edge's line is then the point's tangent plane, whatever the rounding of the edge's
+    /// computed ends (see `query.rs`, "Edges on the tile plane").
+    #[inline]
+    pub(crate) fn on_tile(&self, i: u8) -> bool {
+        self.on_tile & (1 << i) != 0
     }
 
     /// The vertices.
@@ -655,6 +668,7 @@ mod tests {
                 DVec3::new(0.2, 0.4, 1.0),
             ],
             Crossing::Positive,
+            0,
         );
         Tree::new(&[DVec3::ZERO], &light, alloc::vec![occ], 3)
     }

@@ -502,7 +502,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             for poly in polys {
                 let local: Fragment = poly.iter().map(|&p| p - x).collect();
                 if let Some(frag) = clip_above(&local, DVec3::ZERO, n) {
-                    result = query(tree, xl, &frag, *budget, &mut ws.frags, &mut ws.scratch);
+                    result = query(tree, xl, n, &frag, *budget, &mut ws.frags, &mut ws.scratch);
                     if result.is_err() {
                         break;
                     }
@@ -569,6 +569,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 && query(
                     &mut tree,
                     DVec3::ZERO,
+                    n,
                     &frag,
                     self.tree_cap,
                     &mut ws.frags,

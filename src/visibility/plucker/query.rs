@@ -17,13 +17,28 @@
 //! evaluation per shadow corner. For an ill-conditioned plane (the point near the node's line)
 //! the exact sign decides, so that the two parts of a split never overlap by more than that
 //! rounding. A fragment with every vertex on the plane goes to the node's zero child.
+//!
+//! # Edges on the tile plane
+//!
+//! An occluder edge made by the cut to the tile plane's upper side (`tile.rs`) lies in that
+//! plane, and so does the point: the plane through the point and the edge's line is the
+//! point's tangent plane, and every fragment (clipped to the closed upper side of it) lies on
+//! one side, the side of `up` (the tile's normal). Such a node sends the whole fragment to the
+//! child of `det[up, h_a - x, h_b - x]` (which side of the edge's line the point is on, in
+//! the plane; zero for a point on the line) instead of classifying its vertices against the
+//! plane through the edge's computed ends: those are cut points, rounded at the blocker's
+//! size, so that plane is tilted off the tangent plane by that rounding over the point's
+//! distance from the line. For a point `1e-10` from a blocker's plane that tilt was `1e-6` rad,
+//! and the split it made left a horizon strip of the light visible through the blocker
+//! (`tests/visibility_plucker.rs`, a point a hair below a sheet). For the same reason such an
+//! edge is never taken as a separating plane in [`relevant_occluder`].
 
 use alloc::vec::Vec;
 
 use glam::DVec3;
 use smallvec::SmallVec;
 
-use super::bsp::{MAX_OCCLUDER_VERTICES, Node, Tree};
+use super::bsp::{MAX_OCCLUDER_VERTICES, Node, Occluder, Tree};
 use super::line::{Orienter, Sign};
 use crate::GeomError;
 use crate::solid::ShadingFrame;
@@ -192,10 +207,12 @@ fn cut_point(a: DVec3, b: DVec3, va: f64, vb: f64) -> DVec3 {
 /// relative to the point too, so they are the same numbers whatever the tree's origin: the
 /// point's tangent-plane cut and the directions of light points very close to it (a point
 /// within a few `1e-11` of a face plane) do not pick up the rounding of the tile's offset. Stops with [`CapExceeded`] as soon as the tree's size passes `cap` bytes
-/// (the tree is then valid but larger; the caller resets it).
+/// (the tree is then valid but larger; the caller resets it). `up` is the tile plane's
+/// normal, and `poly` lies on the closed upper side of the plane through `x` with that normal.
 pub(crate) fn query(
     tree: &mut Tree,
     x: DVec3,
+    up: DVec3,
     poly: &[DVec3],
     cap: usize,
     out: &mut Vec<Fragment>,
@@ -225,12 +242,23 @@ pub(crate) fn query(
                             return Err(CapExceeded);
                         }
                     }
-                    let (ha, hb) = tree.occluder(occ).edge(edge);
+                    let occluder = tree.occluder(occ);
+                    let (ha, hb) = occluder.edge(edge);
                     // The fragment is relative to the point: the node's line is moved there
                     // instead, so that light points close to the point keep their precision.
                     let or = Orienter::new(ha - x, hb - x, DVec3::ZERO);
                     let frag = &pool[s as usize..(s + len) as usize];
-                    match classify(&or, frag, &mut vals) {
+                    let class = if occluder.on_tile(edge) {
+                        // See "Edges on the tile plane" in the module documentation.
+                        match or.sign(up) {
+                            Sign::Positive => Class::Pos,
+                            Sign::Negative => Class::Neg,
+                            Sign::Zero => Class::Zero,
+                        }
+                    } else {
+                        classify(&or, frag, &mut vals)
+                    };
+                    match class {
                         Class::Pos => n = pos,
                         Class::Neg => n = neg,
                         Class::Zero => n = if zero_pos { pos } else { neg },
@@ -325,23 +353,25 @@ fn relevant_occluder(
     for step in 0..len as usize {
         let i = (first + step) % len as usize;
         let o = tree.list(start, len)[i];
-        if !separated(tree.occluder(o).vertices(), x, frag, &planes, outside) {
+        if !separated(tree.occluder(o), x, frag, &planes, outside) {
             return Some(o);
         }
     }
     None
 }
 
-/// Whether a plane through the origin (the point) strictly separates the occluder with
-/// vertices `verts - x` from the fragment `frag`: one of the fragment's edge planes `planes`
-/// (with the side `outside` away from the fragment), or one through an edge of the occluder.
+/// Whether a plane through the origin (the point) strictly separates the occluder `occ`
+/// (at `x`) from the fragment `frag`: one of the fragment's edge planes `planes` (with the
+/// side `outside` away from the fragment), or one through an edge of the occluder not on the
+/// tile plane (see the module documentation).
 fn separated(
-    verts: &[DVec3],
+    occ: &Occluder,
     x: DVec3,
     frag: &[DVec3],
     planes: &[Orienter],
     outside: Option<Sign>,
 ) -> bool {
+    let verts = occ.vertices();
     let mut buf = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
     for (r, &b) in buf.iter_mut().zip(verts) {
         *r = b - x;
@@ -356,6 +386,9 @@ fn separated(
     }
     let m = v.len();
     for j in 0..m {
+        if occ.on_tile(j as u8) {
+            continue;
+        }
         let or = Orienter::new(v[j], v[(j + 1) % m], DVec3::ZERO);
         let Some(inner) = or.strict_sign(v[(j + 2) % m]) else {
             continue;
@@ -572,7 +605,7 @@ mod tests {
     }
 
     fn occluder(v: &[DVec3], crossing: Crossing) -> Occluder {
-        Occluder::new(v, crossing)
+        Occluder::new(v, crossing, 0)
     }
 
     /// The 3D area of what `x` sees of `light` past the occluder `occ`.
@@ -583,6 +616,7 @@ mod tests {
         query(
             &mut tree,
             x,
+            DVec3::Z,
             &relative,
             usize::MAX,
             &mut out,

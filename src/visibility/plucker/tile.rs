@@ -12,6 +12,9 @@
 //! - the tile plane: the part of a line behind `x` lies below the tangent plane, the part between
 //!   `x` and the light above it, so keeping the blockers' parts above the plane makes "the line
 //!   stabs a kept blocker" equivalent to "a blocker lies on the segment from `x` to the light";
+//!   the edges this cut makes lie in the tile plane and are marked, so that the query decides
+//!   their side by the plane itself, not by their rounded cut points (`query.rs`, "Edges on
+//!   the tile plane");
 //! - the shaft: the convex hull of the tile and the light polygon holds every such segment, so a
 //!   triangle outside one of its supporting planes can hide nothing (seed 002 Alg. 2 line 7).
 //!
@@ -429,11 +432,11 @@ pub(crate) fn build_group_tree<'m>(
         let near_somewhere = on || (front && behind) || (lo <= band && hi >= -band);
         let local = bt.v.map(|v| v - o);
         let vals: SmallVec<[(f64, Sign); 8]> = df.iter().map(|&d| (d, Sign::of(d))).collect();
-        let Some(cut) = keep_positive(&local, &vals) else {
+        let Some(part) = keep_positive(&local, &vals) else {
             continue;
         };
         // Cut 2: above the tile plane.
-        let Some(mut cut) = clip_above(&cut, p0, tile.n) else {
+        let Some(mut cut) = clip_above(&part, p0, tile.n) else {
             continue;
         };
         // Cut points a rounding away from a corner would make edges without a line; a sliver
@@ -442,6 +445,7 @@ pub(crate) fn build_group_tree<'m>(
         if cut.len() > MAX_OCCLUDER_VERTICES || cut.len() < 3 || is_sliver(&cut) {
             continue;
         }
+        let on_tile = tile_plane_edges(&part, &cut, p0, tile.n);
         let plane = Orienter::new(local[1], local[2], local[0]);
         let (mut pos, mut neg) = (false, false);
         for &e in &light {
@@ -457,7 +461,7 @@ pub(crate) fn build_group_tree<'m>(
             (true, true) => Crossing::Both,
             (false, false) => continue,
         };
-        occluders.push(Occluder::new(&cut, crossing));
+        occluders.push(Occluder::new(&cut, crossing, on_tile));
         if near_somewhere {
             near.push(Near {
                 owner: bt.owner,
@@ -473,4 +477,26 @@ pub(crate) fn build_group_tree<'m>(
         near,
         band,
     })
+}
+
+/// The edges of `cut` (the part of the convex polygon `part` above the plane through `p0` with
+/// normal `n`, by [`clip_above`], welded) that lie on that plane, as a bit mask: those whose
+/// two ends are not vertices of `part` strictly above the plane (by the same computed values
+/// as `clip_above`), i.e. cut points or vertices on the plane. One plane cuts a convex
+/// polygon along one edge, so these are the cut's edge (or an edge of `part` on the plane).
+///
+/// The cut points of that edge are rounded at the polygon's size, so the plane through a
+/// point of the tile and the edge's computed line can be tilted by that rounding over the
+/// point's distance from the line: `1e-6` rad for a point `1e-10` from a blocker of size 1.
+/// In exact arithmetic the plane is the tile plane, and the query uses that instead.
+fn tile_plane_edges(part: &[DVec3], cut: &[DVec3], p0: DVec3, n: DVec3) -> u8 {
+    let on = |p: &DVec3| !part.iter().any(|q| q == p && n.dot(*q - p0) > 0.0);
+    let k = cut.len();
+    let mut mask = 0u8;
+    for i in 0..k {
+        if on(&cut[i]) && on(&cut[(i + 1) % k]) {
+            mask |= 1 << i;
+        }
+    }
+    mask
 }
