@@ -458,6 +458,12 @@ fn clip_to_planes(
             return false;
         }
         tmp.clear();
+        // A cut at a vertex on the plane repeats it: of consecutive points in the same
+        // direction, the later is kept (cyclically), whose flag is the edge's that leaves it.
+        let mut push = |q: RingPoint| match tmp.last_mut() {
+            Some(last) if last.d == q.d => *last = q,
+            _ => tmp.push(q),
+        };
         let mut prev = ring[ring.len() - 1];
         let mut sp = n.dot(prev.d);
         for &cur in ring.iter() {
@@ -465,7 +471,7 @@ fn clip_to_planes(
             if sc >= 0.0 {
                 if sp < 0.0 {
                     // Entering: the rest of the edge `prev -> cur` follows.
-                    tmp.push(RingPoint {
+                    push(RingPoint {
                         p: DVec2::ZERO,
                         d: cut(prev.d, sp, cur.d, sc),
                         id: *fresh,
@@ -473,10 +479,10 @@ fn clip_to_planes(
                     });
                     *fresh += 1;
                 }
-                tmp.push(cur);
+                push(cur);
             } else if sp >= 0.0 {
                 // Leaving: along the plane to the next entry.
-                tmp.push(RingPoint {
+                push(RingPoint {
                     p: DVec2::ZERO,
                     d: cut(prev.d, sp, cur.d, sc),
                     id: *fresh,
@@ -486,15 +492,10 @@ fn clip_to_planes(
             }
             (prev, sp) = (cur, sc);
         }
-        // A cut at a vertex on the plane repeats it: the later copy is kept, whose flag is the
-        // edge's that leaves the point.
-        ring.clear();
-        for (k, q) in tmp.iter().enumerate() {
-            let next = tmp[(k + 1) % tmp.len()];
-            if next.d != q.d {
-                ring.push(*q);
-            }
+        if tmp.len() > 1 && tmp[tmp.len() - 1].d == tmp[0].d {
+            tmp.pop();
         }
+        core::mem::swap(ring, tmp);
         if ring.len() < 3 {
             return false;
         }
