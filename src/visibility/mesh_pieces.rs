@@ -158,7 +158,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         if u.cross(v).dot(c) < 0.0 {
             core::mem::swap(&mut u, &mut v);
         }
-        let chart = Chart { c, u, v };
+        let mut chart = Chart { c, u, v };
         let mut fresh = FRESH_IDS;
         s.overlay.clear();
         // The light's rings (winding 1 inside), or its contour (winding = front faces over it).
@@ -225,6 +225,10 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             out.set_region(&[], &[], true);
             return true;
         }
+        // The chart's axes turned to fit the box below tightly around the light's region: what
+        // the blockers leave in that box is the overlay's input.
+        align_chart(&mut chart, &mut s.overlay.pts);
+        let Chart { c, u, v } = chart;
         // The box around the light in the chart, and its planes through the point.
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for q in &s.overlay.pts {
@@ -367,7 +371,9 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             }
         }
         if !mesh_light && s.overlay.family.iter().all(|&f| f == LIGHT) {
-            // No blocker reaches the box: the region is the light's.
+            // No blocker reaches the box: the region is the light's (decided by this path,
+            // counted as its overlays are).
+            out.overlays += 1;
             return true;
         }
         if !s.overlay.resolve(c, u, v) {
@@ -376,6 +382,55 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
         out.set_region(&s.overlay.out, &s.overlay.out_ends, !s.overlay.touching);
         out.overlays += 1;
         true
+    }
+}
+
+/// Most light ring points whose edges are all tried as the chart's axis by [`align_chart`].
+const ALIGN_EDGES: usize = 16;
+
+/// Turns the chart's axes `u`, `v` about its centre (a rotation: `u x v = c` stays) so that
+/// the box of the light's points `pts` in the chart is small, and projects them again. The
+/// axes tried are the initial ones and, for a light of few points (a quad, a polygon), the
+/// directions of its edges: a convex polygon's smallest enclosing rectangle has a side along
+/// one of its edges (Freeman and Shapira, *Determining the minimum-area encasing rectangle
+/// for an arbitrary closed curve*, 1975). Any axes give the same region (the chart is a
+/// central projection whatever they are); only the box, and with it the blockers' contour
+/// kept by [`Cull::Cone`] and the overlay's input, shrinks. For a quad light seen with
+/// the axes at 45 degrees to its edges, the box's area halves.
+fn align_chart(chart: &mut Chart, pts: &mut [RingPoint]) {
+    if pts.len() > ALIGN_EDGES {
+        return;
+    }
+    let area = |w: DVec2| {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for q in pts.iter() {
+            let r = DVec2::new(q.p.dot(w), q.p.perp_dot(w));
+            lo = lo.min(r);
+            hi = hi.max(r);
+        }
+        let e = hi - lo;
+        e.x * e.y
+    };
+    let mut best = (area(DVec2::X), DVec2::X);
+    for k in 0..pts.len() {
+        let e = pts[(k + 1) % pts.len()].p - pts[k].p;
+        if let Some(w) = e.try_normalize() {
+            let a = area(w);
+            if a < best.0 {
+                best = (a, w);
+            }
+        }
+    }
+    let w = best.1;
+    if w == DVec2::X {
+        return;
+    }
+    // New axes: `u' = w.x u + w.y v`, `v' = c x u'` as a rotation by the same angle.
+    let (u, v) = (chart.u, chart.v);
+    chart.u = u * w.x + v * w.y;
+    chart.v = v * w.x - u * w.y;
+    for q in pts.iter_mut() {
+        q.p = chart.project(q.d);
     }
 }
 
@@ -403,6 +458,12 @@ fn clip_to_planes(
             return false;
         }
         tmp.clear();
+        // A cut at a vertex on the plane repeats it: of consecutive points in the same
+        // direction, the later is kept (cyclically), whose flag is the edge's that leaves it.
+        let mut push = |q: RingPoint| match tmp.last_mut() {
+            Some(last) if last.d == q.d => *last = q,
+            _ => tmp.push(q),
+        };
         let mut prev = ring[ring.len() - 1];
         let mut sp = n.dot(prev.d);
         for &cur in ring.iter() {
@@ -410,7 +471,7 @@ fn clip_to_planes(
             if sc >= 0.0 {
                 if sp < 0.0 {
                     // Entering: the rest of the edge `prev -> cur` follows.
-                    tmp.push(RingPoint {
+                    push(RingPoint {
                         p: DVec2::ZERO,
                         d: cut(prev.d, sp, cur.d, sc),
                         id: *fresh,
@@ -418,10 +479,10 @@ fn clip_to_planes(
                     });
                     *fresh += 1;
                 }
-                tmp.push(cur);
+                push(cur);
             } else if sp >= 0.0 {
                 // Leaving: along the plane to the next entry.
-                tmp.push(RingPoint {
+                push(RingPoint {
                     p: DVec2::ZERO,
                     d: cut(prev.d, sp, cur.d, sc),
                     id: *fresh,
@@ -431,15 +492,10 @@ fn clip_to_planes(
             }
             (prev, sp) = (cur, sc);
         }
-        // A cut at a vertex on the plane repeats it: the later copy is kept, whose flag is the
-        // edge's that leaves the point.
-        ring.clear();
-        for (k, q) in tmp.iter().enumerate() {
-            let next = tmp[(k + 1) % tmp.len()];
-            if next.d != q.d {
-                ring.push(*q);
-            }
+        if tmp.len() > 1 && tmp[tmp.len() - 1].d == tmp[0].d {
+            tmp.pop();
         }
+        core::mem::swap(ring, tmp);
         if ring.len() < 3 {
             return false;
         }
@@ -534,4 +590,51 @@ fn ray_meets_box(x: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> bool {
 #[inline]
 fn norm1(v: DVec3) -> f64 {
     v.x.abs() + v.y.abs() + v.z.abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn box_area(pts: &[RingPoint]) -> f64 {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for q in pts {
+            lo = lo.min(q.p);
+            hi = hi.max(q.p);
+        }
+        (hi - lo).x * (hi - lo).y
+    }
+
+    /// A square with its corners on the chart's axes: turned, the axes run along its edges,
+    /// the box's area halves, the chart stays a rotation of the first (`u x v = c`) and the
+    /// points are projected in the new chart.
+    #[test]
+    fn align_chart_fits_the_box_to_a_turned_square() {
+        let mut chart = Chart {
+            c: DVec3::Z,
+            u: DVec3::X,
+            v: DVec3::Y,
+        };
+        let mut pts: Vec<RingPoint> = (0..4)
+            .map(|k| {
+                let a = core::f64::consts::FRAC_PI_2 * k as f64;
+                let d = DVec3::new(0.2 * a.cos(), 0.2 * a.sin(), 1.0) * 3.0;
+                RingPoint {
+                    p: chart.project(d),
+                    d,
+                    id: k,
+                    bridge: false,
+                }
+            })
+            .collect();
+        let before = box_area(&pts);
+        align_chart(&mut chart, &mut pts);
+        let after = box_area(&pts);
+        assert!((after - 0.5 * before).abs() < 1e-12, "{before} -> {after}");
+        assert!((chart.u.cross(chart.v) - chart.c).length() < 1e-15);
+        assert!(chart.u.dot(chart.c).abs() < 1e-15 && chart.v.dot(chart.c).abs() < 1e-15);
+        for q in &pts {
+            assert_eq!(q.p, chart.project(q.d));
+        }
+    }
 }

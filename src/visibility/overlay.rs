@@ -99,6 +99,8 @@ pub(crate) struct Overlay {
     pub(crate) family: Vec<u8>,
     /// Per vertex: its ring.
     ring_of: Vec<u32>,
+    /// Per vertex: the next one along its ring (the one load [`Overlay::succ`] costs).
+    next: Vec<u32>,
     bbox: Vec<[f64; 4]>,
     /// Non-bridge edges by the left end of their boxes: the key's order-preserving bits above,
     /// the edge below (integers sort faster than floating-point keys through the index).
@@ -159,6 +161,7 @@ impl Overlay {
         let mut o = Overlay::default();
         o.pts.reserve(n);
         o.ring_of.reserve(n);
+        o.next.reserve(n);
         o.bbox.reserve(n);
         o.order.reserve(n);
         o.active.reserve(n / 4);
@@ -219,12 +222,7 @@ impl Overlay {
 
     #[inline(always)]
     fn succ(&self, k: usize) -> usize {
-        let r = self.ring_of[k] as usize;
-        if k + 1 == self.ends[r] as usize {
-            if r == 0 { 0 } else { self.ends[r - 1] as usize }
-        } else {
-            k + 1
-        }
+        self.next[k] as usize
     }
 
     #[inline(always)]
@@ -253,10 +251,13 @@ impl Overlay {
         self.touching = false;
         let n = self.pts.len();
         self.ring_of.clear();
+        self.next.clear();
         let mut start = 0usize;
         for (r, &end) in self.ends.iter().enumerate() {
             self.ring_of
                 .extend(core::iter::repeat_n(r as u32, end as usize - start));
+            self.next.extend(start as u32 + 1..end);
+            self.next.push(start as u32);
             start = end as usize;
         }
         if !self.crossings() {

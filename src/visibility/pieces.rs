@@ -202,7 +202,8 @@ pub struct Pieces {
     /// Scratch storage of the closed meshes' path (`visibility/mesh_pieces.rs`), made on its
     /// first use: its growable buffers are no cost to points that never take that path.
     pub(super) mesh: Option<Box<MeshScratch>>,
-    /// Regions resolved by that path's overlay (diagnostics).
+    /// Regions decided by that path: resolved by its overlay, or found clear of every
+    /// blocker's contour in the light's box (diagnostics).
     pub(super) overlays: u64,
     /// Tests: take the general traversal for two crossings too, and count the subtractions
     /// that [`Pieces::traverse_two`] answered.
@@ -294,8 +295,9 @@ impl Pieces {
         (self.traced, self.cut)
     }
 
-    /// How many regions this storage has resolved by the overlay of closed meshes' contours
-    /// (see the source of `visibility::mesh_pieces`), over all calls; for tests and benchmarks.
+    /// How many regions this storage has decided by the overlay of closed meshes' contours
+    /// (see the source of `visibility::mesh_pieces`): resolved by the overlay, or found with no
+    /// blocker's contour in the light's box, over all calls; for tests and benchmarks.
     #[doc(hidden)]
     #[must_use]
     pub fn overlays(&self) -> u64 {
