@@ -471,11 +471,10 @@ pub(crate) fn build_group_tree<'m>(
         // one of its vertices, left above the plane by the rounding of the plane's offset
         // (taken from the tile's first point) and of the shared vertices. From a single point
         // the cut leaves a sliver or nothing and the per-call tree drops it; the shared tree
-        // keeps it, and the planes through a point and its edges, which lie in the tile plane
-        // within rounding but are not the cut's marked edges, are tilted by that rounding: the
-        // light was split by them and a part of it hidden (1.5e-6 sr, from a point on an
-        // icosphere's face, `tests/visibility_plucker.rs`). No shared decision is certified
-        // for such a piece: every point of the tile takes a tree of its own.
+        // keeps it, and no decision of the tree on lines grazing such a piece is certified (from
+        // a point on an icosphere's face, 0.13 from its edges, slivers 4e-15 above the plane
+        // hid 1.5e-6 sr of the light: `tests/visibility_plucker.rs`). Every point of the tile
+        // takes a tree of its own.
         if cut.iter().all(|&c| tile.n.dot(c - p0) <= band) {
             flat = true;
         }
