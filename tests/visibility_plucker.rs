@@ -61,6 +61,19 @@ fn light(shape: impl Into<Body>, rgb: DVec3) -> Light {
 }
 
 /// A point uniform in the box `[lo, hi)`.
+/// The fuzz target's two-sheet light (`Prim::Sheets`): a quad of half-size `h` at `c` facing
+/// down and one at `c + d` facing up, one open mesh light that hides parts of itself, in a scene
+/// of no occluders shaded face by face.
+fn two_sheet_light(c: DVec3, d: DVec3, h: f64) -> Scene {
+    let sheets = TriangleMesh::quad(c, DVec3::Y * h, DVec3::X * h)
+        .unwrap()
+        .merged(&TriangleMesh::quad(c + d, DVec3::X * h, DVec3::Y * h).unwrap())
+        .unwrap();
+    Scene::new(vec![light(sheets, DVec3::ONE)], vec![])
+        .unwrap()
+        .with_method(Method::PerTriangle)
+}
+
 fn in_box(rng: &mut Rng, lo: DVec3, hi: DVec3) -> DVec3 {
     DVec3::new(
         rng.range(lo.x, hi.x),
@@ -736,16 +749,11 @@ fn a_point_a_hair_above_a_self_hiding_light_sees_what_the_clipping_backend_sees(
     // left a 9.3e-9 sr sliver of the lower sheet visible; the per-call tree and the clipping
     // backend see nothing. Points that close to a blocker's plane now get a tree of their own.
     // Offsets from 2^-14 to 2^-34 above the corner, every cell size of the fuzz target's range.
-    let c = DVec3::new(85.0, -86.0, 6.0) / 8.0;
-    let d = DVec3::new(0.0, 42.0, -86.0) / 8.0;
-    let h = 21.0 / 16.0;
-    let sheets = TriangleMesh::quad(c, DVec3::Y * h, DVec3::X * h)
-        .unwrap()
-        .merged(&TriangleMesh::quad(c + d, DVec3::X * h, DVec3::Y * h).unwrap())
-        .unwrap();
-    let scene = Scene::new(vec![light(sheets, DVec3::ONE)], vec![])
-        .unwrap()
-        .with_method(Method::PerTriangle);
+    let scene = two_sheet_light(
+        DVec3::new(85.0, -86.0, 6.0) / 8.0,
+        DVec3::new(0.0, 42.0, -86.0) / 8.0,
+        21.0 / 16.0,
+    );
     let clip = scene.visibility();
     let pl = PluckerVisibility::from_clip(clip.clone());
     let corner = DVec3::new(11.9375, -12.0625, 0.75);
@@ -1005,16 +1013,11 @@ fn a_point_a_hair_below_a_sheet_sees_none_of_the_sheet_behind_it() {
     // visible without developing the tree. Both backends must agree at every point: per call,
     // the unoccluded region (the light's own faces still block), and through contexts of
     // several cell sizes (shared trees outside the near band, trees of their own inside it).
-    let c = DVec3::new(2.0, 0.0, 0.0) / 8.0;
-    let d = DVec3::new(10.0, -1.0, -1.0) / 8.0;
-    let h = 17.0 / 16.0;
-    let sheets = TriangleMesh::quad(c, DVec3::Y * h, DVec3::X * h)
-        .unwrap()
-        .merged(&TriangleMesh::quad(c + d, DVec3::X * h, DVec3::Y * h).unwrap())
-        .unwrap();
-    let scene = Scene::new(vec![light(sheets, DVec3::ONE)], vec![])
-        .unwrap()
-        .with_method(Method::PerTriangle);
+    let scene = two_sheet_light(
+        DVec3::new(2.0, 0.0, 0.0) / 8.0,
+        DVec3::new(10.0, -1.0, -1.0) / 8.0,
+        17.0 / 16.0,
+    );
     let clip = scene.visibility();
     let pl = PluckerVisibility::from_clip(clip.clone());
     let n = DVec3::new(0.0, -1.0, -1.0).normalize();

@@ -1770,10 +1770,22 @@ fn contour_loop(
     if count < 3 {
         return None;
     }
+    follow_loop(&next, start, count, order)
+}
+
+/// Writes into `order` the loop of `count` vertices that the successor table `next` (`u8::MAX`
+/// where a vertex has none) makes from `start`; `None` where the walk breaks off or closes
+/// before `count` vertices (the contour is not one loop).
+fn follow_loop(
+    next: &[u8; INLINE_VERTICES],
+    start: u8,
+    count: usize,
+    order: &mut [u8; INLINE_VERTICES],
+) -> Option<usize> {
     order[0] = start;
     let mut at = next[start as usize];
     for slot in order.iter_mut().take(count).skip(1) {
-        if at == NONE || at == start {
+        if at == u8::MAX || at == start {
             return None;
         }
         *slot = at;
@@ -1825,16 +1837,7 @@ fn contour_by_bits(
         }
         contour &= contour - 1;
     }
-    order[0] = start;
-    let mut at = next[start as usize];
-    for slot in order.iter_mut().take(count).skip(1) {
-        if at == NONE || at == start {
-            return None;
-        }
-        *slot = at;
-        at = next[at as usize];
-    }
-    (at == start).then_some(count)
+    follow_loop(&next, start, count, order)
 }
 
 /// The silhouette's turn at `cur` from the edge with difference `d_in` to the one with `d_out`
