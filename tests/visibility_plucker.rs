@@ -1094,7 +1094,7 @@ fn a_point_near_an_icosphere_sees_through_a_shared_tree_what_the_clipping_backen
     // and the clipping backend agree; a context's shared tile tree gave up to 1.5e-6 sr too
     // little at 14 of 64 cell sizes from 1/32 to 2. The point is on a face (0.13 from its
     // edges) with the face's normal: the tree held 2 to 6 slivers of other faces, 4e-15 above
-    // the tile plane by rounding, that the per-call tree drops. Such tiles now send every point
+    // the tile plane by rounding, that the per-call tree drops. Such tiles send every point
     // to a tree of its own.
     let g = |i: f64, j: f64, k: f64| DVec3::new(i, j, k) / 8.0;
     let quad = TriangleMesh::quad(
