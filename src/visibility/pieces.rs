@@ -401,13 +401,7 @@ impl Pieces {
             planes,
             ..
         } = self;
-        let (a, b) = bufs.split_at_mut(1);
-        let (from, to) = if *cur == 0 {
-            (&a[0], &mut b[0])
-        } else {
-            (&b[0], &mut a[0])
-        };
-        to.clear();
+        let (from, to) = flip_buffers(bufs, *cur);
         for range in from.ranges() {
             let ring = &from.pts[range];
             match cut_by_planes(ring, planes, rings) {
@@ -425,6 +419,15 @@ impl Pieces {
         self.flip();
         ok
     }
+}
+
+/// The region's current chain `bufs[cur]` to read and the other one, cleared, to write the
+/// next region into (the caller then flips `cur`).
+fn flip_buffers(bufs: &mut [Chain; 2], cur: usize) -> (&Chain, &mut Chain) {
+    let [a, b] = bufs;
+    let (from, to) = if cur == 0 { (&*a, b) } else { (&*b, a) };
+    to.clear();
+    (from, to)
 }
 
 /// The ring cut by every plane of `planes` (Sutherland–Hodgman), the result, if any, in
@@ -650,13 +653,7 @@ impl Pieces {
             ..
         } = self;
         let inside = *inside_bits;
-        let (a, b) = bufs.split_at_mut(1);
-        let (from, to) = if *cur == 0 {
-            (&a[0], &mut b[0])
-        } else {
-            (&b[0], &mut a[0])
-        };
-        to.clear();
+        let (from, to) = flip_buffers(bufs, *cur);
         let (r0, r1) = (exit.ring.0 as usize, exit.ring.1 as usize);
         let len = r1 - r0;
         let (ia, ib) = (exit.edge as usize - r0, entry.edge as usize - r0);
@@ -745,13 +742,7 @@ impl Pieces {
             ..
         } = self;
         let inside = *inside_bits;
-        let (a, b) = bufs.split_at_mut(1);
-        let (from, to) = if *cur == 0 {
-            (&a[0], &mut b[0])
-        } else {
-            (&b[0], &mut a[0])
-        };
-        to.clear();
+        let (from, to) = flip_buffers(bufs, *cur);
         let (fp, kv, order): (&[DVec3], &[DVec3], &[u16]) = (&from.pts, kv, order);
         let crossings: &mut [Crossing] = crossings;
         let mut guard = n + 1;
@@ -853,13 +844,7 @@ impl Pieces {
             ..
         } = self;
         let inside = *inside_bits;
-        let (a, b) = bufs.split_at_mut(1);
-        let (from, to) = if *cur == 0 {
-            (&a[0], &mut b[0])
-        } else {
-            (&b[0], &mut a[0])
-        };
-        to.clear();
+        let (from, to) = flip_buffers(bufs, *cur);
         for range in from.ranges() {
             if (inside >> range.start) & 1 == 0 {
                 to.push_ring(&from.pts[range]);
