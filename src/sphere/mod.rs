@@ -21,6 +21,7 @@ pub use boolean::MIN_CAP_COS;
 pub use clip::HORIZON_TOLERANCE;
 pub use gnomonic::{Gnomonic, enclosing_cap};
 pub use order::{MATCH_TOLERANCE, order_directed_edges, order_edges};
+pub(crate) use polygon::ring_slices;
 pub use polygon::{ANTIPODAL_TOLERANCE, COINCIDENT_TOLERANCE, SphericalPolygon};
 pub use sample::{PolygonSampler, SAMPLE_TOLERANCE, SphericalTriangle};
 pub(crate) use wolfe::min_norm_point;

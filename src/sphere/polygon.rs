@@ -274,12 +274,7 @@ impl SphericalPolygon {
 
     /// The rings, each a slice of unit vectors (the closing edge from last to first is implied).
     pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + Clone + '_ {
-        let mut start = 0usize;
-        self.ends.iter().map(move |&e| {
-            let s = start;
-            start = e as usize;
-            &self.verts[s..e as usize]
-        })
+        ring_slices(&self.verts, &self.ends)
     }
 
     /// Number of rings.
@@ -813,6 +808,21 @@ pub(crate) fn regularized(
         return (r, true);
     }
     (SphericalPolygon::from_parts(out, out_ends), changed)
+}
+
+/// The rings of a flat vertex buffer `verts` whose ring `k` ends (exclusive) at `ends[k]`, the
+/// layout of [`SphericalPolygon`] and of the crate's other ring chains.
+#[inline]
+pub(crate) fn ring_slices<'a>(
+    verts: &'a [DVec3],
+    ends: &'a [u32],
+) -> impl Iterator<Item = &'a [DVec3]> + Clone + 'a {
+    let mut start = 0usize;
+    ends.iter().map(move |&e| {
+        let s = start;
+        start = e as usize;
+        &verts[s..e as usize]
+    })
 }
 
 /// Ends the ring begun at `start`: drops vertices that coincide with their predecessor, and the

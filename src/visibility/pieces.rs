@@ -278,12 +278,7 @@ impl Pieces {
     /// The rings, each a slice of directions in the shading frame (not normalized).
     pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + Clone + '_ {
         let c = &self.bufs[self.cur];
-        let mut start = 0usize;
-        c.ends.iter().map(move |&e| {
-            let r = &c.pts[start..e as usize];
-            start = e as usize;
-            r
-        })
+        crate::sphere::ring_slices(&c.pts, &c.ends)
     }
 
     /// How many blocker subtractions this storage has run, over all calls: by boundary tracing

@@ -54,12 +54,7 @@ impl SilhouetteRings {
     /// The rings, each a slice of directions of any positive length (the closing edge from last
     /// to first implied).
     pub fn rings(&self) -> impl Iterator<Item = &[DVec3]> + Clone + '_ {
-        let mut start = 0usize;
-        self.ends.iter().map(move |&e| {
-            let s = start;
-            start = e as usize;
-            &self.verts[s..e as usize]
-        })
+        crate::sphere::ring_slices(&self.verts, &self.ends)
     }
 
     /// Number of rings.
