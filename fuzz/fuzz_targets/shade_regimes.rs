@@ -28,27 +28,15 @@
 use arealight::GeomError;
 use arealight::glam::DVec3;
 use arealight::shade::{
-    Body, ConvexPolyhedron, Light, LightShading, Material, Method, Scene, ShadingFrame,
-    TriangleMesh,
+    Body, Light, LightShading, Material, Method, Scene, ShadingFrame, TriangleMesh,
 };
 use arealight::solid::{FACE_TOLERANCE, Side, face_side};
 use libfuzzer_sys::arbitrary::{self, Arbitrary};
 use libfuzzer_sys::fuzz_target;
 
-/// A point of the coarse grid: integers over 8.
-#[derive(Debug, Clone, Copy, Arbitrary)]
-struct Grid(i8, i8, i8);
-
-impl Grid {
-    fn at(self) -> DVec3 {
-        DVec3::new(f64::from(self.0), f64::from(self.1), f64::from(self.2)) / 8.0
-    }
-}
-
-/// A small positive size on the grid (1/16 to 2).
-fn size(s: u8) -> f64 {
-    f64::from(1 + (s % 32)) / 16.0
-}
+#[path = "scene_common/mod.rs"]
+mod scene_common;
+use scene_common::{Grid, cuboid, icosphere, quad, sheets};
 
 /// A unit direction from three small integers (`+z` when they are all zero).
 fn unit(d: (i8, i8, i8)) -> DVec3 {
@@ -72,21 +60,10 @@ enum Prim {
 impl Prim {
     fn build(self) -> Option<Body> {
         Some(match self {
-            Prim::Quad(c, u, v) => TriangleMesh::quad(c.at(), u.at(), v.at()).ok()?.into(),
-            Prim::Cuboid(c, x, y, z) => {
-                ConvexPolyhedron::cuboid(c.at(), DVec3::new(size(x), size(y), size(z)))
-                    .ok()?
-                    .into()
-            }
-            Prim::Icosphere(c, r) => ConvexPolyhedron::icosphere(c.at(), size(r), 1).ok()?.into(),
-            Prim::Sheets(c, d, s) => {
-                let h = size(s);
-                TriangleMesh::quad(c.at(), DVec3::Y * h, DVec3::X * h)
-                    .ok()?
-                    .merged(&TriangleMesh::quad(c.at() + d.at(), DVec3::X * h, DVec3::Y * h).ok()?)
-                    .ok()?
-                    .into()
-            }
+            Prim::Quad(c, u, v) => quad(c, u, v)?,
+            Prim::Cuboid(c, x, y, z) => cuboid(c, x, y, z)?,
+            Prim::Icosphere(c, r) => icosphere(c, r)?,
+            Prim::Sheets(c, d, s) => sheets(c, d, s)?,
             Prim::Sliver(a, b, t, e, dir) => {
                 let (a, b) = (a.at(), b.at());
                 let off = 10f64.powi(-9 - i32::from(e % 7)) * (b - a).length();

@@ -30,8 +30,7 @@ use std::cell::RefCell;
 use arealight::glam::DVec3;
 use arealight::ltc::clamped_cosine_integral;
 use arealight::shade::{
-    Body, ConvexPolyhedron, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene,
-    ShadingFrame, TriangleMesh,
+    Body, Light, Material, Method, MonteCarlo, ReferenceBrdf, Scene, ShadingFrame, TriangleMesh,
 };
 use arealight::sphere::SphericalPolygon;
 use arealight::visibility::Visibility;
@@ -39,20 +38,9 @@ use arealight::visibility::plucker::{PluckerContext, PluckerVisibility};
 use libfuzzer_sys::arbitrary::{self, Arbitrary};
 use libfuzzer_sys::fuzz_target;
 
-/// A point of the coarse grid: integers over 8.
-#[derive(Debug, Clone, Copy, Arbitrary)]
-struct Grid(i8, i8, i8);
-
-impl Grid {
-    fn at(self) -> DVec3 {
-        DVec3::new(self.0 as f64, self.1 as f64, self.2 as f64) / 8.0
-    }
-}
-
-/// A small positive size on the grid (1/16 to 2).
-fn size(s: u8) -> f64 {
-    (1 + (s % 32)) as f64 / 16.0
-}
+#[path = "scene_common/mod.rs"]
+mod scene_common;
+use scene_common::{Grid, cuboid, icosphere, quad, sheets};
 
 #[derive(Debug, Clone, Copy, Arbitrary)]
 enum Prim {
@@ -68,21 +56,10 @@ enum Prim {
 impl Prim {
     fn build(self) -> Option<Body> {
         Some(match self {
-            Prim::Quad(c, u, v) => TriangleMesh::quad(c.at(), u.at(), v.at()).ok()?.into(),
-            Prim::Cuboid(c, x, y, z) => {
-                ConvexPolyhedron::cuboid(c.at(), DVec3::new(size(x), size(y), size(z)))
-                    .ok()?
-                    .into()
-            }
-            Prim::Icosphere(c, r) => ConvexPolyhedron::icosphere(c.at(), size(r), 1).ok()?.into(),
-            Prim::Sheets(c, d, s) => {
-                let h = size(s);
-                TriangleMesh::quad(c.at(), DVec3::Y * h, DVec3::X * h)
-                    .ok()?
-                    .merged(&TriangleMesh::quad(c.at() + d.at(), DVec3::X * h, DVec3::Y * h).ok()?)
-                    .ok()?
-                    .into()
-            }
+            Prim::Quad(c, u, v) => quad(c, u, v)?,
+            Prim::Cuboid(c, x, y, z) => cuboid(c, x, y, z)?,
+            Prim::Icosphere(c, r) => icosphere(c, r)?,
+            Prim::Sheets(c, d, s) => sheets(c, d, s)?,
             Prim::Triangle(a, b, c) => {
                 TriangleMesh::new(vec![a.at(), b.at(), c.at()], vec![[0, 1, 2]])
                     .ok()?
