@@ -569,6 +569,7 @@ pub(crate) fn chain_rings(
     mut emit: impl FnMut(&[u32], bool),
 ) -> bool {
     let n = edges.len();
+    s.paired = false;
     if n == 0 {
         return true;
     }
@@ -636,6 +637,7 @@ pub(crate) fn chain_rings(
         if v == u32::MAX || link[head as usize] == u32::MAX {
             continue;
         }
+        s.paired = true;
         let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
         let mut k = head;
         while k != u32::MAX {
@@ -709,6 +711,9 @@ pub(crate) fn chain_rings(
 pub(crate) struct ChainScratch {
     work: Vec<u32>,
     ring: Vec<u32>,
+    /// Whether the last [`chain_rings`] paired edges at a vertex left by several: only then
+    /// can its rings pass one vertex twice.
+    pub(crate) paired: bool,
 }
 
 impl ChainScratch {
@@ -717,6 +722,7 @@ impl ChainScratch {
         ChainScratch {
             work: Vec::with_capacity(6 * n),
             ring: Vec::with_capacity(n),
+            paired: false,
         }
     }
 }
