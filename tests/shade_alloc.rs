@@ -1,6 +1,6 @@
 //! Shading a point allocates nothing for lights and occluders of up to 16 vertices: neither
-//! `Scene::shade` (which makes its scratch storage on the stack) nor `Scene::shade_in` (the
-//! caller's). Counted with a wrapping global allocator, only on the test's own thread.
+//! `Scene::shade` (which lends the thread's kept scratch storage, held in thread-local storage,
+//! not on the heap) nor `Scene::shade_in` (the caller's). Counted with a wrapping global allocator, only on the test's own thread.
 //!
 //! The scenes are the benchmark's (a quad light over a cube, a flat box and an icosahedron) and
 //! a convex light (a box) over the same occluders, shaded at ground points in their penumbrae,

@@ -174,35 +174,26 @@ std::thread_local! {
     /// The context [`with_context`] lends to the entry points that take none: the scratch
     /// storage of closed meshes (the overlay's buffers, reserved for a few hundred vertices)
     /// costs about as much to set up and free as a small mesh's whole query, so a renderer
-    /// calling [`Scene::shade`] per pixel should not pay it per call. Taken out while in use,
-    /// so a query that found it taken (none does today: the queries call no user code) makes
-    /// its own.
-    static CONTEXT: core::cell::Cell<Option<alloc::boxed::Box<ShadeContext>>> =
-        const { core::cell::Cell::new(None) };
+    /// calling [`Scene::shade`] per pixel should not pay it per call. Thread-local storage, not
+    /// the heap: lending it allocates nothing.
+    static CONTEXT: core::cell::RefCell<ShadeContext> =
+        core::cell::RefCell::new(ShadeContext::new());
 }
 
-/// Runs `f` with this thread's kept [`ShadeContext`] (feature `std`), or with a fresh one
-/// where there is none to lend (without `std`, while another query holds it, or while the
-/// thread is being torn down). A context holds no results, only buffers, so the value is the
-/// same bit for bit whichever context `f` gets.
+/// Runs `f` (once) with this thread's kept [`ShadeContext`] (feature `std`), or with a fresh
+/// one where there is none to lend (without `std`, while another query on this thread holds it,
+/// which none does today since the queries call no user code, or while the thread is being
+/// torn down). A context holds no results, only buffers, so the value is the same bit for bit
+/// whichever context `f` gets.
 #[inline]
-fn with_context<R>(f: impl FnOnce(&mut ShadeContext) -> R) -> R {
+fn with_context<R>(mut f: impl FnMut(&mut ShadeContext) -> R) -> R {
     #[cfg(feature = "std")]
+    if let Ok(Some(out)) =
+        CONTEXT.try_with(|cell| cell.try_borrow_mut().ok().map(|mut ctx| f(&mut ctx)))
     {
-        let mut ctx = CONTEXT
-            .try_with(core::cell::Cell::take)
-            .ok()
-            .flatten()
-            .unwrap_or_else(|| alloc::boxed::Box::new(ShadeContext::new()));
-        let out = f(&mut ctx);
-        // Fails only while the thread is torn down: the context is then dropped here.
-        let _ = CONTEXT.try_with(|cell| cell.set(Some(ctx)));
-        out
+        return out;
     }
-    #[cfg(not(feature = "std"))]
-    {
-        f(&mut ShadeContext::new())
-    }
+    f(&mut ShadeContext::new())
 }
 
 /// The diffuse and LTC integrals of the fast path's pieces, as [`integrals`] of the same region
@@ -312,7 +303,9 @@ impl Scene {
         view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
-        with_context(|ctx| self.shade_in(ctx, point, normal, view, material))
+        let frame = frame(point, normal, view)?;
+        let spec = specular_setup(&frame, material)?;
+        with_context(|ctx| self.shade_frame_in(ctx, &frame, material, &spec))
     }
 
     /// [`Scene::shade`] in the caller's [`ShadeContext`]: the same value, bit for bit, without
@@ -331,10 +324,21 @@ impl Scene {
         material: &Material,
     ) -> Result<DVec3, GeomError> {
         let frame = frame(point, normal, view)?;
-        let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
+        self.shade_frame_in(ctx, &frame, material, &spec)
+    }
+
+    /// [`Scene::shade_in`] at a validated frame.
+    fn shade_frame_in(
+        &self,
+        ctx: &mut ShadeContext,
+        frame: &ShadingFrame,
+        material: &Material,
+        spec: &SpecularSetup,
+    ) -> Result<DVec3, GeomError> {
+        let mut total = DVec3::ZERO;
         for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, &spec, ctx)?;
+            total += self.shade_light_in(i, frame, material, spec, ctx)?;
         }
         Ok(total)
     }
