@@ -314,11 +314,18 @@ impl Overlay {
         for i in 0..self.order.len() {
             let e = (self.order[i] & u128::from(u32::MAX)) as usize;
             let be = self.bbox[e];
-            let bbox = &self.bbox;
-            self.active.retain(|&f| bbox[f as usize][1] >= be[0]);
+            // One pass over the active edges: those whose boxes end left of `e`'s leave for good
+            // (the later edges start no further left), the others stay, in order, and are
+            // tested against `e` where their boxes overlap in `y` too.
+            let mut kept = 0;
             for j in 0..self.active.len() {
                 let f = self.active[j] as usize;
                 let bf = self.bbox[f];
+                if bf[1] < be[0] {
+                    continue;
+                }
+                self.active[kept] = f as u32;
+                kept += 1;
                 if bf[2] > be[3] || be[2] > bf[3] {
                     continue;
                 }
@@ -326,6 +333,7 @@ impl Overlay {
                     return false;
                 }
             }
+            self.active.truncate(kept);
             self.active.push(e as u32);
         }
         true
