@@ -588,6 +588,8 @@ pub(crate) fn chain_rings(
     work.resize(2 * n + 2 * (mask + 1), u32::MAX);
     let (next, rest) = work.split_at_mut(n);
     let (link, table) = rest.split_at_mut(n);
+    // Whether some vertex is left by several edges (only then is the table scanned for them).
+    let mut several = false;
     for (k, &(a, _)) in edges.iter().enumerate() {
         if a == u32::MAX {
             return false;
@@ -602,6 +604,7 @@ pub(crate) fn chain_rings(
             if table[2 * h] == a {
                 link[k] = table[2 * h + 1];
                 table[2 * h + 1] = k as u32;
+                several = true;
                 break;
             }
             h = (h + 1) & mask;
@@ -619,7 +622,7 @@ pub(crate) fn chain_rings(
             h = (h + 1) & mask;
         }
     };
-    // Single successors; vertices left by several edges are paired by angle.
+    // Single successors.
     for k in 0..n {
         let head = first_out(table, edges[k].1);
         if head == u32::MAX {
@@ -632,7 +635,10 @@ pub(crate) fn chain_rings(
             next[k] = head;
         }
     }
-    for t in 0..=mask {
+    // Vertices left by several edges, paired by angle: the table is scanned only if there are
+    // any.
+    let scan = if several { mask + 1 } else { 0 };
+    for t in 0..scan {
         let (v, head) = (table[2 * t], table[2 * t + 1]);
         if v == u32::MAX || link[head as usize] == u32::MAX {
             continue;
