@@ -26,13 +26,17 @@
 //!   builds the scene and shades the 8 points `n` times (default 1) with no criterion, so that
 //!   `valgrind --tool=callgrind` counts the instructions of exactly that: run it with `n = 0`
 //!   too and divide the difference by `8 n` for the instructions per shading point (the scene
-//!   construction and a check of the visible fractions cancel);
+//!   construction and a check of the visible fractions cancel); `Scene::shade` per point (a
+//!   renderer's plain call), or with `MESH_SCALE_CONTEXT=1` `Scene::shade_in` with one kept
+//!   `ShadeContext`;
 //! - `MESH_SCALE_IMAGE=<scene>`: renders a 200 x 150 image of the ground and the occluder (one
 //!   shading point per pixel, one thread) and prints the time and images per second.
 
 use arealight::glam::DVec3;
 use arealight::internals::{bumpy_sphere, torus};
-use arealight::shade::{Body, ConvexPolyhedron, Light, Material, Method, Scene, TriangleMesh};
+use arealight::shade::{
+    Body, ConvexPolyhedron, Light, Material, Method, Scene, ShadeContext, TriangleMesh,
+};
 use criterion::{BenchmarkId, Criterion, criterion_group};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -345,8 +349,23 @@ fn main() {
         }
         let (pts, m) = (points(), material());
         let mut sum = DVec3::ZERO;
-        for _ in 0..reps {
-            sum += shade_all(&s, &pts, &m);
+        if std::env::var("MESH_SCALE_CONTEXT").is_ok_and(|v| v == "1") {
+            // A renderer's kept context (`Scene::shade_in`), its buffers made by one pass that
+            // every `reps` pays alike.
+            let mut ctx = ShadeContext::new();
+            let pass = |ctx: &mut ShadeContext| -> DVec3 {
+                pts.iter()
+                    .map(|&(x, n, v)| s.shade_in(ctx, black_box(x), n, v, &m).unwrap())
+                    .sum()
+            };
+            pass(&mut ctx);
+            for _ in 0..reps {
+                sum += pass(&mut ctx);
+            }
+        } else {
+            for _ in 0..reps {
+                sum += shade_all(&s, &pts, &m);
+            }
         }
         // The same work for any `reps` (so that it cancels in a difference of counts): the
         // visible fraction of the light at each point.

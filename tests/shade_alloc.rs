@@ -1,6 +1,6 @@
 //! Shading a point allocates nothing for lights and occluders of up to 16 vertices: neither
-//! `Scene::shade` (which makes its scratch storage on the stack) nor `Scene::shade_in` (the
-//! caller's). Counted with a wrapping global allocator, only on the test's own thread.
+//! `Scene::shade` (which lends the thread's kept scratch storage, held in thread-local storage,
+//! not on the heap) nor `Scene::shade_in` (the caller's). Counted with a wrapping global allocator, only on the test's own thread.
 //!
 //! The scenes are the benchmark's (a quad light over a cube, a flat box and an icosahedron) and
 //! a convex light (a box) over the same occluders, shaded at ground points in their penumbrae,
@@ -128,4 +128,62 @@ fn shading_allocates_nothing_for_small_inputs() {
     // The counter does see allocations on this thread.
     let (_, n) = allocations(|| vec![1u8; 16]);
     assert_eq!(n, 1);
+}
+
+/// `Scene::shade` keeps its scratch storage per thread: over a closed mesh blocker (whose
+/// contour overlay needs heap buffers) the first call on a thread may allocate them, later calls
+/// on that thread allocate nothing, and every value equals `Scene::shade_in`'s with a fresh
+/// context, bit for bit, on this thread and on another. (With a context made per call, every
+/// call allocates: checked.)
+#[test]
+fn shade_keeps_its_scratch_per_thread() {
+    let quad =
+        TriangleMesh::quad(DVec3::new(0.0, 0.0, 3.0), DVec3::Y * 0.5, DVec3::X * 0.5).unwrap();
+    let cube = ConvexPolyhedron::cuboid(DVec3::new(0.0, 0.0, 1.5), DVec3::splat(0.35)).unwrap();
+    let scene = Scene::new(
+        vec![Light::new(quad, DVec3::ONE).unwrap()],
+        vec![cube.mesh().clone().into()],
+    )
+    .unwrap();
+    let m = Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.4).unwrap();
+    let mut rng = Rng::new(11);
+    let pts: Vec<(DVec3, DVec3)> = (0..24)
+        .map(|_| {
+            let x = DVec3::new(rng.range(-0.9, 0.9), rng.range(-0.9, 0.9), 0.0);
+            (x, view_above(&mut rng, DVec3::Z, 0.2))
+        })
+        .collect();
+    let fresh: Vec<DVec3> = pts
+        .iter()
+        .map(|&(x, v)| {
+            let mut ctx = ShadeContext::new();
+            scene.shade_in(&mut ctx, x, DVec3::Z, v, &m).unwrap()
+        })
+        .collect();
+    let (first, _) = allocations(|| scene.shade(pts[0].0, DVec3::Z, pts[0].1, &m));
+    assert_eq!(first.unwrap(), fresh[0]);
+    let mut later = 0;
+    for (k, &(x, v)) in pts.iter().enumerate() {
+        let (a, n) = allocations(|| scene.shade(x, DVec3::Z, v, &m));
+        assert_eq!(a.unwrap(), fresh[k], "{x}");
+        later += n;
+    }
+    assert_eq!(later, 0, "allocations after the thread's first call");
+    // The points reach the overlay: a fresh context allocates there.
+    let (_, n) = allocations(|| {
+        let mut ctx = ShadeContext::new();
+        scene.shade_in(&mut ctx, pts[0].0, DVec3::Z, pts[0].1, &m)
+    });
+    assert!(n > 0, "no scratch storage was needed");
+    // Another thread: its own context, the same values.
+    let other: Vec<DVec3> = std::thread::scope(|s| {
+        s.spawn(|| {
+            pts.iter()
+                .map(|&(x, v)| scene.shade(x, DVec3::Z, v, &m).unwrap())
+                .collect()
+        })
+        .join()
+        .unwrap()
+    });
+    assert_eq!(other, fresh);
 }

@@ -11,7 +11,8 @@
 //! pieces cut by half-spaces, never built as spherical polygons, integrated as they are) where it
 //! applies, and from the spherical path ([`ClipVisibility::visible_region`]) elsewhere; the two
 //! agree to rounding (`tests/shade_speed.rs`). A [`ShadeContext`] holds the fast path's scratch
-//! storage: [`Scene::shade_in`] reuses the caller's, [`Scene::shade`] makes one on the stack.
+//! storage: [`Scene::shade_in`] reuses the caller's; [`Scene::shade`] and the other entry points
+//! reuse one per thread (feature `std`; without it they make one on the stack per call).
 
 use alloc::vec::Vec;
 
@@ -103,10 +104,10 @@ pub(super) fn specular_setup(
 /// Scratch storage and counters of shading queries ([`Scene::shade_in`]): the visibility fast
 /// path's [`Pieces`], kept so that their buffers are reused from one query to the next.
 ///
-/// Inline storage covers lights and blockers of up to 16 vertices, so neither a context kept by
-/// the caller nor the one [`Scene::shade`] makes on the stack allocates for them; larger inputs,
-/// and closed mesh blockers and closed non-planar mesh lights of any size, spill to the heap
-/// once per context. A context holds no results: any context serves any
+/// Inline storage covers lights and blockers of up to 16 vertices, so a context allocates
+/// nothing for them; larger inputs, and closed mesh blockers and closed non-planar mesh lights
+/// of any size, spill to the heap once per context. [`Scene::shade`] reuses one context per
+/// thread (feature `std`; without it, one on the stack per call). A context holds no results: any context serves any
 /// scene. One per thread (it is `Send`, and the scene is shared).
 ///
 /// # Examples
@@ -166,6 +167,33 @@ impl ShadeContext {
     pub fn spherical_lights(&self) -> u64 {
         self.spherical
     }
+}
+
+#[cfg(feature = "std")]
+std::thread_local! {
+    /// The context [`with_context`] lends to the entry points that take none: the scratch
+    /// storage of closed meshes (the overlay's buffers, reserved for a few hundred vertices)
+    /// costs about as much to set up and free as a small mesh's whole query, so a renderer
+    /// calling [`Scene::shade`] per pixel should not pay it per call. Thread-local storage, not
+    /// the heap: lending it allocates nothing.
+    static CONTEXT: core::cell::RefCell<ShadeContext> =
+        core::cell::RefCell::new(ShadeContext::new());
+}
+
+/// Runs `f` (once) with this thread's kept [`ShadeContext`] (feature `std`), or with a fresh
+/// one where there is none to lend (without `std`, while another query on this thread holds it,
+/// which none does today since the queries call no user code, or while the thread is being
+/// torn down). A context holds no results, only buffers, so the value is the same bit for bit
+/// whichever context `f` gets.
+#[inline]
+fn with_context<R>(mut f: impl FnMut(&mut ShadeContext) -> R) -> R {
+    #[cfg(feature = "std")]
+    if let Ok(Some(out)) =
+        CONTEXT.try_with(|cell| cell.try_borrow_mut().ok().map(|mut ctx| f(&mut ctx)))
+    {
+        return out;
+    }
+    f(&mut ShadeContext::new())
 }
 
 /// The diffuse and LTC integrals of the fast path's pieces, as [`integrals`] of the same region
@@ -265,7 +293,9 @@ impl Scene {
     /// closed light that bounds a solid, or on a convex light's surface, receives nothing from
     /// it.
     ///
-    /// Each call makes a [`ShadeContext`] on the stack; [`Scene::shade_in`] reuses one.
+    /// With the `std` feature (a default) each thread keeps one [`ShadeContext`] that its
+    /// calls reuse; without it each call makes one on the stack. [`Scene::shade_in`] takes the
+    /// caller's.
     pub fn shade(
         &self,
         point: impl IntoDVec3,
@@ -273,7 +303,9 @@ impl Scene {
         view: impl IntoDVec3,
         material: &Material,
     ) -> Result<DVec3, GeomError> {
-        self.shade_in(&mut ShadeContext::new(), point, normal, view, material)
+        let frame = frame(point, normal, view)?;
+        let spec = specular_setup(&frame, material)?;
+        with_context(|ctx| self.shade_frame_in(ctx, &frame, material, &spec))
     }
 
     /// [`Scene::shade`] in the caller's [`ShadeContext`]: the same value, bit for bit, without
@@ -292,10 +324,21 @@ impl Scene {
         material: &Material,
     ) -> Result<DVec3, GeomError> {
         let frame = frame(point, normal, view)?;
-        let mut total = DVec3::ZERO;
         let spec = specular_setup(&frame, material)?;
+        self.shade_frame_in(ctx, &frame, material, &spec)
+    }
+
+    /// [`Scene::shade_in`] at a validated frame.
+    fn shade_frame_in(
+        &self,
+        ctx: &mut ShadeContext,
+        frame: &ShadingFrame,
+        material: &Material,
+        spec: &SpecularSetup,
+    ) -> Result<DVec3, GeomError> {
+        let mut total = DVec3::ZERO;
         for i in 0..self.lights().len() {
-            total += self.shade_light_in(i, &frame, material, &spec, ctx)?;
+            total += self.shade_light_in(i, frame, material, spec, ctx)?;
         }
         Ok(total)
     }
@@ -346,17 +389,18 @@ impl Scene {
         }
         let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        let mut ctx = ShadeContext::new();
-        let mut total = DVec3::ZERO;
-        for (i, light) in self.lights().iter().enumerate() {
-            let (diffuse, specular) = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
-            let mut out = material.albedo() * diffuse;
-            if let Some((_, scale)) = spec {
-                out += scale * specular;
+        with_context(|ctx| {
+            let mut total = DVec3::ZERO;
+            for (i, light) in self.lights().iter().enumerate() {
+                let (diffuse, specular) = region_integrals(vis, i, &frame, &spec, true, ctx)?;
+                let mut out = material.albedo() * diffuse;
+                if let Some((_, scale)) = spec {
+                    out += scale * specular;
+                }
+                total += out * light.radiance();
             }
-            total += out * light.radiance();
-        }
-        Ok(total)
+            Ok(total)
+        })
     }
 
     /// The contribution of light `light` alone to [`Scene::shade`] (occluders included).
@@ -375,7 +419,7 @@ impl Scene {
         self.light(light)?;
         let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        self.shade_light_in(light, &frame, material, &spec, &mut ShadeContext::new())
+        with_context(|ctx| self.shade_light_in(light, &frame, material, &spec, ctx))
     }
 
     /// Every light's share of [`Scene::shade`] at `point` (same arguments), split into the
@@ -418,31 +462,32 @@ impl Scene {
     ) -> Result<Vec<LightShading>, GeomError> {
         let frame = frame(point, normal, view)?;
         let spec = specular_setup(&frame, material)?;
-        let mut ctx = ShadeContext::new();
-        let mut out = Vec::with_capacity(self.lights().len());
-        for (i, light) in self.lights().iter().enumerate() {
-            let vis = self.light_visibility(i, &frame);
-            let unshadowed = region_integrals(vis, i, &frame, &spec, false, &mut ctx)?;
-            // Exactly what `shade` computes for the light, so that the shares add up to it. The
-            // unshadowed region may come from the other path (the fast path declines only where
-            // a blocker needs the spherical one); the two agree to rounding, so the shadowed
-            // value can exceed the unshadowed one by rounding.
-            let shadowed = region_integrals(vis, i, &frame, &spec, true, &mut ctx)?;
-            let rgb = light.radiance();
-            let lobes = |(d, s): (f64, f64)| {
-                let specular = spec.map_or(DVec3::ZERO, |(_, scale)| scale * s * rgb);
-                (material.albedo() * d * rgb, specular)
-            };
-            let (diffuse, specular) = lobes(shadowed);
-            let (unshadowed_diffuse, unshadowed_specular) = lobes(unshadowed);
-            out.push(LightShading {
-                diffuse,
-                specular,
-                unshadowed_diffuse,
-                unshadowed_specular,
-            });
-        }
-        Ok(out)
+        with_context(|ctx| {
+            let mut out = Vec::with_capacity(self.lights().len());
+            for (i, light) in self.lights().iter().enumerate() {
+                let vis = self.light_visibility(i, &frame);
+                let unshadowed = region_integrals(vis, i, &frame, &spec, false, ctx)?;
+                // Exactly what `shade` computes for the light, so that the shares add up to it. The
+                // unshadowed region may come from the other path (the fast path declines only where
+                // a blocker needs the spherical one); the two agree to rounding, so the shadowed
+                // value can exceed the unshadowed one by rounding.
+                let shadowed = region_integrals(vis, i, &frame, &spec, true, ctx)?;
+                let rgb = light.radiance();
+                let lobes = |(d, s): (f64, f64)| {
+                    let specular = spec.map_or(DVec3::ZERO, |(_, scale)| scale * s * rgb);
+                    (material.albedo() * d * rgb, specular)
+                };
+                let (diffuse, specular) = lobes(shadowed);
+                let (unshadowed_diffuse, unshadowed_specular) = lobes(unshadowed);
+                out.push(LightShading {
+                    diffuse,
+                    specular,
+                    unshadowed_diffuse,
+                    unshadowed_specular,
+                });
+            }
+            Ok(out)
+        })
     }
 
     fn shade_light_in(

@@ -569,6 +569,7 @@ pub(crate) fn chain_rings(
     mut emit: impl FnMut(&[u32], bool),
 ) -> bool {
     let n = edges.len();
+    s.paired = false;
     if n == 0 {
         return true;
     }
@@ -587,6 +588,8 @@ pub(crate) fn chain_rings(
     work.resize(2 * n + 2 * (mask + 1), u32::MAX);
     let (next, rest) = work.split_at_mut(n);
     let (link, table) = rest.split_at_mut(n);
+    // Whether some vertex is left by several edges (only then is the table scanned for them).
+    let mut several = false;
     for (k, &(a, _)) in edges.iter().enumerate() {
         if a == u32::MAX {
             return false;
@@ -601,6 +604,7 @@ pub(crate) fn chain_rings(
             if table[2 * h] == a {
                 link[k] = table[2 * h + 1];
                 table[2 * h + 1] = k as u32;
+                several = true;
                 break;
             }
             h = (h + 1) & mask;
@@ -618,7 +622,7 @@ pub(crate) fn chain_rings(
             h = (h + 1) & mask;
         }
     };
-    // Single successors; vertices left by several edges are paired by angle.
+    // Single successors.
     for k in 0..n {
         let head = first_out(table, edges[k].1);
         if head == u32::MAX {
@@ -631,11 +635,15 @@ pub(crate) fn chain_rings(
             next[k] = head;
         }
     }
-    for t in 0..=mask {
+    // Vertices left by several edges, paired by angle: the table is scanned only if there are
+    // any.
+    let scan = if several { mask + 1 } else { 0 };
+    for t in 0..scan {
         let (v, head) = (table[2 * t], table[2 * t + 1]);
         if v == u32::MAX || link[head as usize] == u32::MAX {
             continue;
         }
+        s.paired = true;
         let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
         let mut k = head;
         while k != u32::MAX {
@@ -709,6 +717,9 @@ pub(crate) fn chain_rings(
 pub(crate) struct ChainScratch {
     work: Vec<u32>,
     ring: Vec<u32>,
+    /// Whether the last [`chain_rings`] paired edges at a vertex left by several: only then
+    /// can its rings pass one vertex twice.
+    pub(crate) paired: bool,
 }
 
 impl ChainScratch {
@@ -717,6 +728,7 @@ impl ChainScratch {
         ChainScratch {
             work: Vec::with_capacity(6 * n),
             ring: Vec::with_capacity(n),
+            paired: false,
         }
     }
 }

@@ -202,6 +202,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             if !ok || !fits {
                 return false;
             }
+            s.overlay.repeated_ids |= s.chain.paired;
         } else {
             let ov = &mut s.overlay;
             for ring in out.rings() {
@@ -319,6 +320,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 if !ok {
                     return false;
                 }
+                s.overlay.repeated_ids |= s.chain.paired;
                 if let Some(bvh) = bvh {
                     // The chains agree with the contour inside the box up to a closed path
                     // outside it (the left-out edges and the closing arcs), which adds the same

@@ -124,6 +124,11 @@ pub(crate) struct Overlay {
     pub(crate) out_ends: Vec<u32>,
     /// The result's rings touch (a vertex used twice): not simple.
     pub(crate) touching: bool,
+    /// Whether an identity may occur more than once among the input vertices (a contour that
+    /// passes a mesh vertex twice, [`super::contour::ChainScratch::paired`]); set by the caller
+    /// as it adds rings. Without such an input vertex the result cannot touch (see
+    /// [`Overlay::walk`]), and its identities are neither collected nor sorted.
+    pub(crate) repeated_ids: bool,
 }
 
 /// Rounding bound factor of the orientation test: Shewchuk's `ccwerrboundA` is `3.33e-16`.
@@ -179,6 +184,7 @@ impl Overlay {
         self.pts.clear();
         self.ends.clear();
         self.family.clear();
+        self.repeated_ids = false;
     }
 
     /// Closes the ring started at `start` (of family `fam`); one of fewer than three vertices is
@@ -308,11 +314,18 @@ impl Overlay {
         for i in 0..self.order.len() {
             let e = (self.order[i] & u128::from(u32::MAX)) as usize;
             let be = self.bbox[e];
-            let bbox = &self.bbox;
-            self.active.retain(|&f| bbox[f as usize][1] >= be[0]);
+            // One pass over the active edges: those whose boxes end left of `e`'s leave for good
+            // (the later edges start no further left), the others stay, in order, and are
+            // tested against `e` where their boxes overlap in `y` too.
+            let mut kept = 0;
             for j in 0..self.active.len() {
                 let f = self.active[j] as usize;
                 let bf = self.bbox[f];
+                if bf[1] < be[0] {
+                    continue;
+                }
+                self.active[kept] = f as u32;
+                kept += 1;
                 if bf[2] > be[3] || be[2] > bf[3] {
                     continue;
                 }
@@ -320,6 +333,7 @@ impl Overlay {
                     return false;
                 }
             }
+            self.active.truncate(kept);
             self.active.push(e as u32);
         }
         true
@@ -564,10 +578,12 @@ impl Overlay {
                     }
                     self.seen[pid] = true;
                     let cnt = (self.xstart[ce + 1] - self.xstart[ce]) as usize;
-                    if fwd && cj == 0 {
-                        self.out_ids.push(self.pts[ce].id);
-                    } else if !fwd && cj == cnt {
-                        self.out_ids.push(self.pts[self.succ(ce)].id);
+                    if self.repeated_ids {
+                        if fwd && cj == 0 {
+                            self.out_ids.push(self.pts[ce].id);
+                        } else if !fwd && cj == cnt {
+                            self.out_ids.push(self.pts[self.succ(ce)].id);
+                        }
                     }
                     let p = self.start_point(ce, cj, fwd, c, u, v);
                     self.out.push(p);
@@ -590,7 +606,9 @@ impl Overlay {
         // `chain_rings`) can be a vertex of the result more than once: its rings then touch
         // (or one ring pinches), which the boundary tracing of `visibility/pieces.rs` does not
         // take. Crossings cannot repeat (see the module documentation), nor can the light's
-        // own vertices (its rings are simple and disjoint, or a contour's mesh vertices).
+        // own vertices (its rings are simple and disjoint, or a contour's mesh vertices): a
+        // vertex of the result twice is an input identity twice, which only a contour paired
+        // at a vertex has (`repeated_ids`); without one, `out_ids` stayed empty.
         self.out_ids.sort_unstable();
         self.touching = self.out_ids.windows(2).any(|w| w[0] == w[1]);
         true
