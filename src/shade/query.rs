@@ -107,8 +107,8 @@ pub(super) fn specular_setup(
 /// Inline storage covers lights and blockers of up to 16 vertices, so a context allocates
 /// nothing for them; larger inputs, and closed mesh blockers and closed non-planar mesh lights
 /// of any size, spill to the heap once per context. [`Scene::shade`] reuses one context per
-/// thread (feature `std`; without it, one on the stack per call). A context holds no results: any context serves any
-/// scene. One per thread (it is `Send`, and the scene is shared).
+/// thread (feature `std`; without it, one on the stack per call). A context holds no results:
+/// any context serves any scene. One per thread (it is `Send`, and the scene is shared).
 ///
 /// # Examples
 ///
@@ -182,8 +182,8 @@ std::thread_local! {
 
 /// Runs `f` (once) with this thread's kept [`ShadeContext`] (feature `std`), or with a fresh
 /// one where there is none to lend (without `std`, while another query on this thread holds it,
-/// which none does today since the queries call no user code, or while the thread is being
-/// torn down). A context holds no results, only buffers, so the value is the same bit for bit
+/// which cannot happen while the queries call no user code, or while the thread is being torn
+/// down). A context holds no results, only buffers, so the value is the same bit for bit
 /// whichever context `f` gets.
 #[inline]
 fn with_context<R>(mut f: impl FnMut(&mut ShadeContext) -> R) -> R {
