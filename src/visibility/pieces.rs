@@ -91,7 +91,7 @@ use super::cull::{LightCone, above_horizon, may_occlude};
 use super::mesh_pieces::MeshScratch;
 use super::{Blocker, ClipVisibility, Method};
 use crate::GeomError;
-use crate::solid::facing::{FacingAt, Side, face_side};
+use crate::solid::facing::{FacingAt, Side, face_side, in_front};
 use crate::solid::silhouette::chain_by_index;
 use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
 use crate::sphere::{ANTIPODAL_TOLERANCE, MATCH_TOLERANCE};
@@ -217,6 +217,9 @@ pub struct Pieces {
     no_reject: bool,
     #[cfg(test)]
     rejects: u64,
+    /// Tests: silhouette walks whose spacing and turn tests [`walk_is_certified`] answered.
+    #[cfg(test)]
+    certified: u64,
 }
 
 /// Where a ring of the region crosses the boundary of a blocker's region `K`.
@@ -282,6 +285,8 @@ impl Pieces {
             no_reject: false,
             #[cfg(test)]
             rejects: 0,
+            #[cfg(test)]
+            certified: 0,
         }
     }
 
@@ -1598,6 +1603,11 @@ pub(super) struct ConvexFaces {
     /// differ ([`contour_by_bits`]): a few operations per front plane instead of a pass over
     /// every edge.
     plane_edges: Vec<[u64; 2]>,
+    /// For a simple polyhedron (every vertex on exactly three edges between different planes,
+    /// as a box's or a prism's), the shortest such edge and the smallest `|e x f|` of two of
+    /// them at one vertex: the bounds with which [`walk_is_certified`] answers the silhouette
+    /// walk's spacing and turn tests for a whole blocker at once.
+    simple: Option<(f64, f64)>,
 }
 
 /// Polyhedra with at most this many distinct face planes (a box has six; a polyhedron with eight
@@ -1663,6 +1673,7 @@ impl ConvexFaces {
                 plane_edges[g1 as usize][1] |= 1u64 << e;
             }
         }
+        let simple = simple_bounds(p.vertices(), &edges);
         Some(ConvexFaces {
             normals,
             offsets,
@@ -1671,8 +1682,62 @@ impl ConvexFaces {
             loops,
             vertices,
             plane_edges,
+            simple,
         })
     }
+}
+
+/// [`ConvexFaces::simple`] of a polyhedron with vertices `verts` and the edges `edges` between
+/// different planes: `None` unless every vertex that has such an edge has exactly three (and the
+/// bounds are positive).
+fn simple_bounds(verts: &[DVec3], edges: &[[u8; 4]]) -> Option<(f64, f64)> {
+    let mut at: Vec<Vec<DVec3>> = alloc::vec![Vec::new(); verts.len()];
+    let mut shortest = f64::INFINITY;
+    for &[a, b, _, _] in edges {
+        let e = verts[b as usize] - verts[a as usize];
+        shortest = shortest.min(e.length());
+        at[a as usize].push(e);
+        at[b as usize].push(-e);
+    }
+    let mut wedge = f64::INFINITY;
+    for es in at.iter().filter(|es| !es.is_empty()) {
+        if es.len() != 3 {
+            return None;
+        }
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            wedge = wedge.min(es[i].cross(es[j]).length());
+        }
+    }
+    (shortest > 0.0 && wedge > 0.0 && shortest.is_finite()).then_some((shortest, wedge))
+}
+
+/// Whether every spacing and turn test of the silhouette walk ([`convex_blocker`]) is known to
+/// pass for a simple polyhedron ([`ConvexFaces::simple`]: shortest edge `edge`, smallest wedge
+/// `wedge`) seen from a point at distance `dist` from its bounding sphere's center (radius `r`)
+/// whose distances from every face plane are at least `near` in magnitude.
+///
+/// With every `|distance|` that far above the facing tolerance (`FACE_TOLERANCE (r + dist)`,
+/// `1e-11` of it) and the distances' rounding, the contour is the exact one, so the silhouette
+/// is a convex polygon run counter-clockwise, with `s = dist + r` bounding every vertex's
+/// distance from the point:
+///
+/// - an edge `a b` of the contour lies in a front face, so the point is at least `near` from its
+///   line and the sine of the angle the edge subtends is at least `near edge / s^2`: above
+///   `1e-7` it is far from 0 and from `pi` (the spacing tests need `2e-9`), so both the quick
+///   accept and the test on unit vectors that decides where it does not would accept;
+/// - at a simple polyhedron's vertex `b` any two edges span a face, so consecutive contour
+///   vertices `a b c` lie in one face plane and `det(a - x, b - x, c - x)` is the point's
+///   distance from it times `|(b - a) x (c - b)|`, at least `near wedge`, positive for a convex
+///   polygon run counter-clockwise; above `1e-7 s^3` it exceeds the determinant's change under
+///   the rounding of the directions (a few `eps s^3`, scaled alike), so the computed turn is
+///   positive and [`turns_left`] accepts.
+///
+/// So the walk's decisions are all "accept" where this holds, and it need not make them.
+#[inline(always)]
+fn walk_is_certified((edge, wedge): (f64, f64), dist: f64, r: f64, near: f64) -> bool {
+    const REL: f64 = 1e-7;
+    let s = dist + r;
+    near * edge > REL * s * s && near * wedge > REL * s * s * s
 }
 
 /// [`convex_planes`] for a polyhedron with a [`ConvexFaces`] table: the same silhouette
@@ -1693,9 +1758,25 @@ fn convex_blocker(
     let at = FacingAt::new(p.mesh(), frame.origin());
     let dist = at.dist();
     let mut front = 0u64;
-    for (g, (nf, &d)) in faces.normals.iter().zip(&faces.offsets).enumerate() {
-        front |= u64::from(at.front(*nf, d)) << g;
-    }
+    // For a simple polyhedron, also the distance to the nearest face plane, which may answer
+    // every spacing and turn test below at once ([`walk_is_certified`]).
+    let certified = match faces.simple {
+        Some(bounds) => {
+            let mut near = f64::INFINITY;
+            for (g, (nf, &d)) in faces.normals.iter().zip(&faces.offsets).enumerate() {
+                let s = at.distance(*nf, d);
+                front |= u64::from(in_front(s, at.tol())) << g;
+                near = near.min(s.abs());
+            }
+            walk_is_certified(bounds, dist, p.mesh().bounding_sphere().radius, near)
+        }
+        None => {
+            for (g, (nf, &d)) in faces.normals.iter().zip(&faces.offsets).enumerate() {
+                front |= u64::from(at.front(*nf, d)) << g;
+            }
+            false
+        }
+    };
     if front == 0 {
         return false;
     }
@@ -1722,6 +1803,10 @@ fn convex_blocker(
     // `convex_silhouette_dirs`.
     let inv = 1.0 / dist;
     let verts = p.vertices();
+    #[cfg(test)]
+    {
+        out.certified += u64::from(certified);
+    }
     let Pieces { kv, planes, .. } = out;
     kv.clear();
     for &i in order {
@@ -1733,6 +1818,18 @@ fn convex_blocker(
     // `convex_planes`' test deciding where that does not accept.
     let kv: &[DVec3] = kv;
     planes.clear();
+    if certified {
+        // The same planes, bit for bit, without the tests.
+        let plane = |cur: DVec3, next: DVec3| {
+            let n = (cur + next).cross(next - cur);
+            n / norm1(n)
+        };
+        for w in kv.windows(2) {
+            planes.push(plane(w[0], w[1]));
+        }
+        planes.push(plane(kv[count - 1], kv[0]));
+        return true;
+    }
     let (mut cur, mut next) = (kv[0], kv[1]);
     let (mut cur1, mut next1) = (norm1(cur), norm1(next));
     for k in 0..count {
@@ -2052,8 +2149,13 @@ mod tests {
 
     /// The table walk ([`convex_blocker`]) and the general walk ([`convex_planes`]) at one
     /// frame: the same decision and, where both accept, the same directions and planes bit for
-    /// bit. Returns whether they accepted.
-    fn walks_agree(p: &ConvexPolyhedron, faces: &ConvexFaces, frame: &ShadingFrame) -> bool {
+    /// bit. Returns whether they accepted, and whether the table walk's tests were certified
+    /// ([`super::walk_is_certified`]).
+    fn walks_agree(
+        p: &ConvexPolyhedron,
+        faces: &ConvexFaces,
+        frame: &ShadingFrame,
+    ) -> (bool, bool) {
         let (mut a, mut b) = (Pieces::new(), Pieces::new());
         let fast = convex_blocker(p, faces, frame, &mut a);
         let general = convex_planes(p, frame, &mut b);
@@ -2068,13 +2170,13 @@ mod tests {
             assert_eq!(bits(&a.kv), bits(&b.kv), "{x}");
             assert_eq!(bits(&a.planes), bits(&b.planes), "{x}");
         }
-        fast
+        (fast, a.certified > 0)
     }
 
     #[test]
     fn table_walk_matches_convex_planes() {
         let mut rng = Rng(15);
-        let (mut compared, mut tables, mut accepted) = (0, 0, 0);
+        let (mut compared, mut tables, mut accepted, mut certified) = (0, 0, 0, 0);
         for p in polyhedra(&mut rng) {
             // Beyond 64 triangles (the subdivided icosphere) the general walk serves.
             let Some(faces) = ConvexFaces::of(&p) else {
@@ -2100,12 +2202,20 @@ mod tests {
                 let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
                 let Ok(frame) = frame else { continue };
                 compared += 1;
-                accepted += usize::from(walks_agree(&p, &faces, &frame));
+                let (fast, sure) = walks_agree(&p, &faces, &frame);
+                accepted += usize::from(fast);
+                certified += usize::from(sure);
             }
         }
+        // The certified walks are the boxes' and wedges' seen from points clear of their face
+        // planes: a good share of them.
         assert!(
-            tables >= 12 && compared > 8_000 && accepted > compared / 2 && accepted < compared,
-            "{tables} tables, {compared} compared, {accepted} accepted"
+            tables >= 12
+                && compared > 8_000
+                && accepted > compared / 2
+                && accepted < compared
+                && certified > compared / 12,
+            "{tables} tables, {compared} compared, {accepted} accepted, {certified} certified"
         );
     }
 
@@ -2135,11 +2245,14 @@ mod tests {
                 let frame = ShadingFrame::new(x, rng.vec(-1.0, 1.0), rng.vec(-1.0, 1.0));
                 let Ok(frame) = frame else { continue };
                 compared += 1;
-                if walks_agree(&p, &faces, &frame) {
+                let (fast, sure) = walks_agree(&p, &faces, &frame);
+                if fast {
                     accepted += 1;
                 } else {
                     declined += 1;
                 }
+                // In a face plane (within a few ulps) nothing is certified.
+                assert!(!sure || delta != 0.0, "{x}");
             }
         }
         assert!(
