@@ -1762,11 +1762,14 @@ fn convex_blocker(
     // every spacing and turn test below at once ([`walk_is_certified`]).
     let certified = match faces.simple {
         Some(bounds) => {
-            let mut near = f64::INFINITY;
+            let (mut near, tol) = (f64::INFINITY, at.tol());
             for (g, (nf, &d)) in faces.normals.iter().zip(&faces.offsets).enumerate() {
                 let s = at.distance(*nf, d);
-                front |= u64::from(in_front(s, at.tol())) << g;
-                near = near.min(s.abs());
+                front |= u64::from(in_front(s, tol)) << g;
+                // A plain comparison rather than `f64::min` (whose NaN rule costs more): a NaN
+                // distance leaves `near` as it was, and makes no plane front.
+                let a = s.abs();
+                near = if a < near { a } else { near };
             }
             walk_is_certified(bounds, dist, p.mesh().bounding_sphere().radius, near)
         }
