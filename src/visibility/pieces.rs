@@ -1608,7 +1608,20 @@ pub(super) struct ConvexFaces {
     /// them at one vertex: the bounds with which [`walk_is_certified`] answers the silhouette
     /// walk's spacing and turn tests for a whole blocker at once.
     simple: Option<(f64, f64)>,
+    /// With bit sets of edges and at most [`CELL_TABLE_PLANES`] planes: the contours of the sets
+    /// of front planes that points see, found once ([`cell_masks`]): `cells` sorted, and for
+    /// `cells[i]` the loop [`contour_by_bits`] chains, `cell_vertices[a..a + n]` for
+    /// `cell_loops[i] = (a, n)` (`n = 0` where it declines). A set not in the table is chained
+    /// per point as before.
+    cells: Vec<u64>,
+    cell_loops: Vec<(u32, u8)>,
+    cell_vertices: Vec<u8>,
 }
+
+/// Polyhedra with at most this many distinct face planes (and more than
+/// [`CONTOUR_TABLE_PLANES`]) get a table of the contours of the sets of front planes that
+/// points can see ([`cell_masks`]): an icosahedron (20 planes) has a few hundred.
+const CELL_TABLE_PLANES: usize = 24;
 
 /// Polyhedra with at most this many distinct face planes (a box has six; a polyhedron with eight
 /// has at most twelve vertices) get a table of their contours, one per set of front planes.
@@ -1674,7 +1687,7 @@ impl ConvexFaces {
             }
         }
         let simple = simple_bounds(p.vertices(), &edges);
-        Some(ConvexFaces {
+        let mut faces = ConvexFaces {
             normals,
             offsets,
             edges,
@@ -1683,8 +1696,108 @@ impl ConvexFaces {
             vertices,
             plane_edges,
             simple,
-        })
+            cells: Vec::new(),
+            cell_loops: Vec::new(),
+            cell_vertices: Vec::new(),
+        };
+        if !faces.plane_edges.is_empty() && faces.normals.len() <= CELL_TABLE_PLANES {
+            let cells = cell_masks(
+                &faces.normals,
+                &faces.offsets,
+                p.mesh().bounding_sphere().radius,
+            );
+            let mut order = [0u8; INLINE_VERTICES];
+            let (mut loops, mut verts) = (Vec::with_capacity(cells.len()), Vec::new());
+            for &front in &cells {
+                let n = contour_by_bits(front, &faces, &mut order).unwrap_or(0);
+                loops.push((verts.len() as u32, n as u8));
+                verts.extend_from_slice(&order[..n]);
+            }
+            (faces.cells, faces.cell_loops, faces.cell_vertices) = (cells, loops, verts);
+        }
+        Some(faces)
     }
+
+    /// The contour for the front planes `front` from the table of cells, if it holds that set:
+    /// `Some(None)` where [`contour_by_bits`] declines.
+    #[inline(always)]
+    fn cell_contour(&self, front: u64) -> Option<Option<&[u8]>> {
+        let i = self.cells.binary_search(&front).ok()?;
+        let (a, n) = self.cell_loops[i];
+        Some((n > 0).then(|| &self.cell_vertices[a as usize..a as usize + n as usize]))
+    }
+}
+
+/// The sets of front planes (bit `g` for plane `g`, given by unit `normals` and `offsets` from
+/// the bounding sphere's center, radius `r`) of the cells of the planes' arrangement, sorted,
+/// without the empty set: every cell of an arrangement whose normals span space has a vertex,
+/// where three planes meet, so the sets are found at those points, with every combination of
+/// sides for the planes through the point (within a rounding margin). Sets that no point sees
+/// may be among them (they cost a table entry), and sets the rounding hides may be missing (a
+/// point that sees one chains its contour itself): the table only saves work.
+fn cell_masks(normals: &[DVec3], offsets: &[f64], r: f64) -> Vec<u64> {
+    let mut out: Vec<u64> = Vec::new();
+    let n = normals.len();
+    let margin = 1e-9 * r.max(f64::MIN_POSITIVE);
+    let mut through: SmallVec<[usize; 16]> = SmallVec::new();
+    for i in 0..n {
+        for j in i + 1..n {
+            for k in j + 1..n {
+                let (a, b, c) = (normals[i], normals[j], normals[k]);
+                let (bc, ca, ab) = (b.cross(c), c.cross(a), a.cross(b));
+                let det = a.dot(bc);
+                if !(det.abs() > 1e-6) {
+                    continue;
+                }
+                let p = (bc * offsets[i] + ca * offsets[j] + ab * offsets[k]) / det;
+                let mut base = 0u64;
+                through.clear();
+                for g in 0..n {
+                    let s = normals[g].dot(p) - offsets[g];
+                    if s.abs() <= margin || g == i || g == j || g == k {
+                        through.push(g);
+                    } else if s > 0.0 {
+                        base |= 1u64 << g;
+                    }
+                }
+                // Each point once: from the first of its triples (in index order) whose
+                // normals span space.
+                if through.len() > 6 {
+                    continue;
+                }
+                let spans = |x: usize, y: usize, z: usize| {
+                    normals[x].dot(normals[y].cross(normals[z])).abs() > 1e-6
+                };
+                let t = &through[..];
+                let mut first = true;
+                'find: for (ia, &x) in t.iter().enumerate() {
+                    for (ib, &y) in t.iter().enumerate().skip(ia + 1) {
+                        for &z in &t[ib + 1..] {
+                            if (x, y, z) < (i, j, k) && spans(x, y, z) {
+                                first = false;
+                                break 'find;
+                            }
+                        }
+                    }
+                }
+                if !first {
+                    continue;
+                }
+                for combo in 0..1u64 << through.len() {
+                    let mut m = base;
+                    for (t, &g) in through.iter().enumerate() {
+                        m |= ((combo >> t) & 1) << g;
+                    }
+                    if m != 0 {
+                        out.push(m);
+                    }
+                }
+            }
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// [`ConvexFaces::simple`] of a polyhedron with vertices `verts` and the edges `edges` between
@@ -1785,9 +1898,13 @@ fn convex_blocker(
     }
     let mut order = [0u8; INLINE_VERTICES];
     let order: &[u8] = if !faces.plane_edges.is_empty() {
-        match contour_by_bits(front, faces, &mut order) {
-            Some(count) => &order[..count],
-            None => return false,
+        match faces.cell_contour(front) {
+            Some(Some(loop_)) => loop_,
+            Some(None) => return false,
+            None => match contour_by_bits(front, faces, &mut order) {
+                Some(count) => &order[..count],
+                None => return false,
+            },
         }
     } else if faces.loops.is_empty() {
         match contour_loop(front, &faces.edges, &faces.masks, &mut order) {
@@ -2261,6 +2378,49 @@ mod tests {
         assert!(
             compared > 10_000 && accepted > compared / 4 && declined > compared / 20,
             "{compared} compared, {accepted} accepted, {declined} declined"
+        );
+    }
+
+    /// The table of cells ([`ConvexFaces::cell_contour`]) against [`contour_by_bits`] for the
+    /// front planes of points all around icosahedra and random hulls, near and far: the same
+    /// loop (or decline) wherever the table holds the set, and the table holds nearly all sets
+    /// that points see.
+    #[test]
+    fn cell_table_matches_contour_by_bits() {
+        let mut rng = Rng(37);
+        let (mut tables, mut seen, mut hits) = (0, 0, 0);
+        for p in polyhedra(&mut rng) {
+            let Some(faces) = ConvexFaces::of(&p) else {
+                continue;
+            };
+            if faces.cells.is_empty() {
+                continue;
+            }
+            tables += 1;
+            let bs = p.mesh().bounding_sphere();
+            for k in 0..2000 {
+                let dir = rng.vec(-1.0, 1.0);
+                let x = bs.center + dir * (bs.radius * [1.05, 1.5, 4.0, 30.0][k % 4]);
+                let at = crate::solid::facing::FacingAt::new(p.mesh(), x);
+                let mut front = 0u64;
+                for (g, (nf, &d)) in faces.normals.iter().zip(&faces.offsets).enumerate() {
+                    front |= u64::from(at.front(*nf, d)) << g;
+                }
+                if front == 0 {
+                    continue;
+                }
+                seen += 1;
+                let mut order = [0u8; INLINE_VERTICES];
+                let general = contour_by_bits(front, &faces, &mut order);
+                if let Some(cached) = faces.cell_contour(front) {
+                    hits += 1;
+                    assert_eq!(cached, general.map(|n| &order[..n]), "front {front:b}");
+                }
+            }
+        }
+        assert!(
+            tables >= 6 && seen > 10_000 && hits * 100 > seen * 99,
+            "{tables} tables, {seen} sets seen, {hits} in the table"
         );
     }
 
