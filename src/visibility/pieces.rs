@@ -1620,8 +1620,12 @@ pub(super) struct ConvexFaces {
 
 /// Polyhedra with at most this many distinct face planes (and more than
 /// [`CONTOUR_TABLE_PLANES`]) get a table of the contours of the sets of front planes that
-/// points can see ([`cell_masks`]): an icosahedron (20 planes) has a few hundred.
+/// points can see ([`cell_masks`]): an icosahedron (20 planes) has 1 774, about 38 KB.
 const CELL_TABLE_PLANES: usize = 24;
+
+/// Most sets a table of cells holds (about 90 KB); a polyhedron with more keeps chaining its
+/// contour per point.
+const CELL_TABLE_SETS: usize = 4096;
 
 /// Polyhedra with at most this many distinct face planes (a box has six; a polyhedron with eight
 /// has at most twelve vertices) get a table of their contours, one per set of front planes.
@@ -1706,6 +1710,11 @@ impl ConvexFaces {
                 &faces.offsets,
                 p.mesh().bounding_sphere().radius,
             );
+            let cells = if cells.len() <= CELL_TABLE_SETS {
+                cells
+            } else {
+                Vec::new()
+            };
             let mut order = [0u8; INLINE_VERTICES];
             let (mut loops, mut verts) = (Vec::with_capacity(cells.len()), Vec::new());
             for &front in &cells {
