@@ -1741,9 +1741,11 @@ impl ConvexFaces {
 /// the bounding sphere's center, radius `r`) of the cells of the planes' arrangement, sorted,
 /// without the empty set: every cell of an arrangement whose normals span space has a vertex,
 /// where three planes meet, so the sets are found at those points, with every combination of
-/// sides for the planes through the point (within a rounding margin). Sets that no point sees
-/// may be among them (they cost a table entry), and sets the rounding hides may be missing (a
-/// point that sees one chains its contour itself): the table only saves work.
+/// sides for the planes through the point (within a rounding margin), each point once (from
+/// its first spanning triple in index order). Sets that no point sees may be among them (they
+/// cost a table entry), and sets may be missing where the rounding hides them or more than six
+/// planes meet at a point (left out: 128 combinations and more); a point that sees a missing
+/// set chains its contour itself, so the table only saves work.
 fn cell_masks(normals: &[DVec3], offsets: &[f64], r: f64) -> Vec<u64> {
     let mut out: Vec<u64> = Vec::new();
     let n = normals.len();
@@ -1770,7 +1772,7 @@ fn cell_masks(normals: &[DVec3], offsets: &[f64], r: f64) -> Vec<u64> {
                     }
                 }
                 // Each point once: from the first of its triples (in index order) whose
-                // normals span space.
+                // normals span space; points where more than six planes meet are left out.
                 if through.len() > 6 {
                     continue;
                 }
