@@ -4,10 +4,10 @@
 //! them from the front, all from behind, or all edge-on. From behind, a two-sided light shows
 //! what the same light turned around ([`TriangleMesh::flipped`], [`BezierShape::flipped`])
 //! shows from the front, with every blocker unchanged: blockers act on either side alike, and
-//! a light's geometry blocks the other lights with both of its sides. So the scene keeps a second visibility backend in which the
-//! two-sided lights are turned around, and each query of such a light picks the backend by one
-//! call of the facing predicate ([`face_side`]), whose answer for the turned mesh is exactly the
-//! opposite one. Everything below the shading layer keeps seeing one-sided lights.
+//! a light's geometry blocks the other lights with both of its sides. So the scene keeps a
+//! second visibility backend in which the two-sided lights are turned around, and each query of
+//! such a light picks the backend by one call of the facing predicate ([`face_side`]), whose
+//! answer for the turned mesh is exactly the opposite one. Everything below the shading layer keeps seeing one-sided lights.
 
 use alloc::boxed::Box;
 use alloc::vec::Vec;

@@ -28,8 +28,8 @@
 //!
 //! It declines (the caller takes the general path) where the light is wider than one chart, a
 //! mesh light's contour reaches the horizon, the point lies in the box of a component of the
-//! mesh light or of a blocker component in the shaft, the region before the overlay is not a set of simple rings, or the overlay declines
-//! within rounding.
+//! mesh light or of a blocker component in the shaft, the region before the overlay is not a
+//! set of simple rings, or the overlay declines within rounding.
 
 use alloc::boxed::Box;
 use alloc::vec::Vec;

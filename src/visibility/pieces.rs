@@ -1308,8 +1308,8 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
 
 /// The silhouette of the convex polyhedron `p` seen from the frame's point as directions in the
 /// frame (scaled by one positive factor), in `out.kv` if `to_kv` (a blocker's), else in
-/// `out.dirs` (counter-clockwise on the sphere: the silhouette on the left), exactly where [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the
-/// loop of the same vertices without its general ordering: front faces by the facing predicate
+/// `out.dirs` (counter-clockwise on the sphere: the silhouette on the left), exactly where
+/// [`convex_silhouette`](crate::solid::silhouette::convex_silhouette) returns the loop of the same vertices without its general ordering: front faces by the facing predicate
 /// (the same distances and tolerance), contour edges oriented by their front face, chained by
 /// vertex index into one loop whose consecutive directions are further apart than
 /// [`MATCH_TOLERANCE`] and not antipodal within [`ANTIPODAL_TOLERANCE`]. `false` elsewhere: no
