@@ -215,11 +215,12 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             );
         for (owner, body) in bodies {
             let m = body.mesh();
-            for t in 0..m.triangle_count() {
+            for (t, adj) in tile::mesh_adjacency(m).into_iter().enumerate() {
                 tris.push(BlockerTri {
                     v: m.triangle(t),
                     owner,
                     tri: t as u32,
+                    adj,
                 });
             }
         }
