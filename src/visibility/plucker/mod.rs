@@ -485,7 +485,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
         let Slot::Built(built) = &mut tile.slots[g] else {
             return Ok(Status::Done);
         };
-        if built.excludes(x, &|b| self.mesh_of(b)) {
+        if built.excludes(x, n, polys, &|b| self.mesh_of(b)) {
             stats.edge_on_fallbacks += 1;
             return Ok(Status::Fallback);
         }
@@ -824,7 +824,9 @@ pub struct PluckerStats {
     /// Queries answered by the clipping backend: one query alone outgrew the budget.
     pub clip_fallbacks: u64,
     /// Queries from a point that sees a blocker of its tile edge-on or lies within `1e-5` of
-    /// the coordinates' magnitude of its plane, answered by a tree of their own.
+    /// the coordinates' magnitude of its plane, or that a blocker left out of the shared tree
+    /// (its part above the tile plane within that band of it) may hide some of the light
+    /// from, answered by a tree of their own.
     pub edge_on_fallbacks: u64,
     /// Visible fragments returned.
     pub fragments: u64,

@@ -28,7 +28,11 @@
 //! edge-on and hides nothing (as in the clipping backend). Triangles edge-on from every point of
 //! the tile are dropped; those edge-on from some points, or whose plane passes within
 //! [`NEAR_BAND`] of the tile, are listed as `near`, and a query from a point that sees one of
-//! them edge-on, or lies that close to its plane, does not use the shared tree.
+//! them edge-on, or lies that close to its plane, does not use the shared tree. A triangle
+//! whose part above the tile plane lies within that band of it is left out of the shared tree
+//! (rounding leaves such slivers of a receiver's neighbours, on which the tree's decisions are
+//! not certified), and a point it may hide some of the light from (by a bound on its elevation
+//! seen from the point, [`FlatPiece::may_hide`]) does not use the shared tree either.
 
 use alloc::vec::Vec;
 
@@ -339,21 +343,96 @@ pub(crate) struct GroupTree {
     pub(crate) tree: Tree,
     near: Vec<Near>,
     band: f64,
-    /// An occluder lies within the band of the tile plane (see [`build_group_tree`]): no point
-    /// uses the shared tree.
-    flat: bool,
+    /// Blocker triangles whose part above the tile plane lies within the band of it, left out
+    /// of the tree (see [`build_group_tree`]); a point that such a triangle may hide some of
+    /// the light from does not use the shared tree ([`FlatPiece::may_hide`]).
+    flat: Vec<FlatPiece>,
+}
+
+/// A blocker triangle (world coordinates) whose part above a tile's plane lies at most
+/// `height` above it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FlatPiece {
+    tri: [DVec3; 3],
+    height: f64,
+}
+
+impl FlatPiece {
+    /// Whether the triangle may hide from `x` (a point of the tile, `n` the tile plane's unit
+    /// normal) a direction towards a point of one of the convex polygons `light`.
+    ///
+    /// What `x` sees of the triangle is its part above `x`'s tangent plane, which lies at most
+    /// `height` above it (`height` includes the offset a tile accepts between its plane and its
+    /// points, and the rounding), and at least the triangle's distance `r` from `x`: its
+    /// directions from `x` have a sine of elevation at most `height / r`. The directions of
+    /// elevation at least a given one form a convex cone about `n`, so a convex light polygon
+    /// whose vertices are all strictly above that elevation lies above it whole, and the
+    /// triangle hides none of it.
+    pub(crate) fn may_hide(&self, x: DVec3, n: DVec3, light: &[SmallVec<[DVec3; 8]>]) -> bool {
+        let r = triangle_distance(x, self.tri) * (1.0 - 1e-9);
+        if !(r > 0.0) {
+            return true;
+        }
+        let sine = self.height / r * (1.0 + 1e-9);
+        light.iter().flatten().any(|&e| {
+            let w = e - x;
+            !(n.dot(w) > sine * w.length() * (1.0 + 1e-9) + 1e-300)
+        })
+    }
+}
+
+/// The distance from `p` to the triangle `t` (closest point by regions, C. Ericson, *Real-Time
+/// Collision Detection*, 2005, section 5.1.5).
+fn triangle_distance(p: DVec3, t: [DVec3; 3]) -> f64 {
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (p - (a + ab * v)).length();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (p - (a + ac * w)).length();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (p - (b + (c - b) * w)).length();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (p - (a + ab * v + ac * w)).length()
 }
 
 impl GroupTree {
     /// Whether the point `x` must not use the shared tree: it sees a blocker of the tile edge-on
     /// (by the facing predicate, as the clipping backend), or lies within the band of one's
-    /// plane, or the tree holds an occluder flat on the tile plane.
+    /// plane, or a blocker left out of the tree as flat on the tile plane may hide some of the
+    /// light polygons `light` (world coordinates) from it; `n` is the tile plane's normal.
     pub(crate) fn excludes<'m>(
         &self,
         x: DVec3,
+        n: DVec3,
+        light: &[SmallVec<[DVec3; 8]>],
         mesh_of: &dyn Fn(Blocker) -> &'m TriangleMesh,
     ) -> bool {
-        self.flat
+        self.flat.iter().any(|f| f.may_hide(x, n, light))
             || self.near.iter().any(|b| {
                 (b.n.dot(x) - b.d).abs() <= self.band
                     || face_side(mesh_of(b.owner), b.tri as usize, x) == Side::On
@@ -426,7 +505,7 @@ pub(crate) fn build_group_tree<'m>(
     let mut occluders = core::mem::take(&mut bufs.occluders);
     occluders.clear();
     let mut near = Vec::new();
-    let mut flat = false;
+    let mut flat = Vec::new();
     let mut pairable = Vec::new();
     for &i in scratch.iter() {
         let bt = bvh.tri(i);
@@ -496,14 +575,39 @@ pub(crate) fn build_group_tree<'m>(
         // A piece whose every point lies within the band above the tile plane is, in exact
         // arithmetic, often nothing: a neighbour of the receiver's own face, or a face through
         // one of its vertices, left above the plane by the rounding of the plane's offset
-        // (taken from the tile's first point) and of the shared vertices. From a single point
-        // the cut leaves a sliver or nothing and the per-call tree drops it; the shared tree
-        // keeps it, and no decision of the tree on lines grazing such a piece is certified (from
-        // a point on an icosphere's face, 0.13 from its edges, slivers 4e-15 above the plane
-        // hid 1.5e-6 sr of the light: `tests/visibility_plucker.rs`). Every point of the tile
-        // takes a tree of its own.
-        if cut.iter().all(|&c| tile.n.dot(c - p0) <= band) {
-            flat = true;
+        // (taken from the tile's centre) and of the shared vertices. From a single point the
+        // cut leaves a sliver or nothing and the per-call tree drops it; a shared tree that
+        // keeps it makes decisions on lines grazing it that are not certified (from a point on
+        // an icosphere's face, 0.13 from its edges, slivers 4e-15 above the plane hid 1.5e-6
+        // sr of the light: `tests/visibility_plucker.rs`). A shared tree leaves it out, and
+        // only the points it may hide some of the light from take a tree of their own
+        // ([`FlatPiece::may_hide`]: from most points the light is far above such a piece).
+        if tile.cell.len() > 1 {
+            // The highest point of the blocker's part in `H_f` (a convex polygon, highest at a
+            // vertex), before the weld of the cut moves any.
+            let top = part
+                .iter()
+                .map(|&c| tile.n.dot(c - p0))
+                .fold(f64::NEG_INFINITY, f64::max);
+            if top <= band {
+                // The offset a tile accepts between its plane and its points (1e-14 of the
+                // magnitude plus the size, `PluckerContext`) and the rounding of the cut
+                // points and of `p0`, with room to spare.
+                let slack = 1e-12 * (magnitude + size);
+                flat.push(FlatPiece {
+                    tri: bt.v,
+                    height: top.max(0.0) + slack,
+                });
+                if near_somewhere {
+                    near.push(Near {
+                        owner: bt.owner,
+                        tri: bt.tri,
+                        n: tn,
+                        d: td,
+                    });
+                }
+                continue;
+            }
         }
         // Whole triangles (no cut touched them) far from the tile's planes may be merged
         // with a neighbour of their mesh ([`merge_pairs`]).
