@@ -93,6 +93,7 @@ mod line;
 mod query;
 mod tile;
 
+use alloc::collections::BTreeMap;
 use alloc::vec::Vec;
 use core::sync::atomic::{AtomicUsize, Ordering};
 
@@ -391,7 +392,11 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                             ti
                         }
                     };
-                    match self.query_cached(c, ti, g, &source, owners, &polys, frame, &mut out)? {
+                    let status =
+                        self.query_cached(c, ti, g, &source, owners, &polys, frame, &mut out);
+                    // The query may have grown, built, reset or dropped the tile's trees.
+                    c.refresh_bytes(ti);
+                    match status? {
                         Status::Split => tile_index = None,
                         status => break status,
                     }
@@ -885,9 +890,24 @@ struct Tile {
     geom: TileGeometry,
     slots: Vec<Slot>,
     last_used: u64,
+    /// [`Tile::bytes`] when last counted ([`PluckerContext::refresh_bytes`]).
+    counted: usize,
 }
 
+/// What identifies a tile besides its plane's offset: the light, the level, the cell and the
+/// receiver normal's bits ([`PluckerContext::tile_for`]).
+type TileKey = (usize, u8, (i64, i64), [u64; 3]);
+
 impl Tile {
+    fn key(&self) -> TileKey {
+        (
+            self.light,
+            self.level,
+            self.cell,
+            self.normal.to_array().map(f64::to_bits),
+        )
+    }
+
     fn bytes(&self) -> usize {
         self.slots
             .iter()
@@ -927,6 +947,10 @@ pub struct PluckerContext {
     max_tiles: usize,
     reuse: bool,
     tiles: Vec<Tile>,
+    /// The tiles by key (indices into `tiles`; several only for planes of different offsets).
+    index: BTreeMap<TileKey, SmallVec<[u32; 2]>>,
+    /// The sum of the tiles' counted bytes.
+    total_bytes: usize,
     clock: u64,
     current: Option<usize>,
     stats: PluckerStats,
@@ -955,6 +979,8 @@ impl PluckerContext {
             max_tiles: 64,
             reuse: true,
             tiles: Vec::new(),
+            index: BTreeMap::new(),
+            total_bytes: 0,
             clock: 0,
             current: None,
             stats: PluckerStats::default(),
@@ -994,12 +1020,22 @@ impl PluckerContext {
     /// The bytes held by all cached trees.
     #[must_use]
     pub fn cached_bytes(&self) -> usize {
-        self.tiles.iter().map(Tile::bytes).sum()
+        self.total_bytes
+    }
+
+    /// Counts the bytes of tile `i` again (after a query used it), keeping the running total.
+    fn refresh_bytes(&mut self, i: usize) {
+        let tile = &mut self.tiles[i];
+        let now = tile.bytes();
+        self.total_bytes = self.total_bytes - tile.counted + now;
+        tile.counted = now;
     }
 
     /// Drops every tree and resets the counters.
     pub fn clear(&mut self) {
         self.tiles.clear();
+        self.index.clear();
+        self.total_bytes = 0;
         self.current = None;
         self.stats = PluckerStats::default();
     }
@@ -1018,13 +1054,13 @@ impl PluckerContext {
             // Far below the near band of `tile.rs` (`NEAR_BAND`), whose error bound assumes
             // it; far above the rounding of points computed on one receiver plane.
             let tol = 1e-14 * (x.abs().max_element() + s);
-            if let Some(i) = self.tiles.iter().position(|tl| {
-                tl.light == light
-                    && tl.level == level
-                    && tl.cell == cell
-                    && tl.normal.to_array().map(f64::to_bits) == n.to_array().map(f64::to_bits)
-                    && (tl.offset - offset).abs() <= tol
-            }) {
+            let key = (light, level, cell, n.to_array().map(f64::to_bits));
+            let found = self.index.get(&key).and_then(|ids| {
+                ids.iter()
+                    .map(|&i| i as usize)
+                    .find(|&i| (self.tiles[i].offset - offset).abs() <= tol)
+            });
+            if let Some(i) = found {
                 self.tiles[i].last_used = self.clock;
                 if self.tiles[i].split {
                     level += 1;
@@ -1058,9 +1094,11 @@ impl PluckerContext {
                 },
                 slots: (0..groups).map(|_| Slot::Unbuilt).collect(),
                 last_used: self.clock,
+                counted: 0,
             });
-            self.stats.tiles_built += 1;
             let i = self.tiles.len() - 1;
+            self.index.entry(key).or_default().push(i as u32);
+            self.stats.tiles_built += 1;
             self.current = Some(i);
             return i;
         }
@@ -1077,6 +1115,16 @@ impl PluckerContext {
             .map(|(i, _)| i);
         match victim {
             Some(i) => {
+                self.unindex(i);
+                let last = self.tiles.len() - 1;
+                if i != last {
+                    self.unindex(last);
+                    self.index
+                        .entry(self.tiles[last].key())
+                        .or_default()
+                        .push(i as u32);
+                }
+                self.total_bytes -= self.tiles[i].counted;
                 self.tiles.swap_remove(i);
                 if self.current == Some(self.tiles.len()) {
                     self.current = Some(i);
@@ -1088,8 +1136,23 @@ impl PluckerContext {
         }
     }
 
+    /// Drops tile `i` from the index.
+    fn unindex(&mut self, i: usize) {
+        let key = self.tiles[i].key();
+        if let Some(ids) = self.index.get_mut(&key) {
+            ids.retain(|k| *k as usize != i);
+            if ids.is_empty() {
+                self.index.remove(&key);
+            }
+        }
+    }
+
     /// Keeps the cached trees within the budget after a query.
     fn after_query(&mut self) {
+        debug_assert_eq!(
+            self.total_bytes,
+            self.tiles.iter().map(Tile::bytes).sum::<usize>()
+        );
         let mut total = self.cached_bytes();
         while total > self.budget && self.tiles.len() > 1 {
             let keep = self.current;
