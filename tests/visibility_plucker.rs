@@ -940,11 +940,11 @@ fn points_on_a_rough_terrain_see_what_the_rays_see() {
 #[test]
 fn a_crowded_tile_splits_into_sub_cells_and_keeps_the_answer() {
     // A sieve of 2500 small disjoint triangles halfway between the ground and a 1 x 1 quad
-    // light (pitch 0.06): the shaft from a ground cell of side 1 holds more than 256 of them,
+    // light (pitch 0.075): the shaft from a ground cell of side 1 holds more than 160 of them,
     // so its tile splits once into cells of side 1/2, whose shafts hold fewer. The regions
     // agree with the clipping backend (1e-9 of the unoccluded value), and the trees used are
     // those of a context whose cells have side 1/2 from the start (same grid, same occluders).
-    let (pitch, size, n) = (0.06, 0.025, 50);
+    let (pitch, size, n) = (0.075, 0.025, 50);
     let mut verts = Vec::new();
     let mut tris = Vec::new();
     for i in 0..n {

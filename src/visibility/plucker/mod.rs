@@ -119,7 +119,7 @@ use super::Method;
 
 /// A tile whose tree takes more occluders than this (after shaft culling) is split into four
 /// sub-cells of half the side, once ([`MAX_SPLIT`]); see [`PluckerContext`].
-const SPLIT_OCCLUDERS: usize = 256;
+const SPLIT_OCCLUDERS: usize = 160;
 
 /// How many times a tile may be halved.
 const MAX_SPLIT: u8 = 1;
@@ -819,7 +819,7 @@ pub struct PluckerStats {
     pub tiles_built: u64,
     /// Trees created (a face plane of a light in a tile).
     pub trees_built: u64,
-    /// Tiles split into four because a tree of theirs took more than 256 occluders (their
+    /// Tiles split into four because a tree of theirs took more than 160 occluders (their
     /// points then use trees of the sub-cells; see [`PluckerContext`]).
     pub tiles_split: u64,
     /// Tiles dropped to stay within the budget or the tile count.
@@ -927,12 +927,14 @@ impl Tile {
 /// are bitwise equal (points of one flat receiver) and their offsets along it agree to `1e-14`
 /// of their coordinates' magnitude plus the cell size. Smaller cells cull more occluders per
 /// tree, larger ones let more queries reuse one tree. A tile whose tree would take more than
-/// 256 occluders is split once into the four cells of half the side (on the same grid), and its
+/// 160 occluders is split once into the four cells of half the side (on the same grid), and its
 /// points use their sub-cell's trees ([`PluckerStats::tiles_split`]): every occluder
 /// straddling a node's plane is inserted on both sides of it, and in a crowded shaft most do,
 /// so halving the tile pays for the queries the sub-cells no longer share (`benches/plucker.rs`,
 /// cells of half the side: terrain at 100K triangles, 577 occluders per tree, -25% per query;
-/// at 10K, 113 occluders, +8%; a quarter of the side at 100K, -19%). Points within `1e-5` of
+/// at 10K, 113 occluders, +8%; a quarter of the side at 100K, -19%; with pairs of mesh
+/// triangles merged, `tile.rs`, a threshold of 160 instead of 256 at 100K: -3.7%, and a second
+/// split of tiles still above it: +10%). Points within `1e-5` of
 /// that magnitude of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`). A
 /// context follows one backend at a time (it clears itself when used with another).
 ///
