@@ -940,11 +940,11 @@ fn points_on_a_rough_terrain_see_what_the_rays_see() {
 #[test]
 fn a_crowded_tile_splits_into_sub_cells_and_keeps_the_answer() {
     // A sieve of 2500 small disjoint triangles halfway between the ground and a 1 x 1 quad
-    // light (pitch 0.06): the shaft from a ground cell of side 1 holds more than 256 of them,
+    // light (pitch 0.075): the shaft from a ground cell of side 1 holds more than 160 of them,
     // so its tile splits once into cells of side 1/2, whose shafts hold fewer. The regions
     // agree with the clipping backend (1e-9 of the unoccluded value), and the trees used are
     // those of a context whose cells have side 1/2 from the start (same grid, same occluders).
-    let (pitch, size, n) = (0.06, 0.025, 50);
+    let (pitch, size, n) = (0.075, 0.025, 50);
     let mut verts = Vec::new();
     let mut tris = Vec::new();
     for i in 0..n {
@@ -1094,8 +1094,9 @@ fn a_point_near_an_icosphere_sees_through_a_shared_tree_what_the_clipping_backen
     // and the clipping backend agree; a context's shared tile tree gave up to 1.5e-6 sr too
     // little at 14 of 64 cell sizes from 1/32 to 2. The point is on a face (0.13 from its
     // edges) with the face's normal: the tree held 2 to 6 slivers of other faces, 4e-15 above
-    // the tile plane by rounding, that the per-call tree drops. Such tiles send every point
-    // to a tree of its own.
+    // the tile plane by rounding, that the per-call tree drops. A shared tree leaves such
+    // pieces out, and a point they may hide some of the light from (here the light crosses the
+    // point's horizon) takes a tree of its own (`tile.rs`, `FlatPiece`).
     let g = |i: f64, j: f64, k: f64| DVec3::new(i, j, k) / 8.0;
     let quad = TriangleMesh::quad(
         g(0.0, 76.0, -86.0),
@@ -1136,5 +1137,108 @@ fn a_point_near_an_icosphere_sees_through_a_shared_tree_what_the_clipping_backen
     assert!(
         wrong.is_empty(),
         "clip {reference} sr; wrong (cell, error): {wrong:?}"
+    );
+}
+
+/// A vertical blocker triangle in the plane `x = at` whose top vertex is `top` above the
+/// ground plane `z = 0` and whose base is `1e-5` below it: its part above the ground is a
+/// strip of height `top` (within the near band of a ground tile of side 0.1 for `top` below
+/// about `2e-6`).
+fn flat_plate(at: f64, top: f64) -> Body {
+    Body::Mesh(
+        TriangleMesh::new(
+            vec![
+                DVec3::new(at, -1.0, -1e-5),
+                DVec3::new(at, 1.0, -1e-5),
+                DVec3::new(at, 0.0, top),
+            ],
+            vec![[0, 1, 2]],
+        )
+        .unwrap(),
+    )
+}
+
+/// 16 points of the ground cell `[0, 0.1]^2` with `x` in `[x0, x0 + 0.03]`, normal `+z`.
+fn ground_points(rng: &mut Rng, x0: f64) -> Vec<ShadingFrame> {
+    (0..16)
+        .map(|_| {
+            let p = DVec3::new(x0 + 0.03 * rng.f64(), 0.02 + 0.06 * rng.f64(), 0.0);
+            ShadingFrame::new(p, DVec3::Z, DVec3::Z).unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn a_blocker_flat_on_the_tile_plane_hides_the_horizon_through_a_tree_of_its_own() {
+    // A blocker whose part above a tile's plane lies within the near band of it is left out
+    // of the tile's shared tree; a point it may hide some of the light from takes a tree of
+    // its own. Here it really hides some: a vertical plate 0.45 from the points, 5e-7 above
+    // the ground, under a light that crosses the points' horizon, hides a strip of the light
+    // about 1e-7 sr in solid angle along the horizon. Through the shared tree (without the
+    // plate) every point would see that strip.
+    let quad = TriangleMesh::quad(DVec3::new(2.0, 0.0, 0.05), DVec3::Z * 0.25, DVec3::Y * 0.5);
+    let scene = Scene::new(
+        vec![light(quad.unwrap(), DVec3::ONE)],
+        vec![flat_plate(0.5, 5e-7)],
+    )
+    .unwrap();
+    let clip = scene.visibility();
+    let pl = PluckerVisibility::from_clip(clip.clone());
+    let sa = |p: Vec<SphericalPolygon>| p.iter().map(SphericalPolygon::solid_angle).sum::<f64>();
+    let mut ctx = PluckerContext::new(0.1).unwrap();
+    let mut rng = Rng::new(41);
+    for f in ground_points(&mut rng, 0.02) {
+        let unoccluded = sa(clip.unoccluded_region(0, &f).unwrap());
+        let reference = sa(clip.visible_region(0, &f).unwrap());
+        // The plate's strip is there to be missed.
+        assert!(unoccluded - reference > 1e-8, "{unoccluded} {reference}");
+        let shared = sa(pl.visible_region_in(&mut ctx, 0, &f).unwrap());
+        assert!(
+            (shared - reference).abs() <= 1e-9 * unoccluded,
+            "{:?}: shared {shared}, clip {reference}",
+            f.origin()
+        );
+    }
+    assert_eq!(ctx.stats().edge_on_fallbacks, 16, "{:?}", ctx.stats());
+}
+
+#[test]
+fn a_blocker_flat_on_the_tile_plane_below_the_light_leaves_the_shared_tree_in_use() {
+    // The other side of the rule above: a plate crossing the tile, 5e-7 above the ground, and
+    // a light high above. From points at least 0.01 from the plate's plane it rises less than
+    // 1e-4 rad above their horizon, far below the light, so it hides nothing from them, and
+    // they use the tile's shared tree (a cube casts a shadow on some of them).
+    let quad = TriangleMesh::quad(DVec3::new(0.05, 0.05, 2.0), DVec3::Y * 0.3, DVec3::X * 0.3);
+    let scene = Scene::new(
+        vec![light(quad.unwrap(), DVec3::ONE)],
+        vec![
+            flat_plate(0.05, 5e-7),
+            cuboid(DVec3::new(0.3, 0.05, 1.0), DVec3::splat(0.15)).into(),
+        ],
+    )
+    .unwrap();
+    let clip = scene.visibility();
+    let pl = PluckerVisibility::from_clip(clip.clone());
+    let sa = |p: Vec<SphericalPolygon>| p.iter().map(SphericalPolygon::solid_angle).sum::<f64>();
+    let mut ctx = PluckerContext::new(0.1).unwrap();
+    let mut rng = Rng::new(43);
+    let mut shadowed = 0;
+    for f in ground_points(&mut rng, 0.06) {
+        let unoccluded = sa(clip.unoccluded_region(0, &f).unwrap());
+        let reference = sa(clip.visible_region(0, &f).unwrap());
+        shadowed += usize::from(reference < 0.999 * unoccluded);
+        let shared = sa(pl.visible_region_in(&mut ctx, 0, &f).unwrap());
+        assert!(
+            (shared - reference).abs() <= 1e-9 * unoccluded,
+            "{:?}: shared {shared}, clip {reference}",
+            f.origin()
+        );
+    }
+    assert!(shadowed > 0, "the cube shadows no point");
+    let stats = ctx.stats();
+    assert_eq!(
+        (stats.edge_on_fallbacks, stats.trees_built),
+        (0, 1),
+        "{stats:?}"
     );
 }

@@ -50,9 +50,11 @@ pub(crate) enum Crossing {
     Both,
 }
 
-/// A convex occluder polygon in the tree's coordinates (a blocker triangle clipped to the part
-/// that can lie between a shading point of the tile and the light), its vertices in the
-/// triangle's winding order.
+/// An occluder polygon in the tree's coordinates, its vertices in the blocker's winding order:
+/// a blocker triangle clipped to the part that can lie between a shading point of the tile and
+/// the light (convex), or two whole triangles of one mesh sharing an edge, merged into the
+/// quadrilateral of their outer edges where every point of the tile sees it convex (not
+/// necessarily planar; `tile.rs`, `merged_quad`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Occluder {
     verts: [DVec3; MAX_OCCLUDER_VERTICES],
@@ -84,6 +86,12 @@ impl Occluder {
     #[inline]
     pub(crate) fn on_tile(&self, i: u8) -> bool {
         self.on_tile & (1 << i) != 0
+    }
+
+    /// How the query lines cross it.
+    #[inline]
+    pub(crate) fn crossing(&self) -> Crossing {
+        self.crossing
     }
 
     /// The vertices.

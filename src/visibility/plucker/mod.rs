@@ -93,6 +93,7 @@ mod line;
 mod query;
 mod tile;
 
+use alloc::collections::BTreeMap;
 use alloc::vec::Vec;
 use core::sync::atomic::{AtomicUsize, Ordering};
 
@@ -118,7 +119,7 @@ use super::Method;
 
 /// A tile whose tree takes more occluders than this (after shaft culling) is split into four
 /// sub-cells of half the side, once ([`MAX_SPLIT`]); see [`PluckerContext`].
-const SPLIT_OCCLUDERS: usize = 256;
+const SPLIT_OCCLUDERS: usize = 160;
 
 /// How many times a tile may be halved.
 const MAX_SPLIT: u8 = 1;
@@ -215,11 +216,12 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
             );
         for (owner, body) in bodies {
             let m = body.mesh();
-            for t in 0..m.triangle_count() {
+            for (t, adj) in tile::mesh_adjacency(m).into_iter().enumerate() {
                 tris.push(BlockerTri {
                     v: m.triangle(t),
                     owner,
                     tri: t as u32,
+                    adj,
                 });
             }
         }
@@ -390,7 +392,11 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                             ti
                         }
                     };
-                    match self.query_cached(c, ti, g, &source, owners, &polys, frame, &mut out)? {
+                    let status =
+                        self.query_cached(c, ti, g, &source, owners, &polys, frame, &mut out);
+                    // The query may have grown, built, reset or dropped the tile's trees.
+                    c.refresh_bytes(ti);
+                    match status? {
                         Status::Split => tile_index = None,
                         status => break status,
                     }
@@ -484,7 +490,7 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
         let Slot::Built(built) = &mut tile.slots[g] else {
             return Ok(Status::Done);
         };
-        if built.excludes(x, &|b| self.mesh_of(b)) {
+        if built.excludes(x, n, polys, &|b| self.mesh_of(b)) {
             stats.edge_on_fallbacks += 1;
             return Ok(Status::Fallback);
         }
@@ -813,7 +819,7 @@ pub struct PluckerStats {
     pub tiles_built: u64,
     /// Trees created (a face plane of a light in a tile).
     pub trees_built: u64,
-    /// Tiles split into four because a tree of theirs took more than 256 occluders (their
+    /// Tiles split into four because a tree of theirs took more than 160 occluders (their
     /// points then use trees of the sub-cells; see [`PluckerContext`]).
     pub tiles_split: u64,
     /// Tiles dropped to stay within the budget or the tile count.
@@ -823,7 +829,9 @@ pub struct PluckerStats {
     /// Queries answered by the clipping backend: one query alone outgrew the budget.
     pub clip_fallbacks: u64,
     /// Queries from a point that sees a blocker of its tile edge-on or lies within `1e-5` of
-    /// the coordinates' magnitude of its plane, answered by a tree of their own.
+    /// the coordinates' magnitude of its plane, or that a blocker left out of the shared tree
+    /// (its part above the tile plane within that band of it) may hide some of the light
+    /// from, answered by a tree of their own.
     pub edge_on_fallbacks: u64,
     /// Visible fragments returned.
     pub fragments: u64,
@@ -882,9 +890,24 @@ struct Tile {
     geom: TileGeometry,
     slots: Vec<Slot>,
     last_used: u64,
+    /// [`Tile::bytes`] when last counted ([`PluckerContext::refresh_bytes`]).
+    counted: usize,
 }
 
+/// What identifies a tile besides its plane's offset: the light, the level, the cell and the
+/// receiver normal's bits ([`PluckerContext::tile_for`]).
+type TileKey = (usize, u8, (i64, i64), [u64; 3]);
+
 impl Tile {
+    fn key(&self) -> TileKey {
+        (
+            self.light,
+            self.level,
+            self.cell,
+            self.normal.to_array().map(f64::to_bits),
+        )
+    }
+
     fn bytes(&self) -> usize {
         self.slots
             .iter()
@@ -904,12 +927,14 @@ impl Tile {
 /// are bitwise equal (points of one flat receiver) and their offsets along it agree to `1e-14`
 /// of their coordinates' magnitude plus the cell size. Smaller cells cull more occluders per
 /// tree, larger ones let more queries reuse one tree. A tile whose tree would take more than
-/// 256 occluders is split once into the four cells of half the side (on the same grid), and its
+/// 160 occluders is split once into the four cells of half the side (on the same grid), and its
 /// points use their sub-cell's trees ([`PluckerStats::tiles_split`]): every occluder
 /// straddling a node's plane is inserted on both sides of it, and in a crowded shaft most do,
 /// so halving the tile pays for the queries the sub-cells no longer share (`benches/plucker.rs`,
 /// cells of half the side: terrain at 100K triangles, 577 occluders per tree, -25% per query;
-/// at 10K, 113 occluders, +8%; a quarter of the side at 100K, -19%). Points within `1e-5` of
+/// at 10K, 113 occluders, +8%; a quarter of the side at 100K, -19%; with pairs of mesh
+/// triangles merged, `tile.rs`, a threshold of 160 instead of 256 at 100K: -3.7%, and a second
+/// split of tiles still above it: +10%). Points within `1e-5` of
 /// that magnitude of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`). A
 /// context follows one backend at a time (it clears itself when used with another).
 ///
@@ -924,6 +949,10 @@ pub struct PluckerContext {
     max_tiles: usize,
     reuse: bool,
     tiles: Vec<Tile>,
+    /// The tiles by key (indices into `tiles`; several only for planes of different offsets).
+    index: BTreeMap<TileKey, SmallVec<[u32; 2]>>,
+    /// The sum of the tiles' counted bytes.
+    total_bytes: usize,
     clock: u64,
     current: Option<usize>,
     stats: PluckerStats,
@@ -952,6 +981,8 @@ impl PluckerContext {
             max_tiles: 64,
             reuse: true,
             tiles: Vec::new(),
+            index: BTreeMap::new(),
+            total_bytes: 0,
             clock: 0,
             current: None,
             stats: PluckerStats::default(),
@@ -991,12 +1022,22 @@ impl PluckerContext {
     /// The bytes held by all cached trees.
     #[must_use]
     pub fn cached_bytes(&self) -> usize {
-        self.tiles.iter().map(Tile::bytes).sum()
+        self.total_bytes
+    }
+
+    /// Counts the bytes of tile `i` again (after a query used it), keeping the running total.
+    fn refresh_bytes(&mut self, i: usize) {
+        let tile = &mut self.tiles[i];
+        let now = tile.bytes();
+        self.total_bytes = self.total_bytes - tile.counted + now;
+        tile.counted = now;
     }
 
     /// Drops every tree and resets the counters.
     pub fn clear(&mut self) {
         self.tiles.clear();
+        self.index.clear();
+        self.total_bytes = 0;
         self.current = None;
         self.stats = PluckerStats::default();
     }
@@ -1015,13 +1056,13 @@ impl PluckerContext {
             // Far below the near band of `tile.rs` (`NEAR_BAND`), whose error bound assumes
             // it; far above the rounding of points computed on one receiver plane.
             let tol = 1e-14 * (x.abs().max_element() + s);
-            if let Some(i) = self.tiles.iter().position(|tl| {
-                tl.light == light
-                    && tl.level == level
-                    && tl.cell == cell
-                    && tl.normal.to_array().map(f64::to_bits) == n.to_array().map(f64::to_bits)
-                    && (tl.offset - offset).abs() <= tol
-            }) {
+            let key = (light, level, cell, n.to_array().map(f64::to_bits));
+            let found = self.index.get(&key).and_then(|ids| {
+                ids.iter()
+                    .map(|&i| i as usize)
+                    .find(|&i| (self.tiles[i].offset - offset).abs() <= tol)
+            });
+            if let Some(i) = found {
                 self.tiles[i].last_used = self.clock;
                 if self.tiles[i].split {
                     level += 1;
@@ -1055,9 +1096,11 @@ impl PluckerContext {
                 },
                 slots: (0..groups).map(|_| Slot::Unbuilt).collect(),
                 last_used: self.clock,
+                counted: 0,
             });
-            self.stats.tiles_built += 1;
             let i = self.tiles.len() - 1;
+            self.index.entry(key).or_default().push(i as u32);
+            self.stats.tiles_built += 1;
             self.current = Some(i);
             return i;
         }
@@ -1074,6 +1117,16 @@ impl PluckerContext {
             .map(|(i, _)| i);
         match victim {
             Some(i) => {
+                self.unindex(i);
+                let last = self.tiles.len() - 1;
+                if i != last {
+                    self.unindex(last);
+                    self.index
+                        .entry(self.tiles[last].key())
+                        .or_default()
+                        .push(i as u32);
+                }
+                self.total_bytes -= self.tiles[i].counted;
                 self.tiles.swap_remove(i);
                 if self.current == Some(self.tiles.len()) {
                     self.current = Some(i);
@@ -1085,8 +1138,23 @@ impl PluckerContext {
         }
     }
 
+    /// Drops tile `i` from the index.
+    fn unindex(&mut self, i: usize) {
+        let key = self.tiles[i].key();
+        if let Some(ids) = self.index.get_mut(&key) {
+            ids.retain(|k| *k as usize != i);
+            if ids.is_empty() {
+                self.index.remove(&key);
+            }
+        }
+    }
+
     /// Keeps the cached trees within the budget after a query.
     fn after_query(&mut self) {
+        debug_assert_eq!(
+            self.total_bytes,
+            self.tiles.iter().map(Tile::bytes).sum::<usize>()
+        );
         let mut total = self.cached_bytes();
         while total > self.budget && self.tiles.len() > 1 {
             let keep = self.current;

@@ -508,15 +508,87 @@ pub(crate) fn fragment_polygon(
             smallvec::smallvec![n],
         )));
     }
+    let degenerate = |e: &GeomError| {
+        matches!(
+            e,
+            GeomError::ZeroArea { .. }
+                | GeomError::CoincidentVertices { .. }
+                | GeomError::TooFewVertices { .. }
+        )
+    };
     match SphericalPolygon::new(alloc::vec![dirs.to_vec()]) {
         Ok(p) => Ok(Some(p)),
-        Err(
-            GeomError::ZeroArea { .. }
-            | GeomError::CoincidentVertices { .. }
-            | GeomError::TooFewVertices { .. },
-        ) => Ok(None),
+        Err(e) if degenerate(&e) => Ok(None),
+        // The fragment is convex in exact arithmetic, so a ring that crosses itself does so by
+        // rounding: a corner a hair from its neighbour (two cut points of nearly the same
+        // node plane), whose short edge points anywhere. Its convex hull differs from it by
+        // that rounding.
+        Err(GeomError::SelfIntersecting { .. }) => match convex_hull_ring(&units) {
+            Some(hull) => match SphericalPolygon::new(alloc::vec![hull]) {
+                Ok(p) => Ok(Some(p)),
+                Err(e) if degenerate(&e) => Ok(None),
+                Err(e) => Err(e.give_up("a visible light fragment is degenerate within rounding")),
+            },
+            None => Err(GeomError::Undecidable(
+                "a visible light fragment is degenerate within rounding",
+            )),
+        },
         Err(e) => Err(e.give_up("a visible light fragment is degenerate within rounding")),
     }
+}
+
+/// The convex hull of the unit vectors `u` (in an open hemisphere about their mean), as a ring
+/// counter-clockwise seen from outside the sphere, without corners closer than
+/// [`MERGE_TOLERANCE`]; `None` when they are not within such a hemisphere or span no area.
+/// Monotone chain in the gnomonic plane about their mean direction, which maps great circles
+/// to lines, so convexity there is convexity on the sphere.
+fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
+    let m = u.iter().copied().sum::<DVec3>().try_normalize()?;
+    let (e1, e2) = m.any_orthonormal_pair();
+    let mut pts: Vec<(f64, f64, DVec3)> = Vec::with_capacity(u.len());
+    for &w in u {
+        let h = w.dot(m);
+        if !(h > 1e-3) {
+            return None;
+        }
+        pts.push((w.dot(e1) / h, w.dot(e2) / h, w));
+    }
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let cross = |o: &(f64, f64, DVec3), a: &(f64, f64, DVec3), b: &(f64, f64, DVec3)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64, DVec3)> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        for k in 0..pts.len() {
+            let p = if pass == 0 {
+                pts[k]
+            } else {
+                pts[pts.len() - 1 - k]
+            };
+            while hull.len() >= start + 2
+                && cross(&hull[hull.len() - 2], &hull[hull.len() - 1], &p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    // Counter-clockwise in (e1, e2), with e1 x e2 = m: counter-clockwise about m.
+    let mut ring: Vec<DVec3> = Vec::with_capacity(hull.len());
+    for (_, _, w) in hull {
+        if ring
+            .last()
+            .is_none_or(|&q: &DVec3| (q - w).length() > MERGE_TOLERANCE)
+        {
+            ring.push(w);
+        }
+    }
+    while ring.len() > 1 && (ring[0] - ring[ring.len() - 1]).length() <= MERGE_TOLERANCE {
+        ring.pop();
+    }
+    (ring.len() >= 3).then_some(ring)
 }
 
 /// Whether the ring of unit vectors `u` passes every check of [`SphericalPolygon::new`] with a
@@ -743,6 +815,46 @@ mod tests {
         assert!(
             taken > 2_000 && checked > 2_000,
             "{taken} taken, {checked} checked"
+        );
+    }
+
+    #[test]
+    fn a_fragment_crossing_itself_by_rounding_becomes_its_hull() {
+        // From the render demo (quad, cylinder and cone lights, a context of 256 tiles): a
+        // visible fragment, a thin quadrilateral two of whose corners are 9e-13 apart, whose
+        // directions make a ring that crosses itself at that short edge. It covers the
+        // triangle of its three distinct corners, within rounding.
+        let frag = [
+            DVec3::new(-2.9641372256203073, -1.5666377766619046, 2.9348195555923215),
+            DVec3::new(-2.962507948578911, -1.5677777748182766, 2.935254965836143),
+            DVec3::new(-3.238311400344067, -1.4446230104131506, 2.861548870967869),
+            DVec3::new(-3.2383114003448834, -1.4446230104127846, 2.861548870967651),
+        ];
+        let frame = ShadingFrame::new(
+            DVec3::new(1.2202362078367375, 1.6141299014320465, 0.0),
+            DVec3::Z,
+            DVec3::new(
+                -0.11639960546415623,
+                -0.7860180491376988,
+                0.6071464059661019,
+            ),
+        )
+        .unwrap();
+        let poly = fragment_polygon(&frag, DVec3::ZERO, &frame)
+            .expect("a fragment degenerate by rounding has a polygon")
+            .expect("the fragment covers some area");
+        let tri: Vec<DVec3> = [frag[2], frag[1], frag[0]]
+            .iter()
+            .map(|&e| frame.dir_to_local(e))
+            .collect();
+        let expected = SphericalPolygon::new(alloc::vec![tri])
+            .unwrap()
+            .solid_angle();
+        let got = poly.solid_angle();
+        // Within the rounding of the solid angle of a sliver of this aspect (1e-2).
+        assert!(
+            (got - expected).abs() <= 1e-10 * expected,
+            "{got} {expected}"
         );
     }
 

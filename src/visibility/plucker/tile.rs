@@ -18,11 +18,21 @@
 //! - the shaft: the convex hull of the tile and the light polygon holds every such segment, so a
 //!   triangle outside one of its supporting planes can hide nothing (seed 002 Alg. 2 line 7).
 //!
+//! Two whole triangles of one mesh sharing an edge (no cut touched them, far from the tile's
+//! planes) become one quadrilateral occluder when every point of the tile sees them from the
+//! same side and their union convex ([`merge_pairs`], with the proof at `merged_quad`): the
+//! shared edge bounds no blocked set, so the tree needs only the four outer edges. Seed 002's
+//! occluders are triangles; this is an extension.
+//!
 //! A blocker triangle whose plane passes through the point within the facing tolerance is seen
 //! edge-on and hides nothing (as in the clipping backend). Triangles edge-on from every point of
 //! the tile are dropped; those edge-on from some points, or whose plane passes within
 //! [`NEAR_BAND`] of the tile, are listed as `near`, and a query from a point that sees one of
-//! them edge-on, or lies that close to its plane, does not use the shared tree.
+//! them edge-on, or lies that close to its plane, does not use the shared tree. A triangle
+//! whose part above the tile plane lies within that band of it is left out of the shared tree
+//! (rounding leaves such slivers of a receiver's neighbours, on which the tree's decisions are
+//! not certified), and a point it may hide some of the light from (by a bound on its elevation
+//! seen from the point, [`FlatPiece::may_hide`]) does not use the shared tree either.
 
 use alloc::vec::Vec;
 
@@ -42,6 +52,26 @@ pub(crate) struct BlockerTri {
     pub(crate) v: [DVec3; 3],
     pub(crate) owner: Blocker,
     pub(crate) tri: u32,
+    /// The triangle of the same mesh across edge `v[i] -> v[i + 1]` (running it the other
+    /// way), or [`MeshEdge::BORDER`](crate::solid::MeshEdge::BORDER): the candidates of
+    /// [`merge_pairs`].
+    pub(crate) adj: [u32; 3],
+}
+
+/// Per triangle of `mesh`, the triangle across each of its edges ([`BlockerTri::adj`]).
+pub(crate) fn mesh_adjacency(mesh: &TriangleMesh) -> Vec<[u32; 3]> {
+    let tris = mesh.triangles();
+    let mut adj = alloc::vec![[crate::solid::MeshEdge::BORDER; 3]; tris.len()];
+    for e in mesh.edges() {
+        let Some(f1) = e.twin() else { continue };
+        for (f, other, (a, b)) in [(e.f0, f1, (e.a, e.b)), (f1, e.f0, (e.b, e.a))] {
+            let t = tris[f as usize];
+            if let Some(i) = (0..3).find(|&i| t[i] == a && t[(i + 1) % 3] == b) {
+                adj[f as usize][i] = other;
+            }
+        }
+    }
+    adj
 }
 
 /// A plane bounding a shaft: points with `n . p > d` are outside.
@@ -313,21 +343,96 @@ pub(crate) struct GroupTree {
     pub(crate) tree: Tree,
     near: Vec<Near>,
     band: f64,
-    /// An occluder lies within the band of the tile plane (see [`build_group_tree`]): no point
-    /// uses the shared tree.
-    flat: bool,
+    /// Blocker triangles whose part above the tile plane lies within the band of it, left out
+    /// of the tree (see [`build_group_tree`]); a point that such a triangle may hide some of
+    /// the light from does not use the shared tree ([`FlatPiece::may_hide`]).
+    flat: Vec<FlatPiece>,
+}
+
+/// A blocker triangle (world coordinates) whose part above a tile's plane lies at most
+/// `height` above it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FlatPiece {
+    tri: [DVec3; 3],
+    height: f64,
+}
+
+impl FlatPiece {
+    /// Whether the triangle may hide from `x` (a point of the tile, `n` the tile plane's unit
+    /// normal) a direction towards a point of one of the convex polygons `light`.
+    ///
+    /// What `x` sees of the triangle is its part above `x`'s tangent plane, which lies at most
+    /// `height` above it (`height` includes the offset a tile accepts between its plane and its
+    /// points, and the rounding), and at least the triangle's distance `r` from `x`: its
+    /// directions from `x` have a sine of elevation at most `height / r`. The directions of
+    /// elevation at least a given one form a convex cone about `n`, so a convex light polygon
+    /// whose vertices are all strictly above that elevation lies above it whole, and the
+    /// triangle hides none of it.
+    pub(crate) fn may_hide(&self, x: DVec3, n: DVec3, light: &[SmallVec<[DVec3; 8]>]) -> bool {
+        let r = triangle_distance(x, self.tri) * (1.0 - 1e-9);
+        if !(r > 0.0) {
+            return true;
+        }
+        let sine = self.height / r * (1.0 + 1e-9);
+        light.iter().flatten().any(|&e| {
+            let w = e - x;
+            !(n.dot(w) > sine * w.length() * (1.0 + 1e-9) + 1e-300)
+        })
+    }
+}
+
+/// The distance from `p` to the triangle `t` (closest point by regions, C. Ericson, *Real-Time
+/// Collision Detection*, 2005, section 5.1.5).
+fn triangle_distance(p: DVec3, t: [DVec3; 3]) -> f64 {
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (p - (a + ab * v)).length();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (p - (a + ac * w)).length();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (p - (b + (c - b) * w)).length();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (p - (a + ab * v + ac * w)).length()
 }
 
 impl GroupTree {
     /// Whether the point `x` must not use the shared tree: it sees a blocker of the tile edge-on
     /// (by the facing predicate, as the clipping backend), or lies within the band of one's
-    /// plane, or the tree holds an occluder flat on the tile plane.
+    /// plane, or a blocker left out of the tree as flat on the tile plane may hide some of the
+    /// light polygons `light` (world coordinates) from it; `n` is the tile plane's normal.
     pub(crate) fn excludes<'m>(
         &self,
         x: DVec3,
+        n: DVec3,
+        light: &[SmallVec<[DVec3; 8]>],
         mesh_of: &dyn Fn(Blocker) -> &'m TriangleMesh,
     ) -> bool {
-        self.flat
+        self.flat.iter().any(|f| f.may_hide(x, n, light))
             || self.near.iter().any(|b| {
                 (b.n.dot(x) - b.d).abs() <= self.band
                     || face_side(mesh_of(b.owner), b.tri as usize, x) == Side::On
@@ -400,7 +505,8 @@ pub(crate) fn build_group_tree<'m>(
     let mut occluders = core::mem::take(&mut bufs.occluders);
     occluders.clear();
     let mut near = Vec::new();
-    let mut flat = false;
+    let mut flat = Vec::new();
+    let mut pairable = Vec::new();
     for &i in scratch.iter() {
         let bt = bvh.tri(i);
         if !owners.keeps(bt.owner) {
@@ -469,14 +575,53 @@ pub(crate) fn build_group_tree<'m>(
         // A piece whose every point lies within the band above the tile plane is, in exact
         // arithmetic, often nothing: a neighbour of the receiver's own face, or a face through
         // one of its vertices, left above the plane by the rounding of the plane's offset
-        // (taken from the tile's first point) and of the shared vertices. From a single point
-        // the cut leaves a sliver or nothing and the per-call tree drops it; the shared tree
-        // keeps it, and no decision of the tree on lines grazing such a piece is certified (from
-        // a point on an icosphere's face, 0.13 from its edges, slivers 4e-15 above the plane
-        // hid 1.5e-6 sr of the light: `tests/visibility_plucker.rs`). Every point of the tile
-        // takes a tree of its own.
-        if cut.iter().all(|&c| tile.n.dot(c - p0) <= band) {
-            flat = true;
+        // (taken from the tile's centre) and of the shared vertices. From a single point the
+        // cut leaves a sliver or nothing and the per-call tree drops it; a shared tree that
+        // keeps it makes decisions on lines grazing it that are not certified (from a point on
+        // an icosphere's face, 0.13 from its edges, slivers 4e-15 above the plane hid 1.5e-6
+        // sr of the light: `tests/visibility_plucker.rs`). A shared tree leaves it out, and
+        // only the points it may hide some of the light from take a tree of their own
+        // ([`FlatPiece::may_hide`]: from most points the light is far above such a piece).
+        if tile.cell.len() > 1 {
+            // The highest point of the blocker's part in `H_f` (a convex polygon, highest at a
+            // vertex), before the weld of the cut moves any.
+            let top = part
+                .iter()
+                .map(|&c| tile.n.dot(c - p0))
+                .fold(f64::NEG_INFINITY, f64::max);
+            if top <= band {
+                // The offset a tile accepts between its plane and its points (1e-14 of the
+                // magnitude plus the size, `PluckerContext`) and the rounding of the cut
+                // points and of `p0`, with room to spare.
+                let slack = 1e-12 * (magnitude + size);
+                flat.push(FlatPiece {
+                    tri: bt.v,
+                    height: top.max(0.0) + slack,
+                });
+                if near_somewhere {
+                    near.push(Near {
+                        owner: bt.owner,
+                        tri: bt.tri,
+                        n: tn,
+                        d: td,
+                    });
+                }
+                continue;
+            }
+        }
+        // Whole triangles (no cut touched them) far from the tile's planes may be merged
+        // with a neighbour of their mesh ([`merge_pairs`]).
+        if !near_somewhere
+            && on_tile == 0
+            && crossing != Crossing::Both
+            && cut.len() == 3
+            && cut[..] == local[..]
+        {
+            pairable.push(Pairable {
+                key: (bt.owner, bt.tri),
+                adj: bt.adj,
+                occ: occluders.len() as u32,
+            });
         }
         occluders.push(Occluder::new(&cut, crossing, on_tile));
         if near_somewhere {
@@ -488,6 +633,7 @@ pub(crate) fn build_group_tree<'m>(
             });
         }
     }
+    merge_pairs(&mut occluders, &mut pairable, &cell_local);
     bufs.occluders = occluders;
     Some(GroupTree {
         tree: Tree::with_buffers(&cell_local, &light, bufs, seed),
@@ -517,4 +663,210 @@ fn tile_plane_edges(part: &[DVec3], cut: &[DVec3], p0: DVec3, n: DVec3) -> u8 {
         }
     }
     mask
+}
+
+/// A whole blocker triangle kept as occluder `occ`, which [`merge_pairs`] may merge with a
+/// neighbour across an edge (`adj`, triangles of the same mesh).
+#[derive(Debug, Clone, Copy)]
+struct Pairable {
+    key: (Blocker, u32),
+    adj: [u32; 3],
+    occ: u32,
+}
+
+/// Relative margin of the determinants that certify a merged pair ([`merged_quad`]): far
+/// above their rounding (a few `1e-16` of the product of the lengths), and above what the
+/// points a tile accepts off its corners' hull (the cell widened by `1e-9` of its side, and
+/// `1e-14` of the coordinates off the plane) can change, since merged triangles lie outside
+/// the near band ([`NEAR_BAND`]) of every corner.
+const QUAD_MARGIN: f64 = 1e-6;
+
+/// Merges pairs of occluders that are whole triangles of one mesh sharing an edge into one
+/// quadrilateral occluder, where [`merged_quad`] certifies that it blocks exactly the lines
+/// the two triangles block (greedily, each triangle in one pair at most). The tree's cost
+/// grows with its occluders and their edges: a pair is one occluder of four edges instead of
+/// two of three, and the shared edge, which bounds no blocked set, is no node of the tree.
+fn merge_pairs(occluders: &mut Vec<Occluder>, pairable: &mut [Pairable], cell: &[DVec3]) {
+    if pairable.len() < 2 {
+        return;
+    }
+    pairable.sort_unstable_by_key(|p| p.key);
+    // Per occluder: in a pair already; dropped (the second of a pair).
+    let mut taken = alloc::vec![false; occluders.len()];
+    let mut gone = alloc::vec![false; occluders.len()];
+    let mut merged = false;
+    for me in pairable.iter() {
+        if taken[me.occ as usize] {
+            continue;
+        }
+        for t in me.adj {
+            let Ok(j) = pairable.binary_search_by_key(&(me.key.0, t), |p| p.key) else {
+                continue;
+            };
+            let other = pairable[j];
+            if taken[other.occ as usize] || other.occ == me.occ {
+                continue;
+            }
+            let (a, b) = (&occluders[me.occ as usize], &occluders[other.occ as usize]);
+            if a.crossing() != b.crossing() {
+                continue;
+            }
+            let Some(q) = merged_quad(a.vertices(), b.vertices(), cell) else {
+                continue;
+            };
+            occluders[me.occ as usize] = Occluder::new(&q, a.crossing(), 0);
+            taken[me.occ as usize] = true;
+            taken[other.occ as usize] = true;
+            gone[other.occ as usize] = true;
+            merged = true;
+            break;
+        }
+    }
+    if merged {
+        let mut k = 0;
+        occluders.retain(|_| {
+            k += 1;
+            !gone[k - 1]
+        });
+    }
+}
+
+/// The quadrilateral `a, b, c, d` of two triangles `t1`, `t2` (occluder vertices, each in its
+/// mesh winding, with the same [`Crossing`]) sharing the edge `c -> a` of `t1` (`a -> c` of
+/// `t2`), when it blocks, for every line from the tile (the convex hull of `cell`), exactly
+/// what the two open triangles block, up to the lines through the open diagonal `a c` (a set
+/// of measure zero, hidden by the quadrilateral and not by the triangles).
+///
+/// Proof. Fix a point `x` of the tile and write `o(p, q, r) = det[p - x, q - x, r - x]`. The
+/// side of a line from `x` with direction `e` relative to the line of an edge `p -> q` is the
+/// sign of `det[p - x, q - x, e]`, so the lines of one sign `s` for the three edges of a
+/// triangle are those through its projection from `x` (the central projection, or its
+/// antipode, by the side of its plane `x` lies on, which fixes `s` with the crossing). The
+/// four determinants `o(a, b, c)`, `o(a, c, d)` (the two triangles' orientations seen from
+/// `x`), `o(d, a, b)` and `o(b, c, d)` (the turns at `a` and `c`) all of one strict sign mean
+/// that the projections of the two triangles lie on opposite sides of the diagonal's plane
+/// and turn the same way at every corner: their union is a convex spherical quadrilateral,
+/// which is the intersection of the four half-spaces of its edges `a b`, `b c`, `c d`, `d a`.
+/// The two triangles' crossings are equal and `x` lies on the same side of both planes
+/// (their orientations from `x` agree), so the same sign `s` of those four edges selects the
+/// quadrilateral: the merged occluder's invisible class (its chain over four edges, `bsp.rs`)
+/// is the union of the two triangles' classes, plus the diagonal. Each determinant is affine
+/// in `x`, so a strict sign at the corners of the cell holds on the whole tile; it is required
+/// with a margin of [`QUAD_MARGIN`] times the product of the lengths, for points a tile accepts
+/// a hair off its corners' hull and for the rounding.
+///
+/// The rest of the tree uses an occluder's vertices only as bounds (Theorem 1 insertion, the
+/// separating planes of the query's relevance test): the lines through the tile (or the light)
+/// and the quadrilateral lie among those through the tile and the convex hull of its four
+/// vertices, whose sides with any line are bounded by the vertex-to-vertex lines (the side is
+/// affine in each end), and seen from `x` the quadrilateral is convex, so a plane through `x`
+/// and one of its edges has the other two vertices on its inner side.
+fn merged_quad(t1: &[DVec3], t2: &[DVec3], cell: &[DVec3]) -> Option<[DVec3; 4]> {
+    let (t1, t2): (&[DVec3; 3], &[DVec3; 3]) = (t1.try_into().ok()?, t2.try_into().ok()?);
+    // The edge p_i -> p_{i+1} of t1 that t2 runs the other way, q_j -> q_{j+1}.
+    let (i, j) = (0..3)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .find(|&(i, j)| t1[i] == t2[(j + 1) % 3] && t1[(i + 1) % 3] == t2[j])?;
+    let (c, a, b) = (t1[i], t1[(i + 1) % 3], t1[(i + 2) % 3]);
+    let d = t2[(j + 2) % 3];
+    let mut sign = 0.0;
+    for &x in cell {
+        let (ra, rb, rc, rd) = (a - x, b - x, c - x, d - x);
+        let (la, lb, lc, ld) = (ra.length(), rb.length(), rc.length(), rd.length());
+        for (det, size) in [
+            (ra.dot(rb.cross(rc)), la * lb * lc),
+            (ra.dot(rc.cross(rd)), la * lc * ld),
+            (rd.dot(ra.cross(rb)), ld * la * lb),
+            (rb.dot(rc.cross(rd)), lb * lc * ld),
+        ] {
+            if !(det.abs() > QUAD_MARGIN * size) {
+                return None;
+            }
+            if sign == 0.0 {
+                sign = det.signum();
+            } else if det.signum() != sign {
+                return None;
+            }
+        }
+    }
+    (sign != 0.0).then_some([a, b, c, d])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_merged_pair_blocks_the_lines_its_two_triangles_block() {
+        // `merged_quad`'s claim, checked on the lines themselves: for lines from points of the
+        // tile, "all four edges of the quadrilateral have side s" equals "all three edges of
+        // one triangle have side s", for either sign s, away from the diagonal. Pairs: a
+        // triangle and a fourth vertex anywhere (non-convex, folded and back-facing pairs are
+        // common, so the certificate must refuse them), tiles of four corners or one point.
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut rnd = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let side = |x: DVec3, dir: DVec3, p: DVec3, q: DVec3| (p - x).cross(q - x).dot(dir);
+        let (mut merged, mut refused, mut lines) = (0, 0, 0);
+        for case in 0..4000 {
+            let mut v = || DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() * 0.5 + 1.0) * 2.0;
+            let (a, b, c, d) = (v(), v(), v(), v());
+            let (t1, t2) = ([c, a, b], [a, c, d]);
+            let centre = DVec3::new(rnd() - 0.5, rnd() - 0.5, 0.0);
+            let h = if case % 2 == 0 { 0.0 } else { 0.3 * rnd() };
+            let cell: SmallVec<[DVec3; 4]> = if h == 0.0 {
+                core::iter::once(centre).collect()
+            } else {
+                [(-h, -h), (h, -h), (h, h), (-h, h)]
+                    .iter()
+                    .map(|&(u, w)| centre + DVec3::new(u, w, 0.0))
+                    .collect()
+            };
+            let Some(q) = merged_quad(&t1, &t2, &cell) else {
+                refused += 1;
+                continue;
+            };
+            merged += 1;
+            assert_eq!(q, [a, b, c, d], "case {case}");
+            for _ in 0..200 {
+                let (u, w) = (rnd(), rnd());
+                let x = match cell.len() {
+                    1 => cell[0],
+                    _ => {
+                        let s = cell[0].lerp(cell[1], u);
+                        let t = cell[3].lerp(cell[2], u);
+                        s.lerp(t, w)
+                    }
+                };
+                // Directions towards a random point of the quadrilateral's box, so that many
+                // lines hit it.
+                let target = a.min(b).min(c).min(d).lerp(a.max(b).max(c).max(d), rnd())
+                    + DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5) * 0.2;
+                let dir = target - x;
+                let diag = side(x, dir, c, a);
+                if diag.abs() <= 1e-9 * dir.length() * 10.0 {
+                    continue;
+                }
+                lines += 1;
+                for s in [1.0, -1.0] {
+                    let all = |pts: &[DVec3]| {
+                        (0..pts.len())
+                            .all(|i| side(x, dir, pts[i], pts[(i + 1) % pts.len()]) * s > 0.0)
+                    };
+                    let pair = all(&t1) || all(&t2);
+                    assert_eq!(all(&q), pair, "case {case}: x {x}, dir {dir}, s {s}");
+                }
+            }
+        }
+        // The test has power only if both answers are common.
+        assert!(
+            merged > 300 && refused > 300,
+            "{merged} merged, {refused} refused"
+        );
+        assert!(lines > 50_000, "{lines}");
+    }
 }
