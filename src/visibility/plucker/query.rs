@@ -539,9 +539,16 @@ pub(crate) fn fragment_polygon(
 
 /// The convex hull of the unit vectors `u` (in an open hemisphere about their mean), as a ring
 /// counter-clockwise seen from outside the sphere, without corners closer than
-/// [`MERGE_TOLERANCE`]; `None` when they are not within such a hemisphere or span no area.
-/// Monotone chain in the gnomonic plane about their mean direction, which maps great circles
-/// to lines, so convexity there is convexity on the sphere.
+/// [`MERGE_TOLERANCE`]; `None` when they are not within such a hemisphere, span no area, or the
+/// ring `u` is not its hull up to rounding ([`HULL_AREA_TOLERANCE`]). Monotone chain in the
+/// gnomonic plane about their mean direction, which maps great circles to lines, so convexity
+/// there is convexity on the sphere.
+///
+/// The hull stands for the ring only where the two cover the same area to rounding: a ring
+/// that is convex but for a crossing at a corner a hair from its neighbour has the hull's
+/// signed area (in the gnomonic plane) within that crossing's tiny triangle, while a ring
+/// wrong by more than rounding (a dent, corners out of order) falls short of the hull by a
+/// visible part of it, and the caller then gives up rather than answer with the hull.
 fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
     let m = u.iter().copied().sum::<DVec3>().try_normalize()?;
     let (e1, e2) = m.any_orthonormal_pair();
@@ -553,6 +560,7 @@ fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
         }
         pts.push((w.dot(e1) / h, w.dot(e2) / h, w));
     }
+    let ring_area = twice_signed_area(&pts);
     pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let cross = |o: &(f64, f64, DVec3), a: &(f64, f64, DVec3), b: &(f64, f64, DVec3)| {
         (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
@@ -575,6 +583,10 @@ fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
         }
         hull.pop();
     }
+    let hull_area = twice_signed_area(&hull);
+    if !((hull_area - ring_area).abs() <= HULL_AREA_TOLERANCE * hull_area) {
+        return None;
+    }
     // Counter-clockwise in (e1, e2), with e1 x e2 = m: counter-clockwise about m.
     let mut ring: Vec<DVec3> = Vec::with_capacity(hull.len());
     for (_, _, w) in hull {
@@ -589,6 +601,22 @@ fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
         ring.pop();
     }
     (ring.len() >= 3).then_some(ring)
+}
+
+/// How far (relative) a fragment's ring may fall short of its convex hull's area for the hull
+/// to stand for it ([`convex_hull_ring`]): the backends' agreement bound, far above the
+/// rounding of a fragment's corners and far below any part of a light a point may see.
+const HULL_AREA_TOLERANCE: f64 = 1e-9;
+
+/// Twice the signed area of the polygon of the points `(x, y, _)` in their order (shoelace).
+fn twice_signed_area(p: &[(f64, f64, DVec3)]) -> f64 {
+    let n = p.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (p[i], p[(i + 1) % n]);
+            a.0 * b.1 - a.1 * b.0
+        })
+        .sum()
 }
 
 /// Whether the ring of unit vectors `u` passes every check of [`SphericalPolygon::new`] with a
@@ -856,6 +884,35 @@ mod tests {
             (got - expected).abs() <= 1e-10 * expected,
             "{got} {expected}"
         );
+    }
+
+    #[test]
+    fn a_ring_wrong_by_more_than_rounding_is_not_its_hull() {
+        // Rings of directions about +z, counter-clockwise seen from outside (as
+        // `fragment_polygon` makes them). Their hull is a convex quadrilateral, but they cover
+        // it only in part, so the hull must not stand for them.
+        let ring = |c: &[(f64, f64)]| -> Vec<DVec3> {
+            c.iter()
+                .map(|&(x, y)| DVec3::new(x, y, 1.0).normalize())
+                .collect()
+        };
+        let square = [(-0.3, -0.2), (0.3, -0.2), (0.3, 0.2), (-0.3, 0.2)];
+        assert!(
+            convex_hull_ring(&ring(&square)).is_some(),
+            "a convex ring is its hull"
+        );
+        // A bowtie of unequal lobes: the corners out of order.
+        let bowtie = [(-0.3, -0.2), (0.3, 0.2), (0.3, -0.2), (-0.1, 0.2)];
+        assert!(convex_hull_ring(&ring(&bowtie)).is_none(), "a bowtie");
+        // A dent: one more corner pushed in by a sixth of the side.
+        let dent = [
+            (-0.3, -0.2),
+            (0.3, -0.2),
+            (0.3, 0.2),
+            (0.0, 0.14),
+            (-0.3, 0.2),
+        ];
+        assert!(convex_hull_ring(&ring(&dent)).is_none(), "a dent");
     }
 
     #[test]
