@@ -2306,9 +2306,14 @@ mod tests {
         frame: &ShadingFrame,
     ) -> (bool, bool) {
         let (mut a, mut b) = (Pieces::new(), Pieces::new());
+        // A reused scratch holds the previous blocker's vertices and planes, fewer or more
+        // (here NaN, 0 to 39 of them): the walk must size them and overwrite every one.
+        let x = frame.origin();
+        let stale = (x.x.to_bits() % 40) as usize;
+        a.kv.extend(core::iter::repeat_n(DVec3::NAN, stale));
+        a.planes.extend(core::iter::repeat_n(DVec3::NAN, stale));
         let fast = convex_blocker(p, faces, frame, &mut a);
         let general = convex_planes(p, frame, &mut b);
-        let x = frame.origin();
         assert_eq!(fast, general, "{x}");
         if fast {
             let bits = |v: &[DVec3]| -> Vec<u64> {
