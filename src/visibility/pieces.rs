@@ -1010,7 +1010,11 @@ fn edge_crossings(
         ..Crossing::default()
     };
     match (j_in != usize::MAX, j_out != usize::MAX) {
-        (true, true) => out.extend([crossing(t_in, j_in, true), crossing(t_out, j_out, false)]),
+        (true, true) => {
+            // Two pushes: `extend` is a call of its own.
+            out.push(crossing(t_in, j_in, true));
+            out.push(crossing(t_out, j_out, false));
+        }
         (true, false) => out.push(crossing(t_in, j_in, true)),
         (false, true) => out.push(crossing(t_out, j_out, false)),
         (false, false) => {}
@@ -1942,26 +1946,37 @@ fn convex_blocker(
         out.certified += u64::from(certified);
     }
     let Pieces { kv, planes, .. } = out;
-    kv.clear();
-    for &i in order {
-        kv.push(frame.to_local(verts[i as usize]) * inv);
+    // Sized once and written through slices: a push per vertex and per plane checks the
+    // capacity and the inline storage each time. Sized from the previous blocker's length:
+    // shortened in place, or lengthened by the difference (a few pushes, cheaper than
+    // `resize`'s call); every element is overwritten below.
+    while kv.len() < count {
+        kv.push(DVec3::ZERO);
+    }
+    kv.truncate(count);
+    while planes.len() < count {
+        planes.push(DVec3::ZERO);
+    }
+    planes.truncate(count);
+    let (kv, planes): (&mut [DVec3], &mut [DVec3]) = (kv, planes);
+    for (d, &i) in kv.iter_mut().zip(order) {
+        *d = frame.to_local(verts[i as usize]) * inv;
     }
     // Planes, turns and spacing, edge by edge: `convex_planes`' loop, with the spacing test of
     // `small_silhouette_dirs` (on the same pairs of directions, the same decisions). The turn
     // at the end of each edge is taken from the edge's plane first ([`turns_left_by_plane`]),
     // `convex_planes`' test deciding where that does not accept.
     let kv: &[DVec3] = kv;
-    planes.clear();
     if certified {
         // The same planes, bit for bit, without the tests.
         let plane = |cur: DVec3, next: DVec3| {
             let n = (cur + next).cross(next - cur);
             n / norm1(n)
         };
-        for w in kv.windows(2) {
-            planes.push(plane(w[0], w[1]));
+        for (p, w) in planes.iter_mut().zip(kv.windows(2)) {
+            *p = plane(w[0], w[1]);
         }
-        planes.push(plane(kv[count - 1], kv[0]));
+        planes[count - 1] = plane(kv[count - 1], kv[0]);
         return true;
     }
     let (mut cur, mut next) = (kv[0], kv[1]);
@@ -1985,7 +2000,7 @@ fn convex_blocker(
         {
             return false;
         }
-        planes.push(n / n1);
+        planes[k] = n / n1;
         (cur, cur1, next, next1) = (next, next1, after, after1);
     }
     true
@@ -2291,9 +2306,14 @@ mod tests {
         frame: &ShadingFrame,
     ) -> (bool, bool) {
         let (mut a, mut b) = (Pieces::new(), Pieces::new());
+        // A reused scratch holds the previous blocker's vertices and planes, fewer or more
+        // (here NaN, 0 to 39 of them): the walk must size them and overwrite every one.
+        let x = frame.origin();
+        let stale = (x.x.to_bits() % 40) as usize;
+        a.kv.extend(core::iter::repeat_n(DVec3::NAN, stale));
+        a.planes.extend(core::iter::repeat_n(DVec3::NAN, stale));
         let fast = convex_blocker(p, faces, frame, &mut a);
         let general = convex_planes(p, frame, &mut b);
-        let x = frame.origin();
         assert_eq!(fast, general, "{x}");
         if fast {
             let bits = |v: &[DVec3]| -> Vec<u64> {
