@@ -109,6 +109,8 @@ struct FacingNode {
     center: DVec3,
     /// Half the extent of the box of its faces about `center`.
     half: DVec3,
+    /// `half.max_element()`.
+    half_max: f64,
     axis: DVec3,
     spread: f64,
     q_lo: f64,
@@ -243,7 +245,7 @@ impl MeshContours {
             nodes: &self.nodes,
             x,
             cone: match cull {
-                Cull::Cone(_, planes) => Some(Cone::new(planes)),
+                Cull::Cone(_, planes) => Some(Cone::new(planes, x)),
                 _ => None,
             },
         };
@@ -293,6 +295,8 @@ fn outside_box(lo: DVec3, hi: DVec3, x: DVec3) -> bool {
 struct Cone {
     planes: [DVec3; 4],
     abs: [DVec3; 4],
+    /// The rounding margin's part from the point (see [`Cone::classify`]).
+    x_scale: f64,
 }
 
 /// Where a node's box lies against a [`Cone`].
@@ -303,10 +307,11 @@ enum ConeSide {
 }
 
 impl Cone {
-    fn new(planes: &[DVec3; 4]) -> Self {
+    fn new(planes: &[DVec3; 4], x: DVec3) -> Self {
         Cone {
             planes: *planes,
             abs: planes.map(DVec3::abs),
+            x_scale: x.abs().max_element(),
         }
     }
 
@@ -316,7 +321,7 @@ impl Cone {
     #[inline]
     fn classify(&self, n: &FacingNode, x: DVec3) -> ConeSide {
         let y = n.center - x;
-        let m = 1e-9 * (y.abs().max_element() + n.half.max_element() + x.abs().max_element());
+        let m = 1e-9 * (y.abs().max_element() + n.half_max + self.x_scale);
         let mut inside = true;
         for (p, a) in self.planes.iter().zip(&self.abs) {
             let (mid, r) = (p.dot(y), a.dot(n.half));
@@ -536,6 +541,7 @@ fn facing_bounds(mesh: &TriangleMesh, edges: &[[u32; 4]], start: u32, leaf: bool
     FacingNode {
         center,
         half: 0.5 * (hi - lo),
+        half_max: (0.5 * (hi - lo)).max_element(),
         axis,
         spread: spread * (1.0 + 1e-9) + 1e-12,
         q_lo: q_lo - pad,
