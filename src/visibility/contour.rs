@@ -366,8 +366,14 @@ impl Walk<'_> {
 
     #[inline(always)]
     fn edges(&self, range: core::ops::Range<usize>, out: &mut Vec<(u32, u32)>) {
+        // A leaf's edges come in runs of one first face (`share_first_faces`): its facing is
+        // decided once per run.
+        let (mut last, mut s_last) = (u32::MAX, false);
         for &[a, b, f0, f1] in &self.edges[range] {
-            let (s0, s1) = (self.front(f0), self.front(f1));
+            if f0 != last {
+                (last, s_last) = (f0, self.front(f0));
+            }
+            let (s0, s1) = (s_last, self.front(f1));
             if s0 != s1 {
                 out.push(if s0 { (a, b) } else { (b, a) });
             }
@@ -448,6 +454,9 @@ fn build_tree(
         let node = nodes.len();
         let range = &mut edges[first..end];
         let leaf = range.len() <= LEAF_EDGES;
+        if leaf {
+            share_first_faces(range);
+        }
         nodes.push(facing_bounds(
             mesh,
             range,
@@ -505,6 +514,30 @@ fn build_tree(
         stack.push((first + m, end));
         stack.push((first, first + m));
     }
+}
+
+/// Orients and orders a leaf's edges so that edges sharing a face come in runs with it as their
+/// first face: an edge `[a, b, f0, f1]` is the same edge as `[b, a, f1, f0]` (each face runs it
+/// one way), so each edge takes as its first face the one of its two faces that more of the
+/// leaf's edges hold, and the edges are sorted by it; the walk then decides that face once per
+/// run.
+fn share_first_faces(edges: &mut [[u32; 4]]) {
+    let count = |f: u32, edges: &[[u32; 4]]| {
+        edges
+            .iter()
+            .filter(|e| e[2] == f || e[3] == f)
+            .count()
+    };
+    let counts: SmallVec<[(usize, usize); LEAF_EDGES]> = edges
+        .iter()
+        .map(|e| (count(e[2], edges), count(e[3], edges)))
+        .collect();
+    for (e, &(c0, c1)) in edges.iter_mut().zip(&counts) {
+        if c1 > c0 || (c1 == c0 && e[3] < e[2]) {
+            *e = [e[1], e[0], e[3], e[2]];
+        }
+    }
+    edges.sort_unstable_by_key(|e| (e[2], e[3]));
 }
 
 /// The facing bounds of the faces of `edges` (see [`FacingNode`]).
