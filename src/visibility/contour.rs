@@ -522,12 +522,8 @@ fn build_tree(
 /// leaf's edges hold, and the edges are sorted by it; the walk then decides that face once per
 /// run.
 fn share_first_faces(edges: &mut [[u32; 4]]) {
-    let count = |f: u32, edges: &[[u32; 4]]| {
-        edges
-            .iter()
-            .filter(|e| e[2] == f || e[3] == f)
-            .count()
-    };
+    let count =
+        |f: u32, edges: &[[u32; 4]]| edges.iter().filter(|e| e[2] == f || e[3] == f).count();
     let counts: SmallVec<[(usize, usize); LEAF_EDGES]> = edges
         .iter()
         .map(|e| (count(e[2], edges), count(e[3], edges)))
