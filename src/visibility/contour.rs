@@ -583,6 +583,9 @@ fn facing_bounds(mesh: &TriangleMesh, edges: &[[u32; 4]], start: u32, leaf: bool
 /// Iterations of [`cone_axis`]'s search for the centre of the normals' smallest ball.
 const AXIS_STEPS: usize = 16;
 
+/// Nodes of more face slots than this keep the normalized sum as their axis ([`cone_axis`]).
+const AXIS_MAX_FACES: usize = 256;
+
 /// An axis for the normal cone of `normals` (unit vectors): close to the centre of their
 /// smallest enclosing ball (Badoiu and Clarkson, *Smaller core-sets for balls*, SODA 2003:
 /// step towards the farthest point by `1 / (k + 1)`), started at the normalized sum of the
@@ -599,7 +602,14 @@ fn cone_axis(normals: impl Iterator<Item = DVec3> + Clone) -> DVec3 {
     let mut best = sum.try_normalize().unwrap_or(DVec3::Z);
     let mut best_spread = spread_of(best);
     let mut c = best;
-    for k in 1..=AXIS_STEPS {
+    // Large nodes (near the root) hold wide cones that a better axis rarely makes decisive,
+    // and cost the most steps: their axis stays the normalized sum.
+    let steps = if normals.clone().count() > AXIS_MAX_FACES {
+        0
+    } else {
+        AXIS_STEPS
+    };
+    for k in 1..=steps {
         let (far, d) = normals.clone().fold((c, 0.0f64), |(p, m), n| {
             let d = (n - c).length_squared();
             if d > m { (n, d) } else { (p, m) }
