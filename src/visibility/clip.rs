@@ -8,7 +8,7 @@ use smallvec::SmallVec;
 
 use super::contour::MeshContours;
 use super::cull::{LightCone, Shaft, above_horizon, may_occlude, shaft_triangles};
-use super::pieces::ConvexFaces;
+use super::pieces::{CellTables, ConvexFaces};
 use super::union::{BlockerAccel, BlockerGeometry, LightRegion, one_pass};
 use super::{Blocker, Visibility};
 use crate::GeomError;
@@ -161,11 +161,12 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             .chain(lights.iter().map(AsRef::as_ref))
             .map(|b| BlockerAccel::new(b, BVH_MIN_TRIANGLES))
             .collect();
+        let mut tables = CellTables::new();
         let faces = occluders
             .iter()
             .chain(lights.iter().map(AsRef::as_ref))
             .map(|b| match b {
-                Body::Convex(p) => ConvexFaces::of(p),
+                Body::Convex(p) => ConvexFaces::of_sharing(p, &mut tables),
                 _ => None,
             })
             .collect();

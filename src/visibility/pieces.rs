@@ -82,6 +82,8 @@
 //! spherical path decides, or gives up, exactly as without this path.
 
 use alloc::boxed::Box;
+use alloc::collections::BTreeMap;
+use alloc::sync::Arc;
 use alloc::vec::Vec;
 
 use glam::DVec3;
@@ -1616,14 +1618,37 @@ pub(super) struct ConvexFaces {
     /// walk's spacing and turn tests for a whole blocker at once.
     simple: Option<(f64, f64)>,
     /// With bit sets of edges and at most [`CELL_TABLE_PLANES`] planes: the contours of the sets
-    /// of front planes that points see, found once ([`cell_masks`]): `cells` sorted, and for
-    /// `cells[i]` the loop [`contour_by_bits`] chains, `cell_vertices[a..a + n]` for
-    /// `cell_loops[i] = (a, n)` (`n = 0` where it declines). A set not in the table is chained
-    /// per point as before.
-    cells: Vec<u64>,
-    cell_loops: Vec<(u32, u8)>,
-    cell_vertices: Vec<u8>,
+    /// of front planes that points see, found once ([`cell_masks`]). A set not in the table is
+    /// chained per point as before. Shared by the bodies of one scene that have the same planes
+    /// and edges by index ([`CellTables`]).
+    cells: Option<Arc<CellTable>>,
 }
+
+/// The contours of sets of front planes of a convex body ([`ConvexFaces::cells`]): `cells`
+/// sorted, and for `cells[i]` the loop [`contour_by_bits`] chains, `vertices[a..a + n]` for
+/// `loops[i] = (a, n)` (`n = 0` where it declines).
+///
+/// The loop of a set depends only on which edges join which vertices between which planes (the
+/// bit sets and `edges` of [`ConvexFaces`]), not on where they lie, so bodies that agree in
+/// those (copies of one primitive, moved or scaled) can share one table; which sets the table
+/// holds does depend on the geometry, but a set it lacks is only chained per point.
+#[derive(Debug, PartialEq)]
+pub(super) struct CellTable {
+    cells: Vec<u64>,
+    loops: Vec<(u32, u8)>,
+    vertices: Vec<u8>,
+}
+
+/// The tables of cells built so far for one scene, by plane count and edges
+/// ([`ConvexFaces::of_sharing`]; `None` where the body has more sets than [`CELL_TABLE_SETS`]):
+/// a scene of copies of one body with the same numbering builds and stores its table once.
+pub(super) type CellTables = BTreeMap<(usize, Vec<[u8; 4]>), Option<Arc<CellTable>>>;
+
+/// Most tables of cells one scene builds: an icosahedron's takes about 2.3 million instructions
+/// (a millisecond) and 38 KB, at most [`CELL_TABLE_SETS`] sets about 90 KB, so a scene of
+/// thousands of such bodies would spend seconds and hundreds of megabytes on them. The bodies
+/// beyond these chain their contours per point, as bodies without a table do.
+const CELL_TABLE_BUDGET: usize = 64;
 
 /// Polyhedra with at most this many distinct face planes (and more than
 /// [`CONTOUR_TABLE_PLANES`]) get a table of the contours of the sets of front planes that
@@ -1641,7 +1666,14 @@ const CONTOUR_TABLE_PLANES: usize = 8;
 impl ConvexFaces {
     /// The table of `p`; `None` beyond 64 triangles or [`INLINE_VERTICES`] vertices (the
     /// general walk of [`convex_silhouette_dirs`] takes those).
+    #[cfg(test)]
     pub(super) fn of(p: &ConvexPolyhedron) -> Option<ConvexFaces> {
+        Self::of_sharing(p, &mut CellTables::new())
+    }
+
+    /// [`ConvexFaces::of`], taking its table of cells from `tables` where a body with the same
+    /// planes and edges by index built one, and adding the one it builds.
+    pub(super) fn of_sharing(p: &ConvexPolyhedron, tables: &mut CellTables) -> Option<ConvexFaces> {
         let mesh = p.mesh();
         if mesh.normals().len() > 64 || p.vertices().len() > INLINE_VERTICES {
             return None;
@@ -1707,11 +1739,17 @@ impl ConvexFaces {
             vertices,
             plane_edges,
             simple,
-            cells: Vec::new(),
-            cell_loops: Vec::new(),
-            cell_vertices: Vec::new(),
+            cells: None,
         };
         if !faces.plane_edges.is_empty() && faces.normals.len() <= CELL_TABLE_PLANES {
+            let key = (faces.normals.len(), faces.edges.clone());
+            if let Some(table) = tables.get(&key) {
+                faces.cells = table.clone();
+                return Some(faces);
+            }
+            if tables.len() >= CELL_TABLE_BUDGET {
+                return Some(faces);
+            }
             let cells = cell_masks(
                 &faces.normals,
                 &faces.offsets,
@@ -1729,7 +1767,14 @@ impl ConvexFaces {
                 loops.push((verts.len() as u32, n as u8));
                 verts.extend_from_slice(&order[..n]);
             }
-            (faces.cells, faces.cell_loops, faces.cell_vertices) = (cells, loops, verts);
+            faces.cells = (!cells.is_empty()).then(|| {
+                Arc::new(CellTable {
+                    cells,
+                    loops,
+                    vertices: verts,
+                })
+            });
+            tables.insert(key, faces.cells.clone());
         }
         Some(faces)
     }
@@ -1738,9 +1783,10 @@ impl ConvexFaces {
     /// `Some(None)` where [`contour_by_bits`] declines.
     #[inline(always)]
     fn cell_contour(&self, front: u64) -> Option<Option<&[u8]>> {
-        let i = self.cells.binary_search(&front).ok()?;
-        let (a, n) = self.cell_loops[i];
-        Some((n > 0).then(|| &self.cell_vertices[a as usize..a as usize + n as usize]))
+        let table = self.cells.as_deref()?;
+        let i = table.cells.binary_search(&front).ok()?;
+        let (a, n) = table.loops[i];
+        Some((n > 0).then(|| &table.vertices[a as usize..a as usize + n as usize]))
     }
 }
 
@@ -2218,14 +2264,15 @@ mod tests {
     //! walk over a [`ConvexFaces`] table against [`convex_planes`], and the traversal of two
     //! crossings against the general one.
 
+    use alloc::sync::Arc;
     use alloc::vec;
     use alloc::vec::Vec;
 
     use glam::DVec3;
 
     use super::{
-        ConvexFaces, INLINE_VERTICES, Pieces, contour_by_bits, contour_loop, convex_blocker,
-        convex_planes,
+        CELL_TABLE_BUDGET, CELL_TABLE_PLANES, CellTable, CellTables, ConvexFaces, INLINE_VERTICES,
+        Pieces, contour_by_bits, contour_loop, convex_blocker, convex_planes,
     };
     use crate::solid::{Body, ConvexPolyhedron, ShadingFrame, TriangleMesh};
     use crate::visibility::ClipVisibility;
@@ -2415,20 +2462,64 @@ mod tests {
         );
     }
 
+    /// A scene builds at most [`CELL_TABLE_BUDGET`] tables of cells: copies of one body (the
+    /// same numbering) share the first one's, and bodies of other numberings beyond the budget
+    /// get none (they chain per point).
+    #[test]
+    fn cell_tables_are_shared_and_bounded() {
+        let mut rng = Rng(41);
+        let mut shared = CellTables::new();
+        let ico = ConvexPolyhedron::icosphere(DVec3::ZERO, 0.5, 0).unwrap();
+        let first = ConvexFaces::of_sharing(&ico, &mut shared).unwrap();
+        let again = ConvexFaces::of_sharing(&ico.clone(), &mut shared).unwrap();
+        let (a, b) = (first.cells.as_ref().unwrap(), again.cells.as_ref().unwrap());
+        assert!(Arc::ptr_eq(a, b), "a copy builds its own table");
+        let (mut with, mut without) = (0, 0);
+        while shared.len() < CELL_TABLE_BUDGET + 8 && with + without < 4000 {
+            let c = rng.vec(-1.0, 1.0);
+            let pts: Vec<DVec3> = (0..12).map(|_| c + rng.vec(-0.5, 0.5)).collect();
+            let Ok(p) = ConvexPolyhedron::hull(&pts) else {
+                continue;
+            };
+            let Some(faces) = ConvexFaces::of_sharing(&p, &mut shared) else {
+                continue;
+            };
+            if faces.plane_edges.is_empty() || faces.normals.len() > CELL_TABLE_PLANES {
+                continue;
+            }
+            if faces.cells.is_some() {
+                with += 1;
+            } else {
+                without += 1;
+            }
+        }
+        assert!(shared.len() <= CELL_TABLE_BUDGET, "{} tables", shared.len());
+        assert!(
+            with >= 40 && without >= 40,
+            "{with} with a table, {without} without"
+        );
+    }
+
     /// The table of cells ([`ConvexFaces::cell_contour`]) against [`contour_by_bits`] for the
-    /// front planes of points all around icosahedra and random hulls, near and far: the same
-    /// loop (or decline) wherever the table holds the set, and the table holds nearly all sets
-    /// that points see.
+    /// front planes of points all around icosahedra and random hulls, near and far, the tables
+    /// shared as a scene shares them (the icosahedra of several sizes and places take the first
+    /// one's): the same loop (or decline) wherever the table holds the set, and the table holds
+    /// nearly all sets that points see.
     #[test]
     fn cell_table_matches_contour_by_bits() {
         let mut rng = Rng(37);
         let (mut tables, mut seen, mut hits) = (0, 0, 0);
+        let mut shared = CellTables::new();
+        let mut distinct: Vec<*const CellTable> = Vec::new();
         for p in polyhedra(&mut rng) {
-            let Some(faces) = ConvexFaces::of(&p) else {
+            let Some(faces) = ConvexFaces::of_sharing(&p, &mut shared) else {
                 continue;
             };
-            if faces.cells.is_empty() {
+            let Some(table) = &faces.cells else {
                 continue;
+            };
+            if !distinct.contains(&Arc::as_ptr(table)) {
+                distinct.push(Arc::as_ptr(table));
             }
             tables += 1;
             let bs = p.mesh().bounding_sphere();
@@ -2455,6 +2546,10 @@ mod tests {
         assert!(
             tables >= 6 && seen > 10_000 && hits * 100 > seen * 99,
             "{tables} tables, {seen} sets seen, {hits} in the table"
+        );
+        assert!(
+            distinct.len() < tables,
+            "{tables} bodies with tables, as many built"
         );
     }
 
