@@ -7,6 +7,8 @@
 //! `f64`; their topology is re-checked with the exact predicate afterwards (see
 //! `boolean::intersect`).
 
+use alloc::vec::Vec;
+
 use glam::DVec2;
 
 /// Largest coordinate magnitude accepted by [`Shape::new`](super::Shape::new).
@@ -58,6 +60,42 @@ pub(crate) fn strictly_between(a: DVec2, b: DVec2, p: DVec2) -> bool {
     } else {
         (a.y < p.y && p.y < b.y) || (b.y < p.y && p.y < a.y)
     }
+}
+
+/// The convex hull of `pts` as indices into it, counter-clockwise, points on its edges left out
+/// (Andrew's monotone chain, A. M. Andrew, *Another efficient algorithm for convex hulls in two
+/// dimensions*, 1979). Plain floating-point turns: for callers that check what the hull stands
+/// for themselves.
+#[must_use]
+pub(crate) fn monotone_hull(pts: &[DVec2]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..pts.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (p, q) = (pts[a], pts[b]);
+        p.x.total_cmp(&q.x).then(p.y.total_cmp(&q.y))
+    });
+    let turn = |o: usize, a: usize, c: usize| {
+        let (o, a, c) = (pts[o], pts[a], pts[c]);
+        (a.x - o.x) * (c.y - o.y) - (a.y - o.y) * (c.x - o.x)
+    };
+    let mut hull: Vec<usize> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        for k in 0..order.len() {
+            let p = if pass == 0 {
+                order[k]
+            } else {
+                order[order.len() - 1 - k]
+            };
+            while hull.len() >= start + 2
+                && turn(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
 }
 
 /// Twice the signed area of a closed ring (positive for counter-clockwise).

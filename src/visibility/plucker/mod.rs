@@ -97,13 +97,14 @@ use alloc::collections::BTreeMap;
 use alloc::vec::Vec;
 use core::sync::atomic::{AtomicUsize, Ordering};
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use smallvec::SmallVec;
 
 use super::cull::above_horizon;
 use super::{Blocker, ClipVisibility, Visibility};
 use crate::GeomError;
 use crate::math::floor;
+use crate::planar::predicates::monotone_hull;
 use crate::solid::facing::{Side, face_side};
 use crate::solid::{Body, ShadingFrame, TriangleMesh};
 use crate::sphere::SphericalPolygon;
@@ -762,34 +763,8 @@ fn group_hull(mesh: &TriangleMesh, faces: &[u32]) -> Option<SmallVec<[DVec3; 8]>
     if pts.len() > 8 {
         return None;
     }
-    let flat = |p: DVec3| (p.dot(t), p.dot(b));
-    pts.sort_by(|p, q| {
-        let (a, c) = (flat(*p), flat(*q));
-        a.0.total_cmp(&c.0).then(a.1.total_cmp(&c.1))
-    });
-    let cross = |o: DVec3, a: DVec3, c: DVec3| {
-        let (o, a, c) = (flat(o), flat(a), flat(c));
-        (a.0 - o.0) * (c.1 - o.1) - (a.1 - o.1) * (c.0 - o.0)
-    };
-    // Andrew's monotone chain, counter-clockwise in (t, b).
-    let mut hull: Vec<DVec3> = Vec::new();
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Vec<DVec3> = if pass == 0 {
-            pts.clone()
-        } else {
-            pts.iter().rev().copied().collect()
-        };
-        for p in iter {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
+    let flat: Vec<DVec2> = pts.iter().map(|p| DVec2::new(p.dot(t), p.dot(b))).collect();
+    let mut hull: Vec<DVec3> = monotone_hull(&flat).into_iter().map(|i| pts[i]).collect();
     if hull.len() < 3 {
         return None;
     }

@@ -35,12 +35,13 @@
 
 use alloc::vec::Vec;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use smallvec::SmallVec;
 
 use super::bsp::{MAX_OCCLUDER_VERTICES, Node, Occluder, Tree};
 use super::line::{Orienter, Sign};
 use crate::GeomError;
+use crate::planar::predicates::{monotone_hull, signed_area2};
 use crate::solid::ShadingFrame;
 use crate::sphere::SphericalPolygon;
 
@@ -552,44 +553,23 @@ pub(crate) fn fragment_polygon(
 fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
     let m = u.iter().copied().sum::<DVec3>().try_normalize()?;
     let (e1, e2) = m.any_orthonormal_pair();
-    let mut pts: Vec<(f64, f64, DVec3)> = Vec::with_capacity(u.len());
+    let mut pts: Vec<DVec2> = Vec::with_capacity(u.len());
     for &w in u {
         let h = w.dot(m);
         if !(h > 1e-3) {
             return None;
         }
-        pts.push((w.dot(e1) / h, w.dot(e2) / h, w));
+        pts.push(DVec2::new(w.dot(e1), w.dot(e2)) / h);
     }
-    let ring_area = twice_signed_area(&pts);
-    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    let cross = |o: &(f64, f64, DVec3), a: &(f64, f64, DVec3), b: &(f64, f64, DVec3)| {
-        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
-    };
-    let mut hull: Vec<(f64, f64, DVec3)> = Vec::with_capacity(2 * pts.len());
-    for pass in 0..2 {
-        let start = hull.len();
-        for k in 0..pts.len() {
-            let p = if pass == 0 {
-                pts[k]
-            } else {
-                pts[pts.len() - 1 - k]
-            };
-            while hull.len() >= start + 2
-                && cross(&hull[hull.len() - 2], &hull[hull.len() - 1], &p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    let hull_area = twice_signed_area(&hull);
+    let hull = monotone_hull(&pts);
+    let hull_pts: Vec<DVec2> = hull.iter().map(|&i| pts[i]).collect();
+    let (ring_area, hull_area) = (signed_area2(&pts), signed_area2(&hull_pts));
     if !((hull_area - ring_area).abs() <= HULL_AREA_TOLERANCE * hull_area) {
         return None;
     }
     // Counter-clockwise in (e1, e2), with e1 x e2 = m: counter-clockwise about m.
     let mut ring: Vec<DVec3> = Vec::with_capacity(hull.len());
-    for (_, _, w) in hull {
+    for w in hull.into_iter().map(|i| u[i]) {
         if ring
             .last()
             .is_none_or(|&q: &DVec3| (q - w).length() > MERGE_TOLERANCE)
@@ -607,17 +587,6 @@ fn convex_hull_ring(u: &[DVec3]) -> Option<Vec<DVec3>> {
 /// to stand for it ([`convex_hull_ring`]): the backends' agreement bound, far above the
 /// rounding of a fragment's corners and far below any part of a light a point may see.
 const HULL_AREA_TOLERANCE: f64 = 1e-9;
-
-/// Twice the signed area of the polygon of the points `(x, y, _)` in their order (shoelace).
-fn twice_signed_area(p: &[(f64, f64, DVec3)]) -> f64 {
-    let n = p.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (p[i], p[(i + 1) % n]);
-            a.0 * b.1 - a.1 * b.0
-        })
-        .sum()
-}
 
 /// Whether the ring of unit vectors `u` passes every check of [`SphericalPolygon::new`] with a
 /// margin, so that it can be stored without them (they cost more than the rest of a fragment's
