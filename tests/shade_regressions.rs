@@ -1,5 +1,5 @@
-//! Minimized findings of the `shade` and `shade_regimes` fuzz targets (fuzz/fuzz_targets/) in the
-//! visibility and shade layers, each with the invariant the target asserts: a valid query gives a
+//! Minimized findings of the `shade` and `shade_regimes` fuzz targets (fuzz/fuzz_targets/) in
+//! the solid, visibility and shade layers, each with the invariant the target asserts: a valid query gives a
 //! finite, non-negative radiance no larger than the unoccluded one, or `GeomError::Undecidable`.
 
 use arealight::glam::DVec3;
