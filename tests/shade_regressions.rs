@@ -1,6 +1,7 @@
 //! Minimized findings of the `shade` and `shade_regimes` fuzz targets (fuzz/fuzz_targets/) in
-//! the solid, visibility and shade layers, each with the invariant the target asserts: a valid query gives a
-//! finite, non-negative radiance no larger than the unoccluded one, or `GeomError::Undecidable`.
+//! the solid, visibility and shade layers, each with the invariant the target asserts: a valid
+//! query gives a finite, non-negative radiance no larger than the unoccluded one, or
+//! `GeomError::Undecidable`.
 
 use arealight::glam::DVec3;
 use arealight::shade::{
