@@ -455,6 +455,91 @@ fn blockers_in_exact_contact() {
     );
 }
 
+/// Points in the plane of a light's edge that also holds a face of each box (the plane
+/// `x = s/2`, dyadic coordinates times `s`, so the plane holds them exactly), and `1e-16` to
+/// `1e-9` (relative) off it, at three scales: issue 15's point 5 generalized. From the plane,
+/// the light's corners have sides of a few ulps on the boxes' contour planes and the contour
+/// runs straight through the vertex of the face seen edge-on, so the boundary tracing must
+/// decline (`visibility/pieces.rs`); off it, the sides are tiny but not zero. Boxes on the
+/// light's side of the plane (as issue 15's flat box), on the other side, and on the edge line
+/// below the light, one at a time and together. The fast path must agree with the spherical
+/// path to `1e-12` everywhere, and must have answered for most points.
+#[test]
+fn faces_in_the_plane_of_a_light_edge() {
+    let materials = [
+        Material::diffuse(DVec3::splat(0.7)).unwrap(),
+        Material::new(DVec3::splat(0.5), DVec3::splat(0.04), 0.3).unwrap(),
+    ];
+    let mut rng = Rng::new(515);
+    let (mut pairs, mut fast) = (0, 0);
+    let mut failures = Vec::new();
+    let mut pieces = Pieces::new();
+    for s in [1.0 / 1024.0, 1.0, 1000.0] {
+        let quad = TriangleMesh::quad(
+            DVec3::new(0.0, 0.0, 2.0) * s,
+            DVec3::Y * 0.5 * s,
+            DVec3::X * 0.5 * s,
+        )
+        .unwrap();
+        let cube =
+            |c: DVec3, h: DVec3| -> Body { ConvexPolyhedron::cuboid(c * s, h * s).unwrap().into() };
+        let boxes = [
+            cube(
+                DVec3::new(0.375, -0.3125, 1.375),
+                DVec3::new(0.125, 0.09375, 0.0625),
+            ),
+            cube(
+                DVec3::new(0.625, 0.25, 1.25),
+                DVec3::new(0.125, 0.125, 0.0625),
+            ),
+            cube(
+                DVec3::new(0.4375, 0.0625, 0.75),
+                DVec3::new(0.0625, 0.0625, 0.125),
+            ),
+        ];
+        let mut scenes: Vec<Vec<Body>> = boxes.iter().map(|b| vec![b.clone()]).collect();
+        scenes.push(boxes.to_vec());
+        for occ in scenes {
+            let scene =
+                Scene::new(vec![Light::new(quad.clone(), DVec3::ONE).unwrap()], occ).unwrap();
+            for k in 0..160 {
+                let rel = [0.0, 1e-16, -1e-16, 0.0, -1e-15, 1e-13, -1e-11, 1e-9][k % 8];
+                let x = DVec3::new((0.5 + rel) * s, rng.range(-0.6, 0.6) * s, 0.0);
+                let n = if k % 3 == 0 {
+                    DVec3::Z
+                } else {
+                    DVec3::new(rng.range(-0.3, 0.3), rng.range(-0.3, 0.3), 1.0).normalize()
+                };
+                let v = view_above(&mut rng, n, 0.2);
+                let m = &materials[k % 2];
+                let frame = ShadingFrame::new(x, n, v).unwrap();
+                pairs += 1;
+                fast += usize::from(
+                    scene
+                        .visibility()
+                        .visible_pieces(0, &frame, true, &mut pieces)
+                        .unwrap(),
+                );
+                let Some((want, unoccluded)) = spherical(&scene, 0, &frame, m) else {
+                    continue;
+                };
+                let got = scene.shade(x, n, v, m).unwrap();
+                let err = (got - want).abs().max_element();
+                if err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR) {
+                    failures.push(format!("s {s} x {x} n {n}: fast {got} spherical {want}"));
+                }
+            }
+        }
+    }
+    let (traced, cut) = pieces.subtractions();
+    eprintln!("{pairs} pairs, {fast} fast, {traced} traced, {cut} by inclusion-exclusion");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(
+        fast * 4 >= pairs * 3,
+        "only {fast} of {pairs} took the fast path"
+    );
+}
+
 /// Points on an occluder's surface and in a planar light's plane get the spherical path's
 /// finite value (a point on a box's face: the box covers the half-space behind that face; a
 /// point in the light's plane sees none of it), and invalid arguments are errors naming the
