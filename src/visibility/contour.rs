@@ -62,6 +62,10 @@ const NORMAL_WEIGHT: f64 = 0.25;
 /// Most edges in a leaf of the facing hierarchy.
 const LEAF_EDGES: usize = 6;
 
+/// Meshes of at most this many faces have their whole contour ([`Cull::All`]) found by one
+/// pass over their faces and edges instead of the facing hierarchy's walk (a multiple of 64).
+const FLAT_MAX_FACES: usize = 1024;
+
 /// Meshes with more components than this get a hierarchy over the components' boxes.
 const COMPONENT_BVH_MIN: usize = 16;
 
@@ -250,6 +254,31 @@ impl MeshContours {
             },
         };
         match cull {
+            Cull::All if mesh.triangles().len() <= FLAT_MAX_FACES => {
+                // A small mesh seen whole (a light's own contour): every face classified once,
+                // in one pass over the planes, costs less than the hierarchy's walk, which
+                // visits most nodes of such a mesh anyway. Edges are taken in their stored
+                // order, as the walk takes them: the same contour in the same order.
+                let mut front = [0u8; FLAT_MAX_FACES];
+                for ((s, &n), &o) in front.iter_mut().zip(mesh.normals()).zip(mesh.offsets()) {
+                    *s = u8::from(at.front(n, o));
+                }
+                // Face indices are below the face count, at most `FLAT_MAX_FACES` (a power of
+                // two): the mask changes none and spares the bounds checks.
+                let bit = |f: u32| front[f as usize & (FLAT_MAX_FACES - 1)];
+                for c in &self.comps {
+                    if !outside_box(c.lo, c.hi, x) {
+                        return false;
+                    }
+                    for &[a, b, f0, f1] in &self.edges[c.start as usize..c.end as usize] {
+                        let s0 = bit(f0);
+                        if s0 != bit(f1) {
+                            out.push(if s0 != 0 { (a, b) } else { (b, a) });
+                        }
+                    }
+                }
+                true
+            }
             Cull::All => {
                 for c in &self.comps {
                     if !outside_box(c.lo, c.hi, x) {
