@@ -524,25 +524,30 @@ impl Overlay {
             w[self.fam(e0)] -= 1;
         }
         let w0 = w;
+        // A run lies on one ring, of one family; its pieces' class changes only at crossings.
+        let fam = self.fam(e0);
+        let class = |w: [i32; 2]| {
+            let mut left = w;
+            left[fam] += 1;
+            let (l, r) = (visible(left), visible(w));
+            if l && !r {
+                1
+            } else if r && !l {
+                2
+            } else {
+                0
+            }
+        };
+        let mut k = class(w);
         let mut e = e0;
         loop {
-            let fam = self.fam(e);
             let (s0, s1) = (self.xstart[e] as usize, self.xstart[e + 1] as usize);
-            for j in 0..=(s1 - s0) {
-                let mut left = w;
-                left[fam] += 1;
-                let (l, r) = (visible(left), visible(w));
-                self.kept[s0 + e + j] = if l && !r {
-                    1
-                } else if r && !l {
-                    2
-                } else {
-                    0
-                };
-                if j < s1 - s0 {
-                    let sl = self.slots[s0 + j];
-                    w[self.fam(sl.other as usize)] -= i32::from(sl.s);
-                }
+            self.kept[s0 + e] = k;
+            for j in 1..=(s1 - s0) {
+                let sl = self.slots[s0 + j - 1];
+                w[self.fam(sl.other as usize)] -= i32::from(sl.s);
+                k = class(w);
+                self.kept[s0 + e + j] = k;
             }
             e = self.succ(e);
             if cyclic {
@@ -578,6 +583,21 @@ impl Overlay {
                     }
                     self.seen[pid] = true;
                     let cnt = (self.xstart[ce + 1] - self.xstart[ce]) as usize;
+                    if fwd && cnt == 0 && !self.repeated_ids {
+                        // A whole edge run forwards (the common piece): its start, and on to
+                        // the next edge's first piece, which must be kept forwards too (as in
+                        // `step`).
+                        self.out.push(self.pts[ce].d);
+                        let ne = self.succ(ce);
+                        if self.kept[self.xstart[ne] as usize + ne] != 1 {
+                            return false;
+                        }
+                        if (ne, 0) == (e, j) {
+                            break;
+                        }
+                        (ce, cj) = (ne, 0);
+                        continue;
+                    }
                     if self.repeated_ids {
                         if fwd && cj == 0 {
                             self.out_ids.push(self.pts[ce].id);
