@@ -106,6 +106,8 @@ pub(crate) struct Overlay {
     /// the edge below (integers sort faster than floating-point keys through the index).
     order: Vec<u128>,
     active: Vec<u32>,
+    /// Pairs of edges whose boxes overlap (the sweep's candidates).
+    pairs: Vec<(u32, u32)>,
     cross: Vec<Cross>,
     /// Per edge `e`: its crossings are `slots[xstart[e]..xstart[e + 1]]`, along it.
     xstart: Vec<u32>,
@@ -170,6 +172,7 @@ impl Overlay {
         o.bbox.reserve(n);
         o.order.reserve(n);
         o.active.reserve(n / 4);
+        o.pairs.reserve(n);
         o.xstart.reserve(n + 1);
         o.fill.reserve(n);
         o.kept.reserve(2 * n);
@@ -297,44 +300,54 @@ impl Overlay {
     /// Step 1: every crossing of two non-bridge edges.
     fn crossings(&mut self) -> bool {
         let n = self.pts.len();
+        let (pts, next) = (&self.pts[..n], &self.next[..n]);
         self.bbox.clear();
         self.order.clear();
-        for k in 0..n {
-            let (a, b) = (self.pts[k].p, self.pts[self.succ(k)].p);
-            self.bbox
-                .push([a.x.min(b.x), a.x.max(b.x), a.y.min(b.y), a.y.max(b.y)]);
-            if !self.pts[k].bridge {
-                self.order
-                    .push(u128::from(order_bits(a.x.min(b.x))) << 32 | k as u128);
+        self.order.reserve(n);
+        for (k, (q, &s)) in pts.iter().zip(next).enumerate() {
+            let (a, b) = (q.p, pts[s as usize].p);
+            // Plain comparisons (the coordinates are finite): `f64::min`'s NaN rule costs more.
+            let (x0, x1) = if a.x <= b.x { (a.x, b.x) } else { (b.x, a.x) };
+            let (y0, y1) = if a.y <= b.y { (a.y, b.y) } else { (b.y, a.y) };
+            self.bbox.push([x0, x1, y0, y1]);
+            if !q.bridge {
+                self.order.push(u128::from(order_bits(x0)) << 32 | k as u128);
             }
         }
         self.order.sort_unstable();
+        // The sweep collects the candidate pairs, then they are tested.
         self.active.clear();
-        self.cross.clear();
-        for i in 0..self.order.len() {
-            let e = (self.order[i] & u128::from(u32::MAX)) as usize;
-            let be = self.bbox[e];
+        self.pairs.clear();
+        let bbox = &self.bbox[..];
+        for &key in &self.order {
+            let e = key as u32;
+            let be = bbox[e as usize];
             // One pass over the active edges: those whose boxes end left of `e`'s leave for good
             // (the later edges start no further left), the others stay, in order, and are
             // tested against `e` where their boxes overlap in `y` too.
             let mut kept = 0;
             for j in 0..self.active.len() {
-                let f = self.active[j] as usize;
-                let bf = self.bbox[f];
+                let f = self.active[j];
+                let bf = bbox[f as usize];
                 if bf[1] < be[0] {
                     continue;
                 }
-                self.active[kept] = f as u32;
+                self.active[kept] = f;
                 kept += 1;
                 if bf[2] > be[3] || be[2] > bf[3] {
                     continue;
                 }
-                if !self.test_pair(e, f) {
-                    return false;
-                }
+                self.pairs.push((e, f));
             }
             self.active.truncate(kept);
-            self.active.push(e as u32);
+            self.active.push(e);
+        }
+        self.cross.clear();
+        for i in 0..self.pairs.len() {
+            let (e, f) = self.pairs[i];
+            if !self.test_pair(e as usize, f as usize) {
+                return false;
+            }
         }
         true
     }
