@@ -483,29 +483,30 @@ impl Overlay {
     /// `+x` (`along_x`) or `+y`; `None` where a crossing of the ray is within rounding of `q`.
     fn ray(&self, q: DVec2, along_x: bool, skip: usize) -> Option<[i32; 2]> {
         let mut w = [0i32; 2];
-        for k in 0..self.pts.len() {
-            if k == skip {
+        // Half-open: a vertex at `q`'s height (or abscissa) counts as above (right), for both
+        // its edges; an edge is met where its box's range holds `q`'s coordinate that way
+        // (`min <= q < max`, the same as its ends lying on different sides) and reaches `q`
+        // along the ray. Only the boxes are read for the others.
+        let (a, b, lo, hi, reach) = if along_x {
+            (q.y, q.x, 2, 3, 1)
+        } else {
+            (q.x, q.y, 0, 1, 3)
+        };
+        for (k, bx) in self.bbox.iter().enumerate() {
+            if !(bx[lo] <= a && a < bx[hi]) || bx[reach] < b || k == skip {
                 continue;
             }
-            let bx = &self.bbox[k];
             let (p0, p1) = (self.pts[k].p, self.pts[self.succ(k)].p);
-            let ahead_of = if along_x {
-                // Half-open in `y`: a vertex at `q.y` counts as above, for both its edges.
-                if (p0.y > q.y) == (p1.y > q.y) || bx[1] < q.x {
-                    continue;
-                }
-                |o: f64, p0: DVec2, p1: DVec2| (o > 0.0) == (p1.y > p0.y)
-            } else {
-                if (p0.x > q.x) == (p1.x > q.x) || bx[3] < q.y {
-                    continue;
-                }
-                |o: f64, p0: DVec2, p1: DVec2| (o < 0.0) == (p1.x > p0.x)
-            };
-            let (o, b) = orient(p0, p1, q);
-            if o.abs() <= b {
+            let (o, bound) = orient(p0, p1, q);
+            if o.abs() <= bound {
                 return None;
             }
-            if ahead_of(o, p0, p1) {
+            let ahead = if along_x {
+                (o > 0.0) == (p1.y > p0.y)
+            } else {
+                (o < 0.0) == (p1.x > p0.x)
+            };
+            if ahead {
                 w[self.fam(k)] += if o > 0.0 { 1 } else { -1 };
             }
         }
