@@ -447,7 +447,11 @@ impl Overlay {
             };
         }
         for k in 0..n {
-            let g = &mut self.slots[self.xstart[k] as usize..self.xstart[k + 1] as usize];
+            let (a, b) = (self.xstart[k] as usize, self.xstart[k + 1] as usize);
+            if b < a + 2 {
+                continue;
+            }
+            let g = &mut self.slots[a..b];
             // Insertion sort: a few crossings per edge.
             for i in 1..g.len() {
                 let mut j = i;
