@@ -960,6 +960,77 @@ mod tests {
         normals.iter().fold(0.0, |m, &n| m.max((n - axis).length()))
     }
 
+    /// The contour [`MeshContours::contour`] finds for a small mesh seen whole ([`Cull::All`]:
+    /// one pass over the faces and edges) is the hierarchy walk's, edge for edge and in the
+    /// same order: for a torus light of 480 triangles and for two tori as one mesh (two
+    /// components), from points around them, close to them and in the plane of some faces.
+    #[test]
+    fn flat_contour_of_a_small_mesh_is_the_walks() {
+        let one = crate::solid::fixtures::torus(0.6, 0.15, 24, 10).unwrap();
+        let (v, t) = (one.vertices(), one.triangles());
+        let shift = DVec3::new(1.7, 0.3, 0.2);
+        let mut verts = v.to_vec();
+        verts.extend(v.iter().map(|&p| p + shift));
+        let n = v.len() as u32;
+        let mut tris = t.to_vec();
+        tris.extend(t.iter().map(|tri| tri.map(|i| i + n)));
+        let two = TriangleMesh::new(verts, tris).unwrap();
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for mesh in [&one, &two] {
+            assert!(mesh.triangles().len() <= FLAT_MAX_FACES);
+            let closed = Closed::new(mesh);
+            let mc = MeshContours::new(mesh, &closed);
+            assert!(mc.comps.iter().all(|c| c.root != NO_TREE));
+            // Points on the face planes through a vertex, off the mesh's box.
+            let mut points: Vec<DVec3> = mesh
+                .triangles()
+                .iter()
+                .take(40)
+                .map(|&[a, b, _]| {
+                    let (a, b) = (mesh.vertices()[a as usize], mesh.vertices()[b as usize]);
+                    a + (b - a) * 40.0
+                })
+                .collect();
+            for _ in 0..200 {
+                let d = DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * 2.0;
+                let r = [0.8, 1.5, 3.0, 30.0][(unit() * 4.0) as usize % 4];
+                points.push(d.normalize_or(DVec3::Z) * r + DVec3::new(0.5, 0.1, 0.0));
+            }
+            let mut found = 0;
+            for x in points {
+                let mut flat = Vec::new();
+                let ok = mc.contour(mesh, x, Cull::All, &mut flat);
+                let inside = mc.comps.iter().any(|c| !outside_box(c.lo, c.hi, x));
+                assert_eq!(ok, !inside, "{x}");
+                if !ok {
+                    continue;
+                }
+                let walk = Walk {
+                    at: FacingAt::new(mesh, x),
+                    normals: mesh.normals(),
+                    offsets: mesh.offsets(),
+                    edges: &mc.edges,
+                    nodes: &mc.nodes,
+                    x,
+                    cone: None,
+                };
+                let mut walked = Vec::new();
+                for c in &mc.comps {
+                    walk.component(c, &mut walked);
+                }
+                assert_eq!(flat, walked, "{x}");
+                found += usize::from(!flat.is_empty());
+            }
+            assert!(found > 100, "{found}");
+        }
+    }
+
     #[test]
     fn cone_axis_narrows_lopsided_normal_sets() {
         // Many normals along +z and a few 60 degrees off along +x: the normalized sum leans

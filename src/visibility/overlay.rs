@@ -712,3 +712,74 @@ impl Overlay {
         if count == 1 { found } else { None }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rays of [`Overlay::resolve`] (edges met by their boxes, half-open) count the same
+    /// winding numbers as [`Overlay::winding`] (edges met by their ends' sides) along `+x`, and
+    /// along `+y` where both decide, at points level with the rings' vertices (where the
+    /// half-open rule decides) and elsewhere: for star-shaped rings of both orientations, one
+    /// of them crossing the others.
+    #[test]
+    fn rays_count_the_windings_at_vertex_heights() {
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut unit = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut checked = 0;
+        for round in 0..40 {
+            let mut o = Overlay::with_capacity(64);
+            o.clear();
+            let mut id = 0;
+            let rings = [(1.0, DVec2::ZERO), (0.6, DVec2::new(0.7, 0.2)), (0.3, DVec2::ZERO)];
+            for (k, (r, centre)) in rings.into_iter().enumerate() {
+                let (r, centre) = (r * (1.0 + 0.3 * unit()), centre + DVec2::splat(0.1 * k as f64));
+                let start = o.pts.len();
+                let n = 5 + (unit() * 8.0) as usize;
+                for k in 0..n {
+                    // The last ring clockwise: winding -1 inside it.
+                    let dir = if round % 2 == 0 && start > 0 { -1.0 } else { 1.0 };
+                    let a = dir * core::f64::consts::TAU * (k as f64 + 0.3 * unit()) / n as f64;
+                    // Grid coordinates, so that vertices share heights with other vertices.
+                    let p = centre + DVec2::new(a.cos(), a.sin()) * r * (0.6 + 0.4 * unit());
+                    let p = (p * 64.0).round() / 64.0;
+                    o.pts.push(RingPoint {
+                        p,
+                        d: DVec3::new(p.x, p.y, 1.0),
+                        id,
+                        bridge: false,
+                    });
+                    id += 1;
+                }
+                o.close(start, LIGHT);
+            }
+            if !o.resolve(DVec3::Z, DVec3::X, DVec3::Y) {
+                continue;
+            }
+            let heights: Vec<DVec2> = o.pts.iter().map(|q| q.p).collect();
+            for v in heights {
+                for q in [
+                    DVec2::new(v.x + 0.25 * unit() - 0.125, v.y),
+                    DVec2::new(v.x, v.y + 0.25 * unit() - 0.125),
+                    v + DVec2::new(unit() - 0.5, unit() - 0.5) * 0.3,
+                ] {
+                    let (Some(wx), Some(w)) = (o.ray(q, true, usize::MAX), o.winding(0, LIGHT, q))
+                    else {
+                        continue;
+                    };
+                    assert_eq!(wx[0], w, "{q}");
+                    if let Some(wy) = o.ray(q, false, usize::MAX) {
+                        assert_eq!(wy[0], w, "{q}");
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked}");
+    }
+}
