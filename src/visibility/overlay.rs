@@ -311,7 +311,8 @@ impl Overlay {
             let (y0, y1) = if a.y <= b.y { (a.y, b.y) } else { (b.y, a.y) };
             self.bbox.push([x0, x1, y0, y1]);
             if !q.bridge {
-                self.order.push(u128::from(order_bits(x0)) << 32 | k as u128);
+                self.order
+                    .push(u128::from(order_bits(x0)) << 32 | k as u128);
             }
         }
         self.order.sort_unstable();
@@ -736,14 +737,25 @@ mod tests {
             let mut o = Overlay::with_capacity(64);
             o.clear();
             let mut id = 0;
-            let rings = [(1.0, DVec2::ZERO), (0.6, DVec2::new(0.7, 0.2)), (0.3, DVec2::ZERO)];
+            let rings = [
+                (1.0, DVec2::ZERO),
+                (0.6, DVec2::new(0.7, 0.2)),
+                (0.3, DVec2::ZERO),
+            ];
             for (k, (r, centre)) in rings.into_iter().enumerate() {
-                let (r, centre) = (r * (1.0 + 0.3 * unit()), centre + DVec2::splat(0.1 * k as f64));
+                let (r, centre) = (
+                    r * (1.0 + 0.3 * unit()),
+                    centre + DVec2::splat(0.1 * k as f64),
+                );
                 let start = o.pts.len();
                 let n = 5 + (unit() * 8.0) as usize;
                 for k in 0..n {
-                    // The last ring clockwise: winding -1 inside it.
-                    let dir = if round % 2 == 0 && start > 0 { -1.0 } else { 1.0 };
+                    // On even rounds the two later rings run clockwise (winding -1 inside).
+                    let dir = if round % 2 == 0 && start > 0 {
+                        -1.0
+                    } else {
+                        1.0
+                    };
                     let a = dir * core::f64::consts::TAU * (k as f64 + 0.3 * unit()) / n as f64;
                     // Grid coordinates, so that vertices share heights with other vertices.
                     let p = centre + DVec2::new(a.cos(), a.sin()) * r * (0.6 + 0.4 * unit());
