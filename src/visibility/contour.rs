@@ -62,6 +62,10 @@ const NORMAL_WEIGHT: f64 = 0.25;
 /// Most edges in a leaf of the facing hierarchy.
 const LEAF_EDGES: usize = 6;
 
+/// Meshes of at most this many faces have their whole contour ([`Cull::All`]) found by one
+/// pass over their faces and edges instead of the facing hierarchy's walk (a multiple of 64).
+const FLAT_MAX_FACES: usize = 1024;
+
 /// Meshes with more components than this get a hierarchy over the components' boxes.
 const COMPONENT_BVH_MIN: usize = 16;
 
@@ -250,6 +254,31 @@ impl MeshContours {
             },
         };
         match cull {
+            Cull::All if mesh.triangles().len() <= FLAT_MAX_FACES => {
+                // A small mesh seen whole (a light's own contour): every face classified once,
+                // in one pass over the planes, costs less than the hierarchy's walk, which
+                // visits most nodes of such a mesh anyway. Edges are taken in their stored
+                // order, as the walk takes them: the same contour in the same order.
+                let mut front = [0u8; FLAT_MAX_FACES];
+                for ((s, &n), &o) in front.iter_mut().zip(mesh.normals()).zip(mesh.offsets()) {
+                    *s = u8::from(at.front(n, o));
+                }
+                // Face indices are below the face count, at most `FLAT_MAX_FACES` (a power of
+                // two): the mask changes none and spares the bounds checks.
+                let bit = |f: u32| front[f as usize & (FLAT_MAX_FACES - 1)];
+                for c in &self.comps {
+                    if !outside_box(c.lo, c.hi, x) {
+                        return false;
+                    }
+                    for &[a, b, f0, f1] in &self.edges[c.start as usize..c.end as usize] {
+                        let s0 = bit(f0);
+                        if s0 != bit(f1) {
+                            out.push(if s0 != 0 { (a, b) } else { (b, a) });
+                        }
+                    }
+                }
+                true
+            }
             Cull::All => {
                 for c in &self.comps {
                     if !outside_box(c.lo, c.hi, x) {
@@ -929,6 +958,77 @@ mod tests {
     /// The largest `|n - axis|` over `normals`.
     fn spread(normals: &[DVec3], axis: DVec3) -> f64 {
         normals.iter().fold(0.0, |m, &n| m.max((n - axis).length()))
+    }
+
+    /// The contour [`MeshContours::contour`] finds for a small mesh seen whole ([`Cull::All`]:
+    /// one pass over the faces and edges) is the hierarchy walk's, edge for edge and in the
+    /// same order: for a torus light of 480 triangles and for two tori as one mesh (two
+    /// components), from points around them, close to them and in the plane of some faces.
+    #[test]
+    fn flat_contour_of_a_small_mesh_is_the_walks() {
+        let one = crate::solid::fixtures::torus(0.6, 0.15, 24, 10).unwrap();
+        let (v, t) = (one.vertices(), one.triangles());
+        let shift = DVec3::new(1.7, 0.3, 0.2);
+        let mut verts = v.to_vec();
+        verts.extend(v.iter().map(|&p| p + shift));
+        let n = v.len() as u32;
+        let mut tris = t.to_vec();
+        tris.extend(t.iter().map(|tri| tri.map(|i| i + n)));
+        let two = TriangleMesh::new(verts, tris).unwrap();
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for mesh in [&one, &two] {
+            assert!(mesh.triangles().len() <= FLAT_MAX_FACES);
+            let closed = Closed::new(mesh);
+            let mc = MeshContours::new(mesh, &closed);
+            assert!(mc.comps.iter().all(|c| c.root != NO_TREE));
+            // Points on the face planes through a vertex, off the mesh's box.
+            let mut points: Vec<DVec3> = mesh
+                .triangles()
+                .iter()
+                .take(40)
+                .map(|&[a, b, _]| {
+                    let (a, b) = (mesh.vertices()[a as usize], mesh.vertices()[b as usize]);
+                    a + (b - a) * 40.0
+                })
+                .collect();
+            for _ in 0..200 {
+                let d = DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * 2.0;
+                let r = [0.8, 1.5, 3.0, 30.0][(unit() * 4.0) as usize % 4];
+                points.push(d.normalize_or(DVec3::Z) * r + DVec3::new(0.5, 0.1, 0.0));
+            }
+            let mut found = 0;
+            for x in points {
+                let mut flat = Vec::new();
+                let ok = mc.contour(mesh, x, Cull::All, &mut flat);
+                let inside = mc.comps.iter().any(|c| !outside_box(c.lo, c.hi, x));
+                assert_eq!(ok, !inside, "{x}");
+                if !ok {
+                    continue;
+                }
+                let walk = Walk {
+                    at: FacingAt::new(mesh, x),
+                    normals: mesh.normals(),
+                    offsets: mesh.offsets(),
+                    edges: &mc.edges,
+                    nodes: &mc.nodes,
+                    x,
+                    cone: None,
+                };
+                let mut walked = Vec::new();
+                for c in &mc.comps {
+                    walk.component(c, &mut walked);
+                }
+                assert_eq!(flat, walked, "{x}");
+                found += usize::from(!flat.is_empty());
+            }
+            assert!(found > 100, "{found}");
+        }
     }
 
     #[test]
