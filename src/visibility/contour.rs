@@ -206,9 +206,10 @@ impl WideNode {
             hi[k] = mid + spread + self.q_hi[k];
         }
         let (front, none) = (1.5 * tol, 0.5 * tol);
+        // Without short-circuits, so that the lanes stay vector operations.
         let mut bits = 0;
         for k in 0..WIDE {
-            bits |= u32::from(!(lo[k] > front) && !(hi[k] < none)) << k;
+            bits |= u32::from(!(lo[k] > front) & !(hi[k] < none)) << k;
         }
         bits
     }
@@ -356,8 +357,14 @@ fn outside_box(lo: DVec3, hi: DVec3, x: DVec3) -> bool {
 /// The cone of [`Cull::Cone`]: the planes' unit normals, their absolute values, and their
 /// products with the point.
 struct Cone {
-    planes: [DVec3; 4],
-    abs: [DVec3; 4],
+    /// The planes' unit normals by coordinate, and their absolute values.
+    px: [f64; 4],
+    py: [f64; 4],
+    pz: [f64; 4],
+    ax: [f64; 4],
+    ay: [f64; 4],
+    az: [f64; 4],
+    /// `p . x` for each plane `p`.
     at_x: [f64; 4],
     /// The rounding margin's part from the point (see [`Cone::classify`]).
     x_margin: f64,
@@ -373,36 +380,42 @@ enum ConeSide {
 impl Cone {
     fn new(planes: &[DVec3; 4], x: DVec3) -> Self {
         Cone {
-            planes: *planes,
-            abs: planes.map(DVec3::abs),
+            px: planes.map(|p| p.x),
+            py: planes.map(|p| p.y),
+            pz: planes.map(|p| p.z),
+            ax: planes.map(|p| p.x.abs()),
+            ay: planes.map(|p| p.y.abs()),
+            az: planes.map(|p| p.z.abs()),
             at_x: planes.map(|p| p.dot(x)),
             x_margin: 2e-9 * x.abs().max_element(),
         }
     }
 
     /// The box of child `k` of node `n` against the cone through the point, beyond rounding
-    /// (`1e-9` of the box's size and of its centre's and the point's coordinates, at least
-    /// `1e-9` of the box's distance from the point): outside where it lies on the negative side
-    /// of a plane, inside where it lies on the positive side of all four.
+    /// (`1e-9` of the box's size and of its centre's and the point's coordinates, so at least
+    /// `1e-9` of the box's offset from the point): outside where it lies on the negative side
+    /// of a plane, inside where it lies on the positive side of all four. The four planes are
+    /// tested side by side (vector lanes), without an early exit.
     #[inline]
     fn classify(&self, n: &WideNode, k: usize) -> ConeSide {
-        let c = DVec3::new(n.cx[k], n.cy[k], n.cz[k]);
-        let half = n.half[k];
+        let (cx, cy, cz) = (n.cx[k], n.cy[k], n.cz[k]);
+        let h = n.half[k];
         let m = n.margin[k] + self.x_margin;
-        let mut inside = true;
+        let (mut mid, mut r) = ([0.0f64; 4], [0.0f64; 4]);
         for j in 0..4 {
             // `p . (c - x)`, with `p . x` computed once per query: its rounding is a few ulps
             // of `|c| + |x|`, far below the margin.
-            let (mid, r) = (
-                self.planes[j].dot(c) - self.at_x[j],
-                self.abs[j].dot(half),
-            );
-            if mid + r < -m {
-                return ConeSide::Outside;
-            }
-            inside &= mid - r > m;
+            mid[j] = self.px[j] * cx + self.py[j] * cy + self.pz[j] * cz - self.at_x[j];
+            r[j] = self.ax[j] * h.x + self.ay[j] * h.y + self.az[j] * h.z;
         }
-        if inside {
+        let (mut outside, mut inside) = (false, true);
+        for j in 0..4 {
+            outside |= mid[j] + r[j] < -m;
+            inside &= mid[j] - r[j] > m;
+        }
+        if outside {
+            ConeSide::Outside
+        } else if inside {
             ConeSide::Inside
         } else {
             ConeSide::Both
