@@ -1092,4 +1092,101 @@ mod tests {
             assert!(spread(&normals, axis) <= base, "{normals:?}");
         }
     }
+
+    /// The wide hierarchy's walk finds exactly the contour edges a test of every edge finds,
+    /// oriented as their front face runs them, from points far from and close to the meshes
+    /// (a few `1e-9` off a face plane, where the bounds must not decide wrongly), with and
+    /// without the cone: with [`Cull::Cone`] it may leave out only edges outside the cone.
+    #[test]
+    fn wide_walk_finds_every_contour_edge() {
+        use crate::solid::fixtures::{bumpy_sphere, torus};
+        let meshes = [
+            bumpy_sphere(3, 0.15, 17).unwrap(),
+            bumpy_sphere(2, 0.3, 5).unwrap(),
+            torus(1.0, 0.3, 40, 16).unwrap(),
+        ];
+        let mut seed = 0xC0_u64;
+        let mut rnd = move || {
+            seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = seed;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut found, mut near, mut culled, mut in_cone) = (0usize, 0usize, 0usize, 0usize);
+        for mesh in &meshes {
+            let closed = Closed::new(mesh);
+            let mc = MeshContours::new(mesh, &closed);
+            assert!(mc.single_tree());
+            let r = mesh.bounding_sphere().radius;
+            for k in 0..60 {
+                let dir = DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(DVec3::Z);
+                let x = if k % 3 == 0 {
+                    // Just off a face plane, outside the mesh's box.
+                    let f = (rnd() * mesh.triangle_count() as f64) as usize;
+                    let [a, b, c] = mesh.triangle(f);
+                    let n = mesh.triangle_normal(f);
+                    let t = n.any_orthonormal_pair().0;
+                    near += 1;
+                    (a + b + c) / 3.0 + t * (3.0 * r) + n * ((rnd() - 0.5) * 4e-9)
+                } else {
+                    mesh.bounding_sphere().center + dir * r * (1.2 + 4.0 * rnd())
+                };
+                let at = FacingAt::new(mesh, x);
+                let mut expect: Vec<(u32, u32)> = mesh
+                    .edges()
+                    .iter()
+                    .filter_map(|e| {
+                        let (s0, s1) = (
+                            at.front(mesh.normals()[e.f0 as usize], mesh.offsets()[e.f0 as usize]),
+                            at.front(mesh.normals()[e.f1 as usize], mesh.offsets()[e.f1 as usize]),
+                        );
+                        (s0 != s1).then_some(if s0 { (e.a, e.b) } else { (e.b, e.a) })
+                    })
+                    .collect();
+                expect.sort_unstable();
+                let mut got = Vec::new();
+                if !mc.contour(mesh, x, Cull::All, &mut got) {
+                    // Declined: the point is in the mesh's box.
+                    continue;
+                }
+                got.sort_unstable();
+                assert_eq!(got, expect, "point {x}");
+                found += got.len();
+                // A cone about a direction to the mesh's bounding sphere, half as wide as it.
+                let aim = mesh.bounding_sphere().center + dir.any_orthonormal_pair().0 * (0.8 * r);
+                let axis = (aim - x).normalize();
+                let (u, v) = axis.any_orthonormal_pair();
+                let w = 0.5 * r / (aim - x).length();
+                let planes = [
+                    (axis * w - u).normalize(),
+                    (axis * w + u).normalize(),
+                    (axis * w - v).normalize(),
+                    (axis * w + v).normalize(),
+                ];
+                let inside = |p: DVec3| planes.iter().all(|n| n.dot(p - x) > 1e-9);
+                let shaft = Shaft::from_cone(x, axis, &planes, axis, 1e3);
+                let mut coned = Vec::new();
+                assert!(mc.contour(mesh, x, Cull::Cone(&shaft, &planes), &mut coned));
+                coned.sort_unstable();
+                for e in &expect {
+                    let verts = mesh.vertices();
+                    let (a, b) = (verts[e.0 as usize], verts[e.1 as usize]);
+                    if inside(a) || inside(b) {
+                        assert!(
+                            coned.binary_search(e).is_ok(),
+                            "edge {e:?} in the cone left out"
+                        );
+                        in_cone += 1;
+                    }
+                }
+                assert!(coned.iter().all(|e| expect.binary_search(e).is_ok()));
+                culled += expect.len() - coned.len();
+            }
+        }
+        assert!(
+            found > 2000 && near > 40 && culled > 1000 && in_cone > 500,
+            "{found} {near} {culled} {in_cone}"
+        );
+    }
 }

@@ -569,8 +569,9 @@ impl<'a> BoxClip<'a> {
                 }
             }
             if ca != 0 {
-                if s0 == usize::MAX || !(t0 < t1) {
-                    // The chord passes the box by (or touches a corner).
+                // Ending inside, the edge enters (at `b` itself where `b` lies on the plane of
+                // the entry, `t0 = 1`); ending outside, it may pass the box by or touch it.
+                if s0 == usize::MAX || (cb != 0 && !(t0 < t1)) {
                     (a, ca) = (b, cb);
                     continue;
                 }
@@ -820,5 +821,130 @@ mod tests {
         for q in &pts {
             assert_eq!(q.p, chart.project(q.d));
         }
+    }
+
+    /// The winding number of the closed polygon `pts` about `q`, or `None` within `1e-9` of an
+    /// edge (for the test: its points are well spread).
+    fn planar_winding(pts: &[DVec2], q: DVec2) -> Option<i32> {
+        let mut w = 0;
+        for k in 0..pts.len() {
+            let (a, b) = (pts[k], pts[(k + 1) % pts.len()]);
+            let cross = (b - a).perp_dot(q - a);
+            let len = (b - a).length();
+            let t = (q - a).dot(b - a) / (len * len);
+            if (-1e-9..=1.0 + 1e-9).contains(&t) && cross.abs() <= 1e-9 * len {
+                return None;
+            }
+            if a.y <= q.y {
+                if b.y > q.y && cross > 0.0 {
+                    w += 1;
+                }
+            } else if b.y <= q.y && cross < 0.0 {
+                w -= 1;
+            }
+        }
+        Some(w)
+    }
+
+    /// Rings in and around the box, self-crossing, winding about it or not, some of their
+    /// vertices on its planes, cut into pieces and closed along its boundary
+    /// ([`BoxClip::pieces`]): inside the box the pieces wind as the ring does up to one
+    /// constant (what the cone-culled path restores with its ray), whether the ring is given
+    /// closed or as an open chain from an outside vertex back to it.
+    #[test]
+    fn box_pieces_wind_as_the_ring_up_to_a_constant() {
+        let chart = Chart {
+            c: DVec3::Z,
+            u: DVec3::X,
+            v: DVec3::Y,
+        };
+        let (lo, hi) = (DVec2::new(-0.5, -0.4), DVec2::new(0.6, 0.5));
+        let (c, u, v) = (chart.c, chart.u, chart.v);
+        let planes = [hi.x * c - u, u - lo.x * c, hi.y * c - v, v - lo.y * c];
+        let clip = BoxClip::new(&planes, lo, hi, c, u, v);
+        let mut seed = 0x5EED_u64;
+        let mut rnd = move || {
+            seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = seed;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut checked, mut cut_rings, mut constants) = (0, 0, [0; 2]);
+        for case in 0..400 {
+            let n = 3 + (rnd() * 12.0) as usize;
+            let spread = [0.3, 1.0, 2.5][case % 3];
+            let mut pts: Vec<DVec2> = (0..n)
+                .map(|_| DVec2::new(rnd() - 0.5, rnd() - 0.5) * 2.0 * spread)
+                .collect();
+            // Vertices on the box's planes and corners.
+            if case % 4 == 1 {
+                pts[0].x = hi.x;
+                pts[n - 1] = lo;
+            }
+            // A ring around the box, once or twice.
+            if case % 5 == 2 {
+                let turns = 1 + case % 2;
+                pts = (0..8 * turns)
+                    .map(|k| {
+                        let a = core::f64::consts::TAU * k as f64 / 8.0;
+                        DVec2::new(a.cos(), a.sin()) * (1.5 + 0.3 * rnd())
+                    })
+                    .collect();
+            }
+            let ring: Vec<RingPoint> = pts
+                .iter()
+                .enumerate()
+                .map(|(k, &p)| RingPoint {
+                    p: DVec2::ZERO,
+                    d: (c + u * p.x + v * p.y) * (0.5 + rnd()),
+                    id: k as u64,
+                    bridge: false,
+                })
+                .collect();
+            for open in [false, true] {
+                let mut chain = ring.clone();
+                if open {
+                    // From an outside vertex round to it again.
+                    let Some(k) = chain.iter().position(|q| clip.code(q.d) != 0) else {
+                        continue;
+                    };
+                    chain.rotate_left(k);
+                    chain.push(chain[0]);
+                }
+                let mut ov = Overlay::default();
+                let mut fresh = FRESH_IDS;
+                assert!(clip.pieces(&chain, open, &chart, &mut ov, &mut fresh));
+                cut_rings += ov.ends.len();
+                // Every point in the box (cut points on its sides within rounding).
+                for q in &ov.pts {
+                    let p = chart.project(q.d);
+                    let e = 1e-12;
+                    assert!(
+                        p.cmpge(lo - e).all() && p.cmple(hi + e).all(),
+                        "{p} outside"
+                    );
+                }
+                let mut constant = None;
+                for i in 0..7 {
+                    for j in 0..7 {
+                        let f = DVec2::new(0.07 + 0.14 * i as f64, 0.05 + 0.15 * j as f64);
+                        let q = lo + (hi - lo) * f;
+                        let (Some(wp), Some(wr)) =
+                            (ov.winding(0, BLOCKER, q), planar_winding(&pts, q))
+                        else {
+                            continue;
+                        };
+                        checked += 1;
+                        let k = *constant.get_or_insert(wp - wr);
+                        assert_eq!(wp - wr, k, "case {case} open {open} at {q}");
+                    }
+                }
+                constants[usize::from(constant.is_some_and(|k| k != 0))] += 1;
+            }
+        }
+        // Enough directions checked, rings cut, and both zero and nonzero constants met.
+        assert!(checked > 20_000 && cut_rings > 300, "{checked} {cut_rings}");
+        assert!(constants[0] > 50 && constants[1] > 50, "{constants:?}");
     }
 }
