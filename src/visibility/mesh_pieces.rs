@@ -270,7 +270,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 let base = (self.slot(b) as u64 + 1) << 32;
                 let first_ring = s.overlay.ends.len();
                 let (ov, buf, cut) = (&mut s.overlay, &mut s.buf, &mut s.cut);
-                let clip = BoxClip::new(&planes, lo, hi, c, u, v);
+                let clip = bvh.map(|_| BoxClip::new(&planes, lo, hi, c, u, v));
                 let mut pieces_ok = true;
                 let ok = chain_rings(
                     &s.edges,
@@ -287,7 +287,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                                 bridge: false,
                             });
                         }
-                        if bvh.is_some() {
+                        if let Some(clip) = &clip {
                             // Cone-culled: the winding inside the box is restored below, so
                             // the pieces may be closed along the box's boundary in any way.
                             pieces_ok &= clip.pieces(buf, open, &chart, ov, &mut fresh);
@@ -430,6 +430,10 @@ fn align_chart(chart: &mut Chart, pts: &mut [RingPoint]) {
 /// counter-clockwise order.
 struct BoxClip<'a> {
     planes: &'a [DVec3; 4],
+    /// The planes' normals by coordinate (for [`BoxClip::code`]'s four lanes).
+    px: [f64; 4],
+    py: [f64; 4],
+    pz: [f64; 4],
     /// The corners after the bottom, right, top and left sides, counter-clockwise.
     corners: [(DVec2, DVec3); 4],
 }
@@ -443,6 +447,9 @@ impl<'a> BoxClip<'a> {
         let corner = |p: DVec2| (p, c + u * p.x + v * p.y);
         BoxClip {
             planes,
+            px: planes.map(|p| p.x),
+            py: planes.map(|p| p.y),
+            pz: planes.map(|p| p.z),
             corners: [
                 corner(DVec2::new(hi.x, lo.y)),
                 corner(hi),
@@ -455,9 +462,12 @@ impl<'a> BoxClip<'a> {
     /// The planes `d` lies strictly outside of, as bits.
     #[inline]
     fn code(&self, d: DVec3) -> u8 {
+        // The four planes side by side (vector lanes); `n . d` as `DVec3::dot` sums it.
+        let s: [f64; 4] =
+            core::array::from_fn(|j| self.px[j] * d.x + self.py[j] * d.y + self.pz[j] * d.z);
         let mut c = 0;
-        for (j, n) in self.planes.iter().enumerate() {
-            c |= u8::from(n.dot(d) < 0.0) << j;
+        for (j, v) in s.iter().enumerate() {
+            c |= u8::from(*v < 0.0) << j;
         }
         c
     }
