@@ -474,8 +474,8 @@ impl<'a> BoxClip<'a> {
 
     /// Adds to `ov` the pieces of the chain `ring` (closed, or `open`: then both its ends must
     /// lie outside the box, else `false`) inside the box, each closed by the box's boundary:
-    /// from where it leaves the box (marked as a bridge), through the corners counter-clockwise
-    /// up to the side where it entered. Inside the box the rings added wind as the chain does
+    /// from where it leaves the box (marked as a bridge), through the corners (the shorter way
+    /// round) up to the side where it entered. Inside the box the rings added wind as the chain does
     /// up to a constant: the chain less these rings is a closed path outside the box or on its
     /// boundary, whose winding is the same at every direction inside. For contours found with
     /// [`Cull::Cone`] that constant is restored anyway (with that of the left-out edges), so
@@ -600,22 +600,33 @@ impl<'a> BoxClip<'a> {
             if cb == 0 {
                 put(ov, start, db, ring[b].id, false);
             } else {
-                // Leaving: along the boundary, counter-clockwise, back to the side it entered.
+                // Leaving: along the boundary back to the side it entered.
                 if s1 == usize::MAX {
                     return false;
                 }
                 let (sa, sb) = vals[s1];
                 put(ov, start, cut(da, sa, db, sb), *fresh, true);
                 *fresh += 1;
-                let (mut p, end) = (SIDE_POS[s1], SIDE_POS[entered]);
-                while p != end {
-                    let (q, d) = self.corners[p];
+                // Either way round is valid: the one through fewer corners (points the
+                // overlay then handles).
+                let (p, end) = (SIDE_POS[s1], SIDE_POS[entered]);
+                let ccw = (end + 4 - p) % 4;
+                let corners = (0..ccw.min(4 - ccw)).map(|i| {
+                    if ccw <= 2 {
+                        // Counter-clockwise: the corners after the sides from the exit's on.
+                        (p + i) % 4
+                    } else {
+                        // Clockwise: the corners before the sides from the exit's back.
+                        (p + 3 - i) % 4
+                    }
+                });
+                for k in corners {
+                    let (q, d) = self.corners[k];
                     put(ov, start, d, *fresh, true);
                     if let Some(last) = ov.pts.last_mut() {
                         last.p = q;
                     }
                     *fresh += 1;
-                    p = (p + 1) % 4;
                 }
                 if ov.pts.len() > start + 1 && ov.pts[ov.pts.len() - 1].d == ov.pts[start].d {
                     ov.pts.pop();
