@@ -19,10 +19,11 @@
 //!   an axis and the range of the planes' offsets from the node's centre, the normal cones of
 //!   Sander et al., *Silhouette clipping*, SIGGRAPH 2000, section 4, with the offsets anchored
 //!   at the node): a node whose faces are all front faces, or none, holds no contour edge and is
-//!   skipped with its subtree. Nodes are stored depth first with the end of each subtree, so
-//!   the walk needs no stack; splits take the longer of the edges' midpoints and their mean
-//!   normals (scaled by the component's size), so that the cones of normals stay narrow in
-//!   meshes such as tori, whose nodes would otherwise hold whole cross-sections of the tube;
+//!   skipped with its subtree. The hierarchy is built binary (splits take the longer of the
+//!   edges' midpoints and their mean normals, scaled by the component's size, so that the cones
+//!   of normals stay narrow in meshes such as tori, whose nodes would otherwise hold whole
+//!   cross-sections of the tube) and walked four children at a time ([`WideNode`]: a node holds
+//!   its binary node's grandchildren's bounds side by side, tested as vector lanes);
 //! - with [`Cull::Cone`], nodes whose boxes lie outside a cone through the point (the light's
 //!   box in the chart) are skipped as well: the contour found is then the part in that cone,
 //!   as open chains and closed rings ([`chain_rings`]); `visibility/mesh_pieces.rs` restores
@@ -476,7 +477,7 @@ impl Walk<'_> {
         // Nodes to visit, with whether their boxes lie inside the cone (no more cone tests
         // below them). A node pushes at most three more than it takes, and the median splits
         // keep the hierarchy balanced: two levels per node, so a stack of 64 holds every
-        // component of fewer than `6 * 2^40` edges; deeper ones decline.
+        // component of fewer than `2^40` edges; deeper ones decline.
         let mut stack = [(0u32, false); 64];
         stack[0] = (c.root, self.cone.is_none());
         let mut top = 1usize;
