@@ -19,10 +19,11 @@
 //!   an axis and the range of the planes' offsets from the node's centre, the normal cones of
 //!   Sander et al., *Silhouette clipping*, SIGGRAPH 2000, section 4, with the offsets anchored
 //!   at the node): a node whose faces are all front faces, or none, holds no contour edge and is
-//!   skipped with its subtree. Nodes are stored depth first with the end of each subtree, so
-//!   the walk needs no stack; splits take the longer of the edges' midpoints and their mean
-//!   normals (scaled by the component's size), so that the cones of normals stay narrow in
-//!   meshes such as tori, whose nodes would otherwise hold whole cross-sections of the tube;
+//!   skipped with its subtree. The hierarchy is built binary (splits take the longer of the
+//!   edges' midpoints and their mean normals, scaled by the component's size, so that the cones
+//!   of normals stay narrow in meshes such as tori, whose nodes would otherwise hold whole
+//!   cross-sections of the tube) and walked four children at a time ([`WideNode`]: a node holds
+//!   its binary node's grandchildren's bounds side by side, tested as vector lanes);
 //! - with [`Cull::Cone`], nodes whose boxes lie outside a cone through the point (the light's
 //!   box in the chart) are skipped as well: the contour found is then the part in that cone,
 //!   as open chains and closed rings ([`chain_rings`]); `visibility/mesh_pieces.rs` restores
@@ -83,7 +84,7 @@ pub(crate) struct MeshContours {
     /// around `f1` ([`crate::solid::MeshEdge`]); grouped by component, and in leaf order within
     /// a component with a hierarchy.
     edges: Vec<[u32; 4]>,
-    nodes: Vec<FacingNode>,
+    nodes: Vec<WideNode>,
 }
 
 /// A connected component (through shared edges) of a closed mesh.
@@ -94,7 +95,7 @@ struct Component {
     /// Its edges: `edges[start..end]`.
     start: u32,
     end: u32,
-    /// Root of its facing hierarchy, or [`NO_TREE`].
+    /// Root of its facing hierarchy (a [`WideNode`]), or [`NO_TREE`].
     root: u32,
 }
 
@@ -126,29 +127,96 @@ struct FacingNode {
     count: u32,
 }
 
-/// How the facing bounds of a node classify its faces from a point.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum NodeFacing {
-    AllFront,
-    NoneFront,
-    Mixed,
+/// Children of a [`WideNode`].
+const WIDE: usize = 4;
+
+/// A node of the facing hierarchy as the query walks it: the [`FacingNode`] bounds of up to four
+/// children side by side, one array per coordinate, so that the four facing tests run as a few
+/// two-lane vector operations (a wide hierarchy, as the BVH4 of ray tracers: Wald et al.,
+/// *Getting rid of packets*, 2008). Each child is the binary hierarchy's grandchild (or child,
+/// where that is a leaf): a query tests the same bounds as in the binary hierarchy, without its
+/// inner levels in between. A slot without a child has bounds that no point can make mixed
+/// (`q_lo = q_hi = -inf`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct WideNode {
+    cx: [f64; WIDE],
+    cy: [f64; WIDE],
+    cz: [f64; WIDE],
+    ax: [f64; WIDE],
+    ay: [f64; WIDE],
+    az: [f64; WIDE],
+    spread: [f64; WIDE],
+    q_lo: [f64; WIDE],
+    q_hi: [f64; WIDE],
+    /// Half extents of the children's boxes (for the cone test).
+    half: [DVec3; WIDE],
+    /// The part of the cone test's rounding margin from the child's box: `1e-9` of its centre's
+    /// largest coordinate and its largest half extent.
+    margin: [f64; WIDE],
+    /// A leaf's first edge, or an inner child's node.
+    child: [u32; WIDE],
+    /// A leaf's edge count; 0 for an inner child (or no child).
+    count: [u32; WIDE],
 }
 
-impl FacingNode {
-    /// The class of the node's faces from the point `x` (facing predicate `at`): all front or
-    /// none only when the bounds clear the predicate's tolerance by half of it either way.
-    #[inline]
-    fn classify(&self, x: DVec3, tol: f64) -> NodeFacing {
-        let y = x - self.center;
-        let mid = self.axis.dot(y);
-        let spread = self.spread * sqrt(y.length_squared());
-        if mid - spread + self.q_lo > 1.5 * tol {
-            NodeFacing::AllFront
-        } else if mid + spread + self.q_hi < 0.5 * tol {
-            NodeFacing::NoneFront
-        } else {
-            NodeFacing::Mixed
+impl WideNode {
+    /// A node without children.
+    fn empty() -> Self {
+        WideNode {
+            cx: [0.0; WIDE],
+            cy: [0.0; WIDE],
+            cz: [0.0; WIDE],
+            ax: [0.0; WIDE],
+            ay: [0.0; WIDE],
+            az: [0.0; WIDE],
+            spread: [0.0; WIDE],
+            q_lo: [f64::NEG_INFINITY; WIDE],
+            q_hi: [f64::NEG_INFINITY; WIDE],
+            half: [DVec3::ZERO; WIDE],
+            margin: [0.0; WIDE],
+            child: [0; WIDE],
+            count: [0; WIDE],
         }
+    }
+
+    /// Child slot `k` set to the bounds of `n`.
+    fn set(&mut self, k: usize, n: &FacingNode, child: u32) {
+        self.cx[k] = n.center.x;
+        self.cy[k] = n.center.y;
+        self.cz[k] = n.center.z;
+        self.ax[k] = n.axis.x;
+        self.ay[k] = n.axis.y;
+        self.az[k] = n.axis.z;
+        self.spread[k] = n.spread;
+        self.q_lo[k] = n.q_lo;
+        self.q_hi[k] = n.q_hi;
+        self.half[k] = n.half;
+        self.margin[k] = 1e-9 * (n.center.abs().max_element() + n.half_max);
+        self.child[k] = child;
+        self.count[k] = n.count;
+    }
+
+    /// The children whose faces may be mixed seen from `x` (facing predicate tolerance `tol`),
+    /// as bits: a child's faces are all front faces where the lower bound of [`FacingNode`]
+    /// clears the tolerance by half of it (`> 1.5 tol`), none where the upper bound stays
+    /// below half of it (`< 0.5 tol`), else mixed.
+    #[inline(always)]
+    fn mixed(&self, x: DVec3, tol: f64) -> u32 {
+        let (mut lo, mut hi) = ([0.0f64; WIDE], [0.0f64; WIDE]);
+        for k in 0..WIDE {
+            let (yx, yy, yz) = (x.x - self.cx[k], x.y - self.cy[k], x.z - self.cz[k]);
+            let mid = self.ax[k] * yx + self.ay[k] * yy + self.az[k] * yz;
+            let spread = self.spread[k] * sqrt(yx * yx + yy * yy + yz * yz);
+            lo[k] = mid - spread + self.q_lo[k];
+            hi[k] = mid + spread + self.q_hi[k];
+        }
+        let (front, none) = (1.5 * tol, 0.5 * tol);
+        // Without short-circuits, so that the lanes stay vector operations.
+        let mut bits = 0;
+        for k in 0..WIDE {
+            bits |= u32::from(!(lo[k] > front) & !(hi[k] < none)) << k;
+        }
+        bits
     }
 }
 
@@ -192,13 +260,14 @@ impl MeshContours {
             fill[k] += 1;
         }
         let mut nodes = Vec::new();
+        let mut binary = Vec::new();
         let comps = (0..nc)
             .map(|k| {
                 let (start, end) = (first[k] as usize, first[k + 1] as usize);
                 let root = if end - start >= TREE_MIN_EDGES {
-                    let r = nodes.len() as u32;
-                    build_tree(mesh, &mut edges[start..end], start as u32, &mut nodes);
-                    r
+                    binary.clear();
+                    build_tree(mesh, &mut edges[start..end], start as u32, &mut binary);
+                    widen(&binary, 0, &mut nodes)
                 } else {
                     NO_TREE
                 };
@@ -223,7 +292,7 @@ impl MeshContours {
     /// Heap bytes held (edges, nodes, components and their hierarchy) plus the struct.
     pub(crate) fn byte_size(&self) -> usize {
         self.edges.len() * core::mem::size_of::<[u32; 4]>()
-            + self.nodes.len() * core::mem::size_of::<FacingNode>()
+            + self.nodes.len() * core::mem::size_of::<WideNode>()
             + self.comps.len() * core::mem::size_of::<Component>()
             + self.comp_bvh.as_ref().map_or(0, Bvh::byte_size)
             + core::mem::size_of::<Self>()
@@ -281,10 +350,9 @@ impl MeshContours {
             }
             Cull::All => {
                 for c in &self.comps {
-                    if !outside_box(c.lo, c.hi, x) {
+                    if !outside_box(c.lo, c.hi, x) || !walk.component(c, out) {
                         return false;
                     }
-                    walk.component(c, out);
                 }
                 true
             }
@@ -292,11 +360,7 @@ impl MeshContours {
                 let mut ok = true;
                 let mut take = |c: &Component| {
                     if ok && shaft.may_meet_box(c.lo, c.hi) {
-                        if outside_box(c.lo, c.hi, x) {
-                            walk.component(c, out);
-                        } else {
-                            ok = false;
-                        }
+                        ok = outside_box(c.lo, c.hi, x) && walk.component(c, out);
                     }
                 };
                 match &self.comp_bvh {
@@ -320,12 +384,20 @@ fn outside_box(lo: DVec3, hi: DVec3, x: DVec3) -> bool {
     x.cmplt(lo - DVec3::splat(m)).any() || x.cmpgt(hi + DVec3::splat(m)).any()
 }
 
-/// The cone of [`Cull::Cone`]: the planes' unit normals and their absolute values.
+/// The cone of [`Cull::Cone`]: the planes' unit normals, their absolute values, and their
+/// products with the point.
 struct Cone {
-    planes: [DVec3; 4],
-    abs: [DVec3; 4],
+    /// The planes' unit normals by coordinate, and their absolute values.
+    px: [f64; 4],
+    py: [f64; 4],
+    pz: [f64; 4],
+    ax: [f64; 4],
+    ay: [f64; 4],
+    az: [f64; 4],
+    /// `p . x` for each plane `p`.
+    at_x: [f64; 4],
     /// The rounding margin's part from the point (see [`Cone::classify`]).
-    x_scale: f64,
+    x_margin: f64,
 }
 
 /// Where a node's box lies against a [`Cone`].
@@ -338,28 +410,42 @@ enum ConeSide {
 impl Cone {
     fn new(planes: &[DVec3; 4], x: DVec3) -> Self {
         Cone {
-            planes: *planes,
-            abs: planes.map(DVec3::abs),
-            x_scale: x.abs().max_element(),
+            px: planes.map(|p| p.x),
+            py: planes.map(|p| p.y),
+            pz: planes.map(|p| p.z),
+            ax: planes.map(|p| p.x.abs()),
+            ay: planes.map(|p| p.y.abs()),
+            az: planes.map(|p| p.z.abs()),
+            at_x: planes.map(|p| p.dot(x)),
+            x_margin: 2e-9 * x.abs().max_element(),
         }
     }
 
-    /// The box of node `n` against the cone through `x`, beyond rounding (`1e-9` of the box's
-    /// size and distance): outside where it lies on the negative side of a plane, inside where
-    /// it lies on the positive side of all four.
+    /// The box of child `k` of node `n` against the cone through the point, beyond rounding
+    /// (`1e-9` of the box's size and of its centre's and the point's coordinates, so at least
+    /// `1e-9` of the box's offset from the point): outside where it lies on the negative side
+    /// of a plane, inside where it lies on the positive side of all four. The four planes are
+    /// tested side by side (vector lanes), without an early exit.
     #[inline]
-    fn classify(&self, n: &FacingNode, x: DVec3) -> ConeSide {
-        let y = n.center - x;
-        let m = 1e-9 * (y.abs().max_element() + n.half_max + self.x_scale);
-        let mut inside = true;
-        for (p, a) in self.planes.iter().zip(&self.abs) {
-            let (mid, r) = (p.dot(y), a.dot(n.half));
-            if mid + r < -m {
-                return ConeSide::Outside;
-            }
-            inside &= mid - r > m;
+    fn classify(&self, n: &WideNode, k: usize) -> ConeSide {
+        let (cx, cy, cz) = (n.cx[k], n.cy[k], n.cz[k]);
+        let h = n.half[k];
+        let m = n.margin[k] + self.x_margin;
+        let (mut mid, mut r) = ([0.0f64; 4], [0.0f64; 4]);
+        for j in 0..4 {
+            // `p . (c - x)`, with `p . x` computed once per query: its rounding is a few ulps
+            // of `|c| + |x|`, far below the margin.
+            mid[j] = self.px[j] * cx + self.py[j] * cy + self.pz[j] * cz - self.at_x[j];
+            r[j] = self.ax[j] * h.x + self.ay[j] * h.y + self.az[j] * h.z;
         }
-        if inside {
+        let (mut outside, mut inside) = (false, true);
+        for j in 0..4 {
+            outside |= mid[j] + r[j] < -m;
+            inside &= mid[j] - r[j] > m;
+        }
+        if outside {
+            ConeSide::Outside
+        } else if inside {
             ConeSide::Inside
         } else {
             ConeSide::Both
@@ -381,7 +467,7 @@ struct Walk<'a> {
     normals: &'a [DVec3],
     offsets: &'a [f64],
     edges: &'a [[u32; 4]],
-    nodes: &'a [FacingNode],
+    nodes: &'a [WideNode],
     x: DVec3,
     cone: Option<Cone>,
 }
@@ -409,50 +495,52 @@ impl Walk<'_> {
         }
     }
 
-    fn component(&self, c: &Component, out: &mut Vec<(u32, u32)>) {
+    /// Appends the contour edges of component `c`; `false` where its hierarchy is deeper than
+    /// the walk's stack (never for a hierarchy of median splits over fewer than `2^40` edges).
+    fn component(&self, c: &Component, out: &mut Vec<(u32, u32)>) -> bool {
         if c.root == NO_TREE {
             self.edges(c.start as usize..c.end as usize, out);
-            return;
+            return true;
         }
         let tol = self.at.tol();
-        // Depth first without a stack: a node's first child is the next node, and an inner
-        // node's `start` is the end of its subtree, where a skipped subtree resumes.
-        let root = &self.nodes[c.root as usize];
-        let end = if root.count > 0 {
-            c.root + 1
-        } else {
-            root.start
-        };
-        let mut i = c.root;
-        // Nodes before this one lie inside the cone (or there is none): no test.
-        let mut inside_until = if self.cone.is_some() { 0 } else { end };
-        while i < end {
+        // Nodes to visit, with whether their boxes lie inside the cone (no more cone tests
+        // below them). A node pushes at most three more than it takes, and the median splits
+        // keep the hierarchy balanced: two levels per node, so a stack of 64 holds every
+        // component of fewer than `2^40` edges; deeper ones decline.
+        let mut stack = [(0u32, false); 64];
+        stack[0] = (c.root, self.cone.is_none());
+        let mut top = 1usize;
+        while top > 0 {
+            top -= 1;
+            let (i, inside) = stack[top];
             let n = &self.nodes[i as usize];
-            let mut mixed = n.classify(self.x, tol) == NodeFacing::Mixed;
-            // The cone is tested at inner nodes only: at a leaf the test would cost about what
-            // its edges' facing tests cost.
-            if mixed
-                && i >= inside_until
-                && n.count == 0
-                && let Some(cone) = &self.cone
-            {
-                match cone.classify(n, self.x) {
-                    ConeSide::Outside => mixed = false,
-                    ConeSide::Inside => inside_until = n.start,
-                    ConeSide::Both => {}
+            let mut mixed = n.mixed(self.x, tol);
+            while mixed != 0 {
+                let k = mixed.trailing_zeros() as usize;
+                mixed &= mixed - 1;
+                if n.count[k] > 0 {
+                    let start = n.child[k] as usize;
+                    self.edges(start..start + n.count[k] as usize, out);
+                    continue;
                 }
-            }
-            if n.count > 0 {
-                if mixed {
-                    self.edges(n.start as usize..(n.start + n.count) as usize, out);
+                // The cone is tested at inner nodes only: at a leaf the test would cost about
+                // what its edges' facing tests cost.
+                let mut child_inside = inside;
+                if !inside && let Some(cone) = &self.cone {
+                    match cone.classify(n, k) {
+                        ConeSide::Outside => continue,
+                        ConeSide::Inside => child_inside = true,
+                        ConeSide::Both => {}
+                    }
                 }
-                i += 1;
-            } else if mixed {
-                i += 1;
-            } else {
-                i = n.start;
+                if top == stack.len() {
+                    return false;
+                }
+                stack[top] = (n.child[k], child_inside);
+                top += 1;
             }
         }
+        true
     }
 }
 
@@ -543,6 +631,47 @@ fn build_tree(
         stack.push((first + m, end));
         stack.push((first, first + m));
     }
+}
+
+/// The [`WideNode`]s of the binary facing hierarchy `bin` (as [`build_tree`] lays it out) below
+/// its node `i`, appended to `wide`; returns the index of the first. A node's children are its
+/// binary node's grandchildren, or its children where those are leaves.
+fn widen(bin: &[FacingNode], i: usize, wide: &mut Vec<WideNode>) -> u32 {
+    let me = wide.len();
+    wide.push(WideNode::empty());
+    // A leaf root (never built: components of fewer than `TREE_MIN_EDGES` edges have no
+    // hierarchy) is the node's one child.
+    let kids = |i: usize| -> [usize; 2] {
+        let a = i + 1;
+        let b = if bin[a].count > 0 {
+            a + 1
+        } else {
+            bin[a].start as usize
+        };
+        [a, b]
+    };
+    let mut slots: SmallVec<[usize; WIDE]> = SmallVec::new();
+    if bin[i].count > 0 {
+        slots.push(i);
+    } else {
+        for c in kids(i) {
+            if bin[c].count > 0 {
+                slots.push(c);
+            } else {
+                slots.extend(kids(c));
+            }
+        }
+    }
+    for (k, &b) in slots.iter().enumerate() {
+        let n = &bin[b];
+        let child = if n.count > 0 {
+            n.start
+        } else {
+            widen(bin, b, wide)
+        };
+        wide[me].set(k, n, child);
+    }
+    me as u32
 }
 
 /// Orients and orders a leaf's edges so that edges sharing a face come in runs with it as their
@@ -1063,5 +1192,102 @@ mod tests {
             let base = spread(&normals, sum.try_normalize().unwrap_or(DVec3::Z));
             assert!(spread(&normals, axis) <= base, "{normals:?}");
         }
+    }
+
+    /// The wide hierarchy's walk finds exactly the contour edges a test of every edge finds,
+    /// oriented as their front face runs them, from points far from and close to the meshes
+    /// (a few `1e-9` off a face plane, where the bounds must not decide wrongly), with and
+    /// without the cone: with [`Cull::Cone`] it may leave out only edges outside the cone.
+    #[test]
+    fn wide_walk_finds_every_contour_edge() {
+        use crate::solid::fixtures::{bumpy_sphere, torus};
+        let meshes = [
+            bumpy_sphere(3, 0.15, 17).unwrap(),
+            bumpy_sphere(2, 0.3, 5).unwrap(),
+            torus(1.0, 0.3, 40, 16).unwrap(),
+        ];
+        let mut seed = 0xC0_u64;
+        let mut rnd = move || {
+            seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = seed;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut found, mut near, mut culled, mut in_cone) = (0usize, 0usize, 0usize, 0usize);
+        for mesh in &meshes {
+            let closed = Closed::new(mesh);
+            let mc = MeshContours::new(mesh, &closed);
+            assert!(mc.single_tree());
+            let r = mesh.bounding_sphere().radius;
+            for k in 0..60 {
+                let dir = DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(DVec3::Z);
+                let x = if k % 3 == 0 {
+                    // Just off a face plane, outside the mesh's box.
+                    let f = (rnd() * mesh.triangle_count() as f64) as usize;
+                    let [a, b, c] = mesh.triangle(f);
+                    let n = mesh.triangle_normal(f);
+                    let t = n.any_orthonormal_pair().0;
+                    near += 1;
+                    (a + b + c) / 3.0 + t * (3.0 * r) + n * ((rnd() - 0.5) * 4e-9)
+                } else {
+                    mesh.bounding_sphere().center + dir * r * (1.2 + 4.0 * rnd())
+                };
+                let at = FacingAt::new(mesh, x);
+                let mut expect: Vec<(u32, u32)> = mesh
+                    .edges()
+                    .iter()
+                    .filter_map(|e| {
+                        let (s0, s1) = (
+                            at.front(mesh.normals()[e.f0 as usize], mesh.offsets()[e.f0 as usize]),
+                            at.front(mesh.normals()[e.f1 as usize], mesh.offsets()[e.f1 as usize]),
+                        );
+                        (s0 != s1).then_some(if s0 { (e.a, e.b) } else { (e.b, e.a) })
+                    })
+                    .collect();
+                expect.sort_unstable();
+                let mut got = Vec::new();
+                if !mc.contour(mesh, x, Cull::All, &mut got) {
+                    // Declined: the point is in the mesh's box.
+                    continue;
+                }
+                got.sort_unstable();
+                assert_eq!(got, expect, "point {x}");
+                found += got.len();
+                // A cone about a direction to the mesh's bounding sphere, half as wide as it.
+                let aim = mesh.bounding_sphere().center + dir.any_orthonormal_pair().0 * (0.8 * r);
+                let axis = (aim - x).normalize();
+                let (u, v) = axis.any_orthonormal_pair();
+                let w = 0.5 * r / (aim - x).length();
+                let planes = [
+                    (axis * w - u).normalize(),
+                    (axis * w + u).normalize(),
+                    (axis * w - v).normalize(),
+                    (axis * w + v).normalize(),
+                ];
+                let inside = |p: DVec3| planes.iter().all(|n| n.dot(p - x) > 1e-9);
+                let shaft = Shaft::from_cone(x, axis, &planes, axis, 1e3);
+                let mut coned = Vec::new();
+                assert!(mc.contour(mesh, x, Cull::Cone(&shaft, &planes), &mut coned));
+                coned.sort_unstable();
+                for e in &expect {
+                    let verts = mesh.vertices();
+                    let (a, b) = (verts[e.0 as usize], verts[e.1 as usize]);
+                    if inside(a) || inside(b) {
+                        assert!(
+                            coned.binary_search(e).is_ok(),
+                            "edge {e:?} in the cone left out"
+                        );
+                        in_cone += 1;
+                    }
+                }
+                assert!(coned.iter().all(|e| expect.binary_search(e).is_ok()));
+                culled += expect.len() - coned.len();
+            }
+        }
+        assert!(
+            found > 2000 && near > 40 && culled > 1000 && in_cone > 500,
+            "{found} {near} {culled} {in_cone}"
+        );
     }
 }
