@@ -369,6 +369,14 @@ impl Tree {
         self.garbage = 0;
     }
 
+    /// The reach of the tree's sign filter: at least `|p - c|` in each coordinate, after
+    /// rounding, for any two of its occluder vertices, cell and light corners
+    /// ([`Orienter::reach_bound`]).
+    #[inline]
+    pub(crate) fn reach(&self) -> f64 {
+        self.reach
+    }
+
     /// The largest [`Tree::bytes`] so far.
     pub(crate) fn peak_bytes(&self) -> usize {
         self.peak_bytes

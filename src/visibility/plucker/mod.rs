@@ -77,7 +77,11 @@
 //! Every tree has a memory cap (bytes, [`PluckerContext::with_budget`] /
 //! [`PluckerVisibility::with_tree_cap`]). A tree that outgrows it during a query is reset to
 //! its root and the query repeated; a query that alone outgrows it (from an empty tree) is
-//! answered by the clipping backend. Neither aborts; [`PluckerStats`] counts both.
+//! answered by the clipping backend. Neither aborts; [`PluckerStats`] counts both. A point that
+//! cannot use its cell's shared tree (it lies within the near band of a blocker's plane, or
+//! sees one edge-on) takes a tree of its own, or, when the shared tree is crowded (more than 64
+//! occluders, where a tree for one point costs more than the clipping backend), the clipping
+//! backend's answer ([`PluckerStats::crowded_fallbacks`]).
 //!
 //! # References
 //!
@@ -943,7 +947,9 @@ impl Tile {
 /// at 10K, 113 occluders, +8%; a quarter of the side at 100K, -19%; with pairs of mesh
 /// triangles merged, `tile.rs`, a threshold of 160 instead of 256 at 100K: -3.7%, and a second
 /// split of tiles still above it: +10%). Points within `1e-5` of
-/// that magnitude of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`). A
+/// that magnitude of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`),
+/// or the clipping backend's answer when the shared tree holds more than 64 occluders
+/// ([`PluckerStats::crowded_fallbacks`]). A
 /// context follows one backend at a time (it clears itself when used with another).
 ///
 /// The budget bounds the bytes of all cached trees: least recently used tiles are dropped to
