@@ -133,9 +133,9 @@ const MAX_SPLIT: u8 = 1;
 /// plane or sees one edge-on, `tile.rs`) is answered by the clipping backend instead of a tree
 /// of its own when the shared tree holds more occluders than this: a tree built and developed
 /// for one point costs about as much as a query without reuse, and in shafts this crowded that
-/// is more than the clipping backend's answer (`benches/plucker.rs`, a tree per query against
-/// `clip`: 0.8x at 968 terrain triangles, 40 occluders per tree; 1.8x at 10K, 95; 3.5x at
-/// 100K, 220; 0.16x on the boxes at 100K, 32). Both answers are exact; where the clipping
+/// is more than the clipping backend's answer (`benches/plucker.rs`, the cost of a tree per
+/// query over `clip`'s: 0.75x at 968 terrain triangles, 34 occluders per shared tree at most;
+/// 1.3x at 10K, 85; 2.5x at 100K, 223; 0.16x on the boxes at 100K, 29). Both answers are exact; where the clipping
 /// backend gives up (`GeomError`), the point's own tree answers.
 const CROWDED_OCCLUDERS: usize = 64;
 
