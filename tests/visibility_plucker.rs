@@ -1242,3 +1242,57 @@ fn a_blocker_flat_on_the_tile_plane_below_the_light_leaves_the_shared_tree_in_us
         "{stats:?}"
     );
 }
+
+#[test]
+fn a_point_off_a_crowded_shared_tree_is_answered_by_the_clipping_backend() {
+    // The plate of the test above sends every point to a tree of its own; with a sieve of 120
+    // small triangles in the shaft the tile's tree holds more than 64 occluders, and the
+    // clipping backend answers those points instead (a tree of a point's own would cost more).
+    // With the sieve thinned to 30 triangles they take their own trees again. Either way the
+    // answers are the clipping backend's.
+    let quad = TriangleMesh::quad(DVec3::new(2.0, 0.0, 0.05), DVec3::Z * 0.25, DVec3::Y * 0.5);
+    let sieve = |every: usize| {
+        let (mut verts, mut tris) = (Vec::new(), Vec::new());
+        for k in (0..120).step_by(every) {
+            let (i, j) = ((k / 12) as f64, (k % 12) as f64);
+            let c = DVec3::new(1.0, -0.2 + 0.035 * j, 0.005 + 0.012 * i);
+            let n = verts.len() as u32;
+            verts.extend([
+                c,
+                c + DVec3::new(0.0, 0.01, 0.0),
+                c + DVec3::new(0.0, 0.0, 0.006),
+            ]);
+            tris.push([n, n + 1, n + 2]);
+        }
+        Body::Mesh(TriangleMesh::new(verts, tris).unwrap())
+    };
+    let sa = |p: Vec<SphericalPolygon>| p.iter().map(SphericalPolygon::solid_angle).sum::<f64>();
+    for (every, crowded) in [(1, true), (4, false)] {
+        let scene = Scene::new(
+            vec![light(quad.clone().unwrap(), DVec3::ONE)],
+            vec![flat_plate(0.5, 5e-7), sieve(every)],
+        )
+        .unwrap();
+        let clip = scene.visibility();
+        let pl = PluckerVisibility::from_clip(clip.clone());
+        let mut ctx = PluckerContext::new(0.1).unwrap();
+        let mut rng = Rng::new(41);
+        for f in ground_points(&mut rng, 0.02) {
+            let unoccluded = sa(clip.unoccluded_region(0, &f).unwrap());
+            let reference = sa(clip.visible_region(0, &f).unwrap());
+            let shared = sa(pl.visible_region_in(&mut ctx, 0, &f).unwrap());
+            assert!(
+                (shared - reference).abs() <= 1e-9 * unoccluded,
+                "{:?}: shared {shared}, clip {reference}",
+                f.origin()
+            );
+        }
+        let s = ctx.stats();
+        let expect = if crowded { 16 } else { 0 };
+        assert!(
+            s.edge_on_fallbacks == 16 && s.crowded_fallbacks == expect,
+            "sieve of 120 / {every}: {s:?}"
+        );
+        assert_eq!(s.max_tree_occluders > 64, crowded, "{s:?}");
+    }
+}

@@ -19,8 +19,9 @@ use smallvec::SmallVec;
 
 use super::line::{Orienter, Sign};
 
-/// Most vertices of a clipped occluder: a triangle cut by two planes.
-pub(crate) const MAX_OCCLUDER_VERTICES: usize = 5;
+/// Most vertices of an occluder: a triangle cut by two planes has 5, a merged patch of mesh
+/// triangles up to this many (`tile.rs`, `merge_patches`).
+pub(crate) const MAX_OCCLUDER_VERTICES: usize = 6;
 
 /// Tries of the light's test before its rate of decisions counts ([`Tree::try_light`]).
 const LIGHT_WARMUP: u32 = 256;
@@ -52,9 +53,9 @@ pub(crate) enum Crossing {
 
 /// An occluder polygon in the tree's coordinates, its vertices in the blocker's winding order:
 /// a blocker triangle clipped to the part that can lie between a shading point of the tile and
-/// the light (convex), or two whole triangles of one mesh sharing an edge, merged into the
-/// quadrilateral of their outer edges where every point of the tile sees it convex (not
-/// necessarily planar; `tile.rs`, `merged_quad`).
+/// the light (convex), or whole triangles of one mesh sharing edges, merged into the polygon
+/// of their outer edges where every point of the tile sees it convex (not necessarily planar;
+/// `tile.rs`, `merge_patches`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Occluder {
     verts: [DVec3; MAX_OCCLUDER_VERTICES],
@@ -366,6 +367,14 @@ impl Tree {
         }
         self.spare = core::mem::replace(&mut self.lists, fresh);
         self.garbage = 0;
+    }
+
+    /// The reach of the tree's sign filter: at least `|p - c|` in each coordinate, after
+    /// rounding, for any two of its occluder vertices, cell and light corners
+    /// ([`Orienter::reach_bound`]).
+    #[inline]
+    pub(crate) fn reach(&self) -> f64 {
+        self.reach
     }
 
     /// The largest [`Tree::bytes`] so far.

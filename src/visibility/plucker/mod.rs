@@ -77,7 +77,11 @@
 //! Every tree has a memory cap (bytes, [`PluckerContext::with_budget`] /
 //! [`PluckerVisibility::with_tree_cap`]). A tree that outgrows it during a query is reset to
 //! its root and the query repeated; a query that alone outgrows it (from an empty tree) is
-//! answered by the clipping backend. Neither aborts; [`PluckerStats`] counts both.
+//! answered by the clipping backend. Neither aborts; [`PluckerStats`] counts both. A point that
+//! cannot use its cell's shared tree (it lies within the near band of a blocker's plane, or
+//! sees one edge-on) takes a tree of its own, or, when the shared tree is crowded (more than 64
+//! occluders, where a tree for one point costs more than the clipping backend), the clipping
+//! backend's answer ([`PluckerStats::crowded_fallbacks`]).
 //!
 //! # References
 //!
@@ -124,6 +128,16 @@ const SPLIT_OCCLUDERS: usize = 160;
 
 /// How many times a tile may be halved.
 const MAX_SPLIT: u8 = 1;
+
+/// A point that cannot use its tile's shared tree (it lies in the near band of a blocker's
+/// plane or sees one edge-on, `tile.rs`) is answered by the clipping backend instead of a tree
+/// of its own when the shared tree holds more occluders than this: a tree built and developed
+/// for one point costs about as much as a query without reuse, and in shafts this crowded that
+/// is more than the clipping backend's answer (`benches/plucker.rs`, the cost of a tree per
+/// query over `clip`'s: 0.75x at 968 terrain triangles, 34 occluders per shared tree at most;
+/// 1.3x at 10K, 85; 2.5x at 100K, 223; 0.16x on the boxes at 100K, 29). Both answers are exact; where the clipping
+/// backend gives up (`GeomError`), the point's own tree answers.
+const CROWDED_OCCLUDERS: usize = 64;
 
 /// The default memory cap of one tree, in bytes.
 pub const DEFAULT_TREE_CAP: usize = 64 << 20;
@@ -404,9 +418,22 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
                 },
                 None => Status::Fallback,
             };
+            if status == Status::Crowded {
+                let clip = if blocked {
+                    self.clip.visible_region(light, frame)
+                } else {
+                    self.clip.unoccluded_region(light, frame)
+                };
+                if let Ok(region) = clip {
+                    if let Some(c) = ctx.as_deref_mut() {
+                        c.stats.crowded_fallbacks += 1;
+                    }
+                    return Ok(region);
+                }
+            }
             let status = match status {
                 Status::Done => Status::Done,
-                Status::Fallback => {
+                Status::Fallback | Status::Crowded => {
                     let ws = match ctx.as_deref_mut() {
                         Some(c) => &mut c.ws,
                         None => &mut local_scratch,
@@ -493,7 +520,11 @@ impl<L: AsRef<Body>> PluckerVisibility<L> {
         };
         if built.excludes(x, n, polys, &|b| self.mesh_of(b)) {
             stats.edge_on_fallbacks += 1;
-            return Ok(Status::Fallback);
+            return Ok(if built.tree.occluder_count() > CROWDED_OCCLUDERS {
+                Status::Crowded
+            } else {
+                Status::Fallback
+            });
         }
         let tree = &mut built.tree;
         if !*reuse {
@@ -697,6 +728,9 @@ enum Status {
     Done,
     /// The shared tree does not apply to this point: use a tree of its own.
     Fallback,
+    /// The shared tree does not apply to this point and holds more than [`CROWDED_OCCLUDERS`]
+    /// occluders: ask the clipping backend, else use a tree of its own.
+    Crowded,
     /// One query alone outgrew the cap: answer by the clipping backend.
     TooBig,
     /// The tile was split: look up the point's sub-cell.
@@ -808,6 +842,9 @@ pub struct PluckerStats {
     /// (its part above the tile plane within that band of it) may hide some of the light
     /// from, answered by a tree of their own.
     pub edge_on_fallbacks: u64,
+    /// Of those, queries answered by the clipping backend because the shared tree was crowded
+    /// (a tree of the point's own would cost more; see [`PluckerContext`]).
+    pub crowded_fallbacks: u64,
     /// Visible fragments returned.
     pub fragments: u64,
     /// The largest tree seen, in bytes.
@@ -910,7 +947,9 @@ impl Tile {
 /// at 10K, 113 occluders, +8%; a quarter of the side at 100K, -19%; with pairs of mesh
 /// triangles merged, `tile.rs`, a threshold of 160 instead of 256 at 100K: -3.7%, and a second
 /// split of tiles still above it: +10%). Points within `1e-5` of
-/// that magnitude of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`). A
+/// that magnitude of a blocker's plane get a tree of their own (see `tile.rs`, `NEAR_BAND`),
+/// or the clipping backend's answer when the shared tree holds more than 64 occluders
+/// ([`PluckerStats::crowded_fallbacks`]). A
 /// context follows one backend at a time (it clears itself when used with another).
 ///
 /// The budget bounds the bytes of all cached trees: least recently used tiles are dropped to

@@ -335,7 +335,12 @@ fn relevant_occluder(
 ) -> Option<u32> {
     let k = frag.len();
     let c = frag.iter().copied().sum::<DVec3>() / k as f64;
-    let mut planes: SmallVec<[Orienter; 8]> = SmallVec::new();
+    // Every point the separation tests evaluate, an occluder vertex or a fragment corner (a
+    // point of the light) relative to `x`, is within the tree's reach of the origin: `x` lies
+    // in the tile (a hair off its corners' hull, far less than the reach), so twice the reach
+    // bounds it after rounding.
+    let reach = 2.0 * tree.reach();
+    let mut planes: SmallVec<[(Orienter, f64); 8]> = SmallVec::new();
     let mut inside = None;
     for i in 0..k {
         let or = Orienter::new(frag[i], frag[(i + 1) % k], DVec3::ZERO);
@@ -347,14 +352,14 @@ fn relevant_occluder(
             break;
         }
         inside = side;
-        planes.push(or);
+        planes.push((or, or.reach_bound(reach)));
     }
     let outside = inside.map(Sign::flip);
     let first = tree.pick(len as usize);
     for step in 0..len as usize {
         let i = (first + step) % len as usize;
         let o = tree.list(start, len)[i];
-        if !separated(tree.occluder(o), x, frag, &planes, outside) {
+        if !separated(tree.occluder(o), x, frag, &planes, outside, reach) {
             return Some(o);
         }
     }
@@ -363,14 +368,17 @@ fn relevant_occluder(
 
 /// Whether a plane through the origin (the point) strictly separates the occluder `occ`
 /// (at `x`) from the fragment `frag`: one of the fragment's edge planes `planes` (with the
-/// side `outside` away from the fragment), or one through an edge of the occluder not on the
-/// tile plane (see the module documentation).
+/// side `outside` away from the fragment, and each plane's bound of the filter for points
+/// within `reach`), or one through an edge of the occluder not on the tile plane (see the
+/// module documentation). Every point tested lies within `reach` of the origin in each
+/// coordinate ([`Orienter::strict_sign_within`]).
 fn separated(
     occ: &Occluder,
     x: DVec3,
     frag: &[DVec3],
-    planes: &[Orienter],
+    planes: &[(Orienter, f64)],
     outside: Option<Sign>,
+    reach: f64,
 ) -> bool {
     let verts = occ.vertices();
     let mut buf = [DVec3::ZERO; MAX_OCCLUDER_VERTICES];
@@ -379,8 +387,10 @@ fn separated(
     }
     let v = &buf[..verts.len()];
     if let Some(out) = outside {
-        for pl in planes {
-            if v.iter().all(|&p| pl.strict_sign(p) == Some(out)) {
+        for (pl, bound) in planes {
+            if v.iter()
+                .all(|&p| pl.strict_sign_within(p, *bound) == Some(out))
+            {
                 return true;
             }
         }
@@ -395,7 +405,11 @@ fn separated(
             continue;
         };
         let away = Some(inner.flip());
-        if frag.iter().all(|&e| or.strict_sign(e) == away) {
+        let bound = or.reach_bound(reach);
+        if frag
+            .iter()
+            .all(|&e| or.strict_sign_within(e, bound) == away)
+        {
             return true;
         }
     }
