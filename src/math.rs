@@ -92,3 +92,17 @@ pub(crate) fn unit_scaled(m: glam::DMat3) -> Option<glam::DMat3> {
     let largest = m.abs().to_cols_array().into_iter().fold(0.0, f64::max);
     (largest > 0.0 && largest.is_finite()).then(|| m * (1.0 / largest))
 }
+
+/// A deterministic stream of uniform numbers in `[0, 1)` for the unit tests' random cases
+/// (SplitMix64, 53 bits a number): one generator the tests share instead of a copy each.
+#[cfg(test)]
+pub(crate) fn test_unit_stream(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}

@@ -1104,13 +1104,7 @@ mod tests {
         let mut tris = t.to_vec();
         tris.extend(t.iter().map(|tri| tri.map(|i| i + n)));
         let two = TriangleMesh::new(verts, tris).unwrap();
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut unit = move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = crate::math::test_unit_stream(0x9e37_79b9_7f4a_7c15);
         for mesh in [&one, &two] {
             assert!(mesh.triangles().len() <= FLAT_MAX_FACES);
             let closed = Closed::new(mesh);
@@ -1208,14 +1202,7 @@ mod tests {
             bumpy_sphere(2, 0.3, 5).unwrap(),
             torus(1.0, 0.3, 40, 16).unwrap(),
         ];
-        let mut seed = 0xC0_u64;
-        let mut rnd = move || {
-            seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = seed;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::math::test_unit_stream(0xC0);
         let (mut found, mut near, mut culled, mut in_cone) = (0usize, 0usize, 0usize, 0usize);
         for mesh in &meshes {
             let closed = Closed::new(mesh);

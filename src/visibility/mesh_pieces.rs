@@ -883,14 +883,7 @@ mod tests {
         let (c, u, v) = (chart.c, chart.u, chart.v);
         let planes = [hi.x * c - u, u - lo.x * c, hi.y * c - v, v - lo.y * c];
         let clip = BoxClip::new(&planes, lo, hi, c, u, v);
-        let mut seed = 0x5EED_u64;
-        let mut rnd = move || {
-            seed = seed.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = seed;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::math::test_unit_stream(0x5EED);
         let (mut checked, mut cut_rings, mut constants) = (0, 0, [0; 2]);
         for case in 0..400 {
             let n = 3 + (rnd() * 12.0) as usize;

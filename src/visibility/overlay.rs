@@ -725,13 +725,7 @@ mod tests {
     /// of them crossing the others.
     #[test]
     fn rays_count_the_windings_at_vertex_heights() {
-        let mut rng = 0x2545_f491_4f6c_dd1du64;
-        let mut unit = move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = crate::math::test_unit_stream(0x2545_f491_4f6c_dd1d);
         let mut checked = 0;
         for round in 0..40 {
             let mut o = Overlay::with_capacity(64);

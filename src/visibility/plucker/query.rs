@@ -772,13 +772,7 @@ mod tests {
         // out by relative amounts from 1e-16 to 1e-2 (convex, flat, reflex), repeated within
         // rounding, two of them swapped (a crossing ring for more than three), or squeezed to
         // slivers.
-        let mut s = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = crate::math::test_unit_stream(0x9e37_79b9_7f4a_7c15);
         let (mut taken, mut checked) = (0, 0);
         for case in 0..20_000 {
             let n = 3 + (rnd() * 6.0) as usize;
