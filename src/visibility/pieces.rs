@@ -571,6 +571,9 @@ impl Pieces {
             inside |= u64::from(first == u32::MAX) << start;
             let (mut prev, mut prev1) = (first, first1);
             for b in start + 1..=end {
+                // The edge's first end: the previous vertex (the ring's last one for the
+                // closing edge, whose second end is the ring's first).
+                let a = b - 1;
                 let (b, out, b1) = if b == end {
                     (start, first, first1)
                 } else {
@@ -581,7 +584,6 @@ impl Pieces {
                     inside |= u64::from(out == u32::MAX) << b;
                     (b, out, b1)
                 };
-                let a = if b == start { end - 1 } else { b - 1 };
                 // Every side of both ends before the first plane either end is outside of is
                 // positive, and was checked against its bound: the crossings' pass starts there.
                 // Ends outside `K` by different first planes: where the end with the earlier
