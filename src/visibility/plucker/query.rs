@@ -267,7 +267,7 @@ fn split_parts(
             push_point(&mut minus, p);
         }
     }
-    let mut append = |mut f: Fragment| {
+    let mut append = |f: &mut Fragment| {
         while f.len() > 1 && f.first() == f.last() {
             f.pop();
         }
@@ -275,11 +275,11 @@ fn split_parts(
             return None;
         }
         let start = pool.len();
-        pool.extend_from_slice(&f);
+        pool.extend_from_slice(f);
         Some((start as u32, f.len() as u32))
     };
-    let minus = append(minus);
-    (minus, append(plus))
+    let minus = append(&mut minus);
+    (minus, append(&mut plus))
 }
 
 /// The point where the edge `a -> b` crosses a plane, from the plane's values `va`, `vb` at its
