@@ -204,9 +204,6 @@ pub(crate) struct Orienter {
     m: DVec3,
     /// The permanent's factors: `|u_y w_z| + |u_z w_y|` and its cyclic shifts.
     mabs: DVec3,
-    /// The plane is well conditioned: `|m|` is at least [`WELL_CONDITIONED`] of `|mabs|`, so a
-    /// value within the error bound means a point within a tiny distance of the plane.
-    well: bool,
 }
 
 /// The smallest ratio `|(a - o) x (b - o)| / |mabs|` for which [`Orienter::eval_near`] takes a
@@ -227,16 +224,15 @@ impl Orienter {
             (u.z * w.x).abs() + (u.x * w.z).abs(),
             (u.x * w.y).abs() + (u.y * w.x).abs(),
         );
-        let well =
-            m.length_squared() >= WELL_CONDITIONED * WELL_CONDITIONED * mabs.length_squared();
-        Orienter {
-            o,
-            a,
-            b,
-            m,
-            mabs,
-            well,
-        }
+        Orienter { o, a, b, m, mabs }
+    }
+
+    /// Whether the plane is well conditioned: `|m|` is at least [`WELL_CONDITIONED`] of
+    /// `|mabs|`, so a value within the error bound means a point within a tiny distance of the
+    /// plane. Computed only when a sign falls within the bound (rarely), not per orienter.
+    #[inline]
+    fn well(&self) -> bool {
+        self.m.length_squared() >= WELL_CONDITIONED * WELL_CONDITIONED * self.mabs.length_squared()
     }
 
     /// The `f64` value of the determinant (for interpolation) and its certified sign.
@@ -276,10 +272,29 @@ impl Orienter {
         let (s, strict) = self.eval_filtered(p);
         let sign = match strict {
             Some(sign) => sign,
-            None if self.well => Sign::Zero,
+            None if self.well() => Sign::Zero,
             None => orient_exact(p, self.a, self.b, self.o),
         };
         (s, sign)
+    }
+
+    /// [`Orienter::eval_near`] for a point within the reach of `bound`
+    /// ([`Orienter::reach_bound`]): a value beyond `bound` is certified with one dot product,
+    /// without the point's own permanent; anything else takes [`Orienter::eval_near`]. The
+    /// value is computed the same way either way, and `bound` is never below the per-point
+    /// filter's bound, so the answer is the same.
+    #[inline]
+    pub(crate) fn eval_near_within(&self, p: DVec3, bound: f64) -> (f64, Sign) {
+        let s = (p - self.o).dot(self.m);
+        if bound > 0.0 {
+            if s > bound {
+                return (s, Sign::Positive);
+            }
+            if s < -bound {
+                return (s, Sign::Negative);
+            }
+        }
+        self.eval_near(p)
     }
 
     /// The certified sign alone.

@@ -69,16 +69,114 @@ enum Class {
 /// it), so that splits append instead of moving polygons around.
 #[derive(Debug, Default, Clone)]
 pub(crate) struct Scratch {
-    /// Node, start in `pool`, vertex count.
-    stack: Vec<(u32, u32, u32)>,
+    /// Node, start in `pool`, vertex count, and the split the fragment is a whole part of
+    /// ([`NO_SPLIT`] for none).
+    stack: Vec<(u32, u32, u32, u32)>,
     pool: Vec<DVec3>,
+    /// The splits of the query into two parts: see [`Merges`].
+    merges: Merges,
 }
 
-fn classify(or: &Orienter, frag: &[DVec3], vals: &mut SmallVec<[(f64, Sign); 8]>) -> Class {
+/// No split: a fragment that is not one of the two parts of a split, as a whole.
+const NO_SPLIT: u32 = u32::MAX;
+
+/// The splits of one query whose parts may come out whole, to give back the fragment that was
+/// split instead of its two parts when both are visible (fewer, larger fragments, so fewer
+/// spherical polygons to build and integrate).
+///
+/// A split of the fragment `F` by a node's plane into the parts `F+` and `F-` (both with
+/// area) is recorded with `F`'s range in the pool; a part that reaches a visible leaf, or an
+/// undefined leaf that the relevance test finds visible, without being split again counts as
+/// visible whole for its split. When both parts of a split are visible whole, every line from
+/// the point through `F+` or `F-` is unblocked, and `F` is their union (the two parts share the
+/// cut edge, vertices on the plane join both): `F` is then visible whole, which counts for the
+/// split `F` is a part of, and so on up. A part split again with both sub-parts recorded counts
+/// for its split only through them; a part that loses a sliver to a split (one side with less
+/// than three distinct points) starts a fresh chain, so no merge ever adds area that was not
+/// found visible. Fragments are held until the query ends; those whose split was merged are
+/// dropped, the merged fragment standing for them.
+#[derive(Debug, Default, Clone)]
+struct Merges {
+    /// Per split: the split it is a part of, the range of `F` in the pool, how many parts are
+    /// visible whole, and whether both were (then `F` stands for them).
+    splits: Vec<(u32, u32, u32, u8, bool)>,
+    /// Visible fragments held until the query ends: their split, their range in the pool.
+    held: Vec<(u32, u32, u32)>,
+}
+
+impl Merges {
+    fn clear(&mut self) {
+        self.splits.clear();
+        self.held.clear();
+    }
+
+    /// Records a split of the fragment `pool[s..s + len]`, itself a whole part of `parent`.
+    fn split(&mut self, parent: u32, s: u32, len: u32) -> u32 {
+        self.splits.push((parent, s, len, 0, false));
+        (self.splits.len() - 1) as u32
+    }
+
+    /// The fragment `pool[s..s + len]`, a whole part of `split`, is visible: appended to `out`
+    /// when it is no part of a split, else held, and merged up while both parts of a split are
+    /// visible whole.
+    fn visible(
+        &mut self,
+        mut split: u32,
+        mut s: u32,
+        mut len: u32,
+        pool: &[DVec3],
+        out: &mut Vec<Fragment>,
+    ) {
+        loop {
+            if split == NO_SPLIT {
+                out.push(
+                    pool[s as usize..(s + len) as usize]
+                        .iter()
+                        .copied()
+                        .collect(),
+                );
+                return;
+            }
+            self.held.push((split, s, len));
+            let rec = &mut self.splits[split as usize];
+            rec.3 += 1;
+            if rec.3 < 2 {
+                return;
+            }
+            rec.4 = true;
+            (split, s, len) = (rec.0, rec.1, rec.2);
+        }
+    }
+
+    /// Appends to `out` the held fragments whose split was not merged.
+    fn flush(&mut self, pool: &[DVec3], out: &mut Vec<Fragment>) {
+        for &(split, s, len) in &self.held {
+            if !self.splits[split as usize].4 {
+                out.push(
+                    pool[s as usize..(s + len) as usize]
+                        .iter()
+                        .copied()
+                        .collect(),
+                );
+            }
+        }
+        self.clear();
+    }
+}
+
+/// The class of `frag` against the plane of `or`, with each vertex's value and sign in `vals`;
+/// `bound` is the plane's filter bound for points within the reach of the query
+/// ([`Orienter::eval_near_within`]).
+fn classify(
+    or: &Orienter,
+    bound: f64,
+    frag: &[DVec3],
+    vals: &mut SmallVec<[(f64, Sign); 8]>,
+) -> Class {
     vals.clear();
     let (mut pos, mut neg) = (false, false);
     for &e in frag {
-        let (v, sign) = or.eval_near(e);
+        let (v, sign) = or.eval_near_within(e, bound);
         match sign {
             Sign::Positive => pos = true,
             Sign::Negative => neg = true,
@@ -136,46 +234,52 @@ fn split(frag: &[DVec3], vals: &[(f64, Sign)]) -> (Option<Fragment>, Option<Frag
     (close(pos), close(neg))
 }
 
-/// Appends to `pool` the part of the fragment `pool[s..s + n]` on the positive (`positive`) or
-/// negative side, as [`split`] does, and returns its range, or `None` for fewer than three
-/// distinct points (the pool is then left as it was).
-fn split_part(
+/// A fragment's start in the pool and its vertex count.
+type Range = (u32, u32);
+
+/// Appends to `pool` the parts of the fragment `pool[s..s + n]` on the negative and on the
+/// positive side of the plane whose values at its vertices are `vals`, as [`split`] does (in
+/// one pass: each cut point is computed once, for both parts), and returns their ranges, each
+/// `None` for fewer than three distinct points.
+fn split_parts(
     pool: &mut Vec<DVec3>,
     s: usize,
     n: usize,
     vals: &[(f64, Sign)],
-    positive: bool,
-) -> Option<(u32, u32)> {
-    let start = pool.len();
-    let (keep, drop) = if positive {
-        (Sign::Positive, Sign::Negative)
-    } else {
-        (Sign::Negative, Sign::Positive)
-    };
-    let push = |pool: &mut Vec<DVec3>, p: DVec3| {
-        if pool.len() == start || pool[pool.len() - 1] != p {
-            pool.push(p);
-        }
-    };
+) -> (Option<Range>, Option<Range>) {
+    let (mut minus, mut plus) = (Fragment::new(), Fragment::new());
     for i in 0..n {
         let j = (i + 1) % n;
         let (a, b) = (pool[s + i], pool[s + j]);
         let ((va, sa), (vb, sb)) = (vals[i], vals[j]);
-        if sa != drop {
-            push(pool, a);
+        if sa != Sign::Negative {
+            push_point(&mut plus, a);
         }
-        if (sa == keep && sb == drop) || (sa == drop && sb == keep) {
-            push(pool, cut_point(a, b, va, vb));
+        if sa != Sign::Positive {
+            push_point(&mut minus, a);
+        }
+        if matches!(
+            (sa, sb),
+            (Sign::Positive, Sign::Negative) | (Sign::Negative, Sign::Positive)
+        ) {
+            let p = cut_point(a, b, va, vb);
+            push_point(&mut plus, p);
+            push_point(&mut minus, p);
         }
     }
-    while pool.len() > start + 1 && pool[start] == pool[pool.len() - 1] {
-        pool.pop();
-    }
-    if pool.len() - start < 3 {
-        pool.truncate(start);
-        return None;
-    }
-    Some((start as u32, (pool.len() - start) as u32))
+    let mut append = |f: &mut Fragment| {
+        while f.len() > 1 && f.first() == f.last() {
+            f.pop();
+        }
+        if f.len() < 3 {
+            return None;
+        }
+        let start = pool.len();
+        pool.extend_from_slice(f);
+        Some((start as u32, f.len() as u32))
+    };
+    let minus = append(&mut minus);
+    (minus, append(&mut plus))
 }
 
 /// The point where the edge `a -> b` crosses a plane, from the plane's values `va`, `vb` at its
@@ -220,12 +324,20 @@ pub(crate) fn query(
     scratch: &mut Scratch,
 ) -> Result<(), CapExceeded> {
     let mut vals: SmallVec<[(f64, Sign); 8]> = SmallVec::new();
-    let Scratch { stack, pool } = scratch;
+    // Every fragment corner relative to `x` is within twice the tree's reach of the origin
+    // (as in `relevant_occluder`), so the node planes' signs may take the reach bound.
+    let reach = 2.0 * tree.reach();
+    let Scratch {
+        stack,
+        pool,
+        merges,
+    } = scratch;
     stack.clear();
     pool.clear();
+    merges.clear();
     pool.extend_from_slice(poly);
-    stack.push((Tree::ROOT, 0, poly.len() as u32));
-    while let Some((mut n, mut s, mut len)) = stack.pop() {
+    stack.push((Tree::ROOT, 0, poly.len() as u32, NO_SPLIT));
+    while let Some((mut n, mut s, mut len, mut part_of)) = stack.pop() {
         loop {
             match *tree.node(n) {
                 Node::Inner {
@@ -257,7 +369,7 @@ pub(crate) fn query(
                             Sign::Zero => Class::Zero,
                         }
                     } else {
-                        classify(&or, frag, &mut vals)
+                        classify(&or, or.reach_bound(reach), frag, &mut vals)
                     };
                     match class {
                         Class::Pos => n = pos,
@@ -265,12 +377,20 @@ pub(crate) fn query(
                         Class::Zero => n = if zero_pos { pos } else { neg },
                         Class::Split => {
                             let (su, lu) = (s as usize, len as usize);
-                            if let Some((ms, ml)) = split_part(pool, su, lu, &vals, false) {
-                                stack.push((neg, ms, ml));
+                            let (minus, plus) = split_parts(pool, su, lu, &vals);
+                            // Only a split into two parts with area is recorded (see
+                            // `Merges`): a part that lost a sliver starts afresh.
+                            let split = if minus.is_some() && plus.is_some() {
+                                merges.split(part_of, s, len)
+                            } else {
+                                NO_SPLIT
+                            };
+                            if let Some((ms, ml)) = minus {
+                                stack.push((neg, ms, ml, split));
                             }
-                            match split_part(pool, su, lu, &vals, true) {
+                            match plus {
                                 Some((ps, pl)) => {
-                                    (s, len) = (ps, pl);
+                                    (s, len, part_of) = (ps, pl, split);
                                     n = pos;
                                 }
                                 None => break,
@@ -279,12 +399,7 @@ pub(crate) fn query(
                     }
                 }
                 Node::Visible => {
-                    out.push(
-                        pool[s as usize..(s + len) as usize]
-                            .iter()
-                            .copied()
-                            .collect(),
-                    );
+                    merges.visible(part_of, s, len, pool, out);
                     break;
                 }
                 Node::Invisible => break,
@@ -295,7 +410,7 @@ pub(crate) fn query(
                         // the fragment: it is visible from this point, whatever the class
                         // holds for other points of the tile.
                         tree.counters.shortcuts += 1;
-                        out.push(frag.iter().copied().collect());
+                        merges.visible(part_of, s, len, pool, out);
                         break;
                     };
                     tree.expand_with(n, ro);
@@ -306,6 +421,7 @@ pub(crate) fn query(
             }
         }
     }
+    merges.flush(pool, out);
     Ok(())
 }
 
@@ -762,6 +878,55 @@ mod tests {
             occluder(&tri, Crossing::Positive),
         );
         assert!(hidden < 0.9 * area(&above), "{hidden}");
+    }
+
+    #[test]
+    fn parts_of_a_split_both_visible_come_out_as_one_fragment() {
+        // A tree shared by two points: the first, under a small triangle, develops its chain;
+        // from the second the triangle's shadow misses the light, but the plane through it and
+        // the triangle's first edge cuts the light in two, and both parts end in visible
+        // leaves. The query gives back the light as one fragment (`Merges`), with its area.
+        let s = 0.2;
+        let tri = [
+            DVec3::new(-s, -s, 1.0),
+            DVec3::new(s, -s, 1.0),
+            DVec3::new(0.0, s, 1.0),
+        ];
+        let light = [
+            DVec3::new(-0.5, -0.5, 2.0),
+            DVec3::new(0.5, -0.5, 2.0),
+            DVec3::new(0.5, 0.5, 2.0),
+            DVec3::new(-0.5, 0.5, 2.0),
+        ];
+        let (x1, x2) = (DVec3::ZERO, DVec3::new(1.5, 0.0, 0.0));
+        let mut tree = Tree::new(
+            &[x1, x2],
+            &light,
+            alloc::vec![occluder(&tri, Crossing::Positive)],
+            7,
+        );
+        let mut scratch = Scratch::default();
+        let mut run = |tree: &mut Tree, x: DVec3| {
+            let mut out = Vec::new();
+            let relative: Vec<DVec3> = light.iter().map(|&p| p - x).collect();
+            query(
+                tree,
+                x,
+                DVec3::Z,
+                &relative,
+                usize::MAX,
+                &mut out,
+                &mut scratch,
+            )
+            .unwrap();
+            out
+        };
+        let first = run(&mut tree, x1);
+        let shadowed: f64 = first.iter().map(|f| area(f)).sum();
+        assert!(shadowed < 0.95 * area(&light), "{shadowed}");
+        let second = run(&mut tree, x2);
+        assert_eq!(second.len(), 1, "{second:?}");
+        assert!((area(&second[0]) - area(&light)).abs() <= 1e-12);
     }
 
     #[test]
