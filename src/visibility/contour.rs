@@ -802,10 +802,11 @@ fn cone_axis(normals: impl Iterator<Item = DVec3> + Clone) -> DVec3 {
 /// balance and more than one edge arrives or leaves declines (`false`).
 pub(crate) fn chain_rings(
     edges: &[(u32, u32)],
+    nverts: usize,
     dir: impl Fn(u32) -> DVec3,
     open: bool,
     s: &mut ChainScratch,
-    mut emit: impl FnMut(&[u32], bool),
+    emit: impl FnMut(&[u32], bool),
 ) -> bool {
     let n = edges.len();
     s.paired = false;
@@ -815,6 +816,109 @@ pub(crate) fn chain_rings(
     if n >= (u32::MAX / 4) as usize {
         return false;
     }
+    let work = &mut s.work;
+    work.clear();
+    let linked = if nverts > 0 && nverts <= DENSE_CHAIN_VERTICES {
+        // The mesh's vertex count is known and small: the first edge leaving each vertex in a
+        // dense array (`s.first`, all `u32::MAX` between calls), no hashing.
+        work.resize(2 * n, u32::MAX);
+        if s.first.len() < nverts {
+            s.first.resize(nverts, u32::MAX);
+        }
+        let first = &mut s.first[..nverts];
+        let ok = successors_dense(edges, &dir, open, work, first, &mut s.paired);
+        // Only the entries of the edges' first vertices were written.
+        for &(a, _) in edges {
+            if let Some(f) = first.get_mut(a as usize) {
+                *f = u32::MAX;
+            }
+        }
+        ok
+    } else {
+        successors_hashed(edges, &dir, open, work, &mut s.paired)
+    };
+    if !linked {
+        return false;
+    }
+    walk_chains(edges, open, &mut s.work, &mut s.ring, emit)
+}
+
+/// Meshes of at most this many vertices chain their contours through a dense array of one
+/// `u32` per vertex (256 KB at most, kept per thread), larger ones through a hash table.
+const DENSE_CHAIN_VERTICES: usize = 1 << 16;
+
+/// [`chain_rings`]' successors through a dense per-vertex array: `work` holds `next` then
+/// `link` per edge (all `u32::MAX`); `first` (all `u32::MAX`) is written at the edges' first
+/// vertices only. The same `next` as [`successors_hashed`]; `false` (declined) where a vertex
+/// index is not below `first.len()`.
+fn successors_dense(
+    edges: &[(u32, u32)],
+    dir: &impl Fn(u32) -> DVec3,
+    open: bool,
+    work: &mut [u32],
+    first: &mut [u32],
+    paired: &mut bool,
+) -> bool {
+    let n = edges.len();
+    let (next, link) = work.split_at_mut(n);
+    let mut several = false;
+    for (k, &(a, _)) in edges.iter().enumerate() {
+        let Some(head) = first.get_mut(a as usize) else {
+            return false;
+        };
+        if *head != u32::MAX {
+            link[k] = *head;
+            several = true;
+        }
+        *head = k as u32;
+    }
+    // Single successors.
+    for k in 0..n {
+        let head = first.get(edges[k].1 as usize).copied().unwrap_or(u32::MAX);
+        if head == u32::MAX {
+            if open {
+                continue;
+            }
+            return false;
+        }
+        if link[head as usize] == u32::MAX {
+            next[k] = head;
+        }
+    }
+    if !several {
+        return true;
+    }
+    // Vertices left by several edges (each once: at the edge at the head of its list).
+    for k in 0..n {
+        let v = edges[k].0;
+        let head = first[v as usize];
+        if head != k as u32 || link[k] == u32::MAX {
+            continue;
+        }
+        *paired = true;
+        let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
+        let mut j = head;
+        while j != u32::MAX {
+            outs.push(j as usize);
+            j = link[j as usize];
+        }
+        if !pair_at(edges, v, &outs, dir, next) {
+            return false;
+        }
+    }
+    true
+}
+
+/// [`chain_rings`]' successors through an open-addressed hash table: `work` becomes `next`
+/// and `link` per edge, then the table.
+fn successors_hashed(
+    edges: &[(u32, u32)],
+    dir: &impl Fn(u32) -> DVec3,
+    open: bool,
+    work: &mut Vec<u32>,
+    paired: &mut bool,
+) -> bool {
+    let n = edges.len();
     // The edges leaving each vertex as a linked list (`link`) from the vertex's slot in an
     // open-addressed table (`[vertex, first edge]`, at most half full): linear in the edges,
     // where a sort of them is `n log n`.
@@ -822,8 +926,6 @@ pub(crate) fn chain_rings(
     let mask = (1usize << bits) - 1;
     let slot_of = |v: u32| (v.wrapping_mul(0x9E37_79B9) >> (32 - bits)) as usize;
     // One buffer: `next` and `link` per edge, then the table's slots as pairs.
-    let work = &mut s.work;
-    work.clear();
     work.resize(2 * n + 2 * (mask + 1), u32::MAX);
     let (next, rest) = work.split_at_mut(n);
     let (link, table) = rest.split_at_mut(n);
@@ -882,19 +984,32 @@ pub(crate) fn chain_rings(
         if v == u32::MAX || link[head as usize] == u32::MAX {
             continue;
         }
-        s.paired = true;
+        *paired = true;
         let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
         let mut k = head;
         while k != u32::MAX {
             outs.push(k as usize);
             k = link[k as usize];
         }
-        if !pair_at(edges, v, &outs, &dir, next) {
+        if !pair_at(edges, v, &outs, dir, next) {
             return false;
         }
     }
-    // Walk: open chains from their first edges (those that no edge leads to), then the rings.
-    let ring = &mut s.ring;
+    true
+}
+
+/// [`chain_rings`]' walk over the successors `work[..n]` (`work[n..2n]` reused as marks):
+/// open chains from their first edges (those that no edge leads to), then the rings.
+fn walk_chains(
+    edges: &[(u32, u32)],
+    open: bool,
+    work: &mut [u32],
+    ring: &mut Vec<u32>,
+    mut emit: impl FnMut(&[u32], bool),
+) -> bool {
+    let n = edges.len();
+    let (next, rest) = work.split_at_mut(n);
+    let link = &mut rest[..n];
     let mut used = 0usize;
     if open {
         link.fill(0);
@@ -956,6 +1071,8 @@ pub(crate) fn chain_rings(
 pub(crate) struct ChainScratch {
     work: Vec<u32>,
     ring: Vec<u32>,
+    /// Per mesh vertex, the first contour edge leaving it (all `u32::MAX` between calls).
+    first: Vec<u32>,
     /// Whether the last [`chain_rings`] paired edges at a vertex left by several: only then
     /// can its rings pass one vertex twice.
     pub(crate) paired: bool,
@@ -967,6 +1084,7 @@ impl ChainScratch {
         ChainScratch {
             work: Vec::with_capacity(6 * n),
             ring: Vec::with_capacity(n),
+            first: Vec::new(),
             paired: false,
         }
     }
@@ -1154,6 +1272,75 @@ mod tests {
             }
             assert!(found > 100, "{found}");
         }
+    }
+
+    /// Runs [`chain_rings`] and returns its answer, its rings and `paired` (where it chains);
+    /// checks that the
+    /// dense array is left all `u32::MAX`.
+    fn chained(
+        edges: &[(u32, u32)],
+        nverts: usize,
+        dirs: &[DVec3],
+        open: bool,
+        s: &mut ChainScratch,
+    ) -> (bool, Vec<(Vec<u32>, bool)>, bool) {
+        let mut rings = Vec::new();
+        let dir = |i: u32| dirs.get(i as usize).copied().unwrap_or(DVec3::Z);
+        let ok = chain_rings(edges, nverts, dir, open, s, |r, o| {
+            rings.push((r.to_vec(), o));
+        });
+        assert!(s.first.iter().all(|&f| f == u32::MAX));
+        (ok, rings, ok && s.paired)
+    }
+
+    #[test]
+    fn dense_chaining_is_the_hashed_one() {
+        let mut unit = crate::math::test_unit_stream(0x51_7cc1_b727_220a);
+        let mesh = crate::solid::fixtures::torus(0.6, 0.15, 24, 10).unwrap();
+        let closed = Closed::new(&mesh);
+        let mc = MeshContours::new(&mesh, &closed);
+        let nv = mesh.vertices().len();
+        let (mut dense, mut hashed) = (ChainScratch::default(), ChainScratch::default());
+        let (mut rings, mut several, mut opened) = (0, 0, 0);
+        for case in 0..600 {
+            let x = DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5).normalize_or(DVec3::Z)
+                * [0.8, 1.5, 3.0][case % 3];
+            let dirs: Vec<DVec3> = mesh.vertices().iter().map(|&p| p - x).collect();
+            let mut edges = Vec::new();
+            if case % 4 == 3 {
+                // Bowties: triangles of vertex 0 and others (several edges leave vertex 0),
+                // the rest of the vertices' indices up to `nv`.
+                let k = 2 + (unit() * 3.0) as u32;
+                for t in 0..k {
+                    let (a, b) = (1 + 2 * t, 2 + 2 * t);
+                    edges.extend([(0, a), (a, b), (b, 0)]);
+                }
+            } else if !mc.contour(&mesh, x, Cull::All, &mut edges) {
+                continue;
+            }
+            // Some edges left out: open chains (or declines, alike in both).
+            let open = case % 2 == 1 && edges.len() > 3;
+            if open {
+                let drop = (unit() * edges.len() as f64) as usize % edges.len();
+                edges.remove(drop);
+            }
+            let a = chained(&edges, nv, &dirs, open, &mut dense);
+            let b = chained(&edges, 0, &dirs, open, &mut hashed);
+            assert_eq!(a, b, "case {case}");
+            // An index past the mesh's vertices: the dense array declines (and is left clean).
+            edges.push((nv as u32 + 5, 0));
+            assert!(
+                !chained(&edges, nv, &dirs, open, &mut dense).0,
+                "case {case}"
+            );
+            rings += a.1.len();
+            several += usize::from(a.0 && a.2);
+            opened += a.1.iter().filter(|r| r.1).count();
+        }
+        assert!(
+            rings > 400 && several > 50 && opened > 50,
+            "{rings} {several} {opened}"
+        );
     }
 
     #[test]

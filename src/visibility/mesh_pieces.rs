@@ -179,6 +179,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
             let mut fits = true;
             let ok = chain_rings(
                 &s.edges,
+                verts.len(),
                 |i| frame.to_local(verts[i as usize]),
                 false,
                 &mut s.chain,
@@ -274,6 +275,7 @@ impl<L: AsRef<Body>> ClipVisibility<L> {
                 let mut pieces_ok = true;
                 let ok = chain_rings(
                     &s.edges,
+                    verts.len(),
                     |i| frame.to_local(verts[i as usize]),
                     bvh.is_some(),
                     &mut s.chain,

@@ -102,9 +102,10 @@ pub(crate) struct Overlay {
     /// Per vertex: the next one along its ring (the one load [`Overlay::succ`] costs).
     next: Vec<u32>,
     bbox: Vec<[f64; 4]>,
-    /// Non-bridge edges by the left end of their boxes: the key's order-preserving bits above,
-    /// the edge below (integers sort faster than floating-point keys through the index).
-    order: Vec<u128>,
+    /// Non-bridge edges by the left end of their boxes: the key's order-preserving bits above
+    /// (the lowest rounded off), the edge below (integers sort faster than floating-point keys
+    /// through the index).
+    order: Vec<u64>,
     active: Vec<u32>,
     /// Pairs of edges whose boxes overlap (the sweep's candidates).
     pairs: Vec<(u32, u32)>,
@@ -148,6 +149,13 @@ fn orient(a: DVec2, b: DVec2, c: DVec2) -> (f64, f64) {
 fn order_bits(v: f64) -> u64 {
     let b = v.to_bits();
     if b >> 63 == 1 { !b } else { b | 1 << 63 }
+}
+
+/// The `f64` of [`order_bits`] `o`: its inverse. Clearing low bits of `o` gives a value no
+/// greater (for `v < 0` they are set in `v`'s mantissa, never reaching its exponent).
+#[inline(always)]
+fn from_order_bits(o: u64) -> f64 {
+    f64::from_bits(if o >> 63 == 1 { o & !(1 << 63) } else { !o })
 }
 
 /// The sign of `v` as `-1` or `1` (`v` is not zero).
@@ -304,6 +312,13 @@ impl Overlay {
         self.bbox.clear();
         self.order.clear();
         self.order.reserve(n);
+        // The keys: a box's left end with its lowest `bits` order bits cleared (rounded towards
+        // `-inf`), the edge in those bits. One `u64` sorts faster than the exact `u128` key.
+        let bits = usize::BITS - n.leading_zeros();
+        if bits > 32 {
+            return false;
+        }
+        let low = (1u64 << bits) - 1;
         for (k, (q, &s)) in pts.iter().zip(next).enumerate() {
             let (a, b) = (q.p, pts[s as usize].p);
             // Plain comparisons (the coordinates are finite): `f64::min`'s NaN rule costs more.
@@ -311,8 +326,7 @@ impl Overlay {
             let (y0, y1) = if a.y <= b.y { (a.y, b.y) } else { (b.y, a.y) };
             self.bbox.push([x0, x1, y0, y1]);
             if !q.bridge {
-                self.order
-                    .push(u128::from(order_bits(x0)) << 32 | k as u128);
+                self.order.push((order_bits(x0) & !low) | k as u64);
             }
         }
         self.order.sort_unstable();
@@ -321,21 +335,24 @@ impl Overlay {
         self.pairs.clear();
         let bbox = &self.bbox[..];
         for &key in &self.order {
-            let e = key as u32;
+            let e = (key & low) as u32;
             let be = bbox[e as usize];
-            // One pass over the active edges: those whose boxes end left of `e`'s leave for good
-            // (the later edges start no further left), the others stay, in order, and are
-            // tested against `e` where their boxes overlap in `y` too.
+            // `e`'s rounded left end: no later key's box starts further left.
+            let left = from_order_bits(key & !low);
+            // One pass over the active edges: those whose boxes end left of `left` leave for
+            // good, the others stay, in order, and are tested against `e` where their boxes
+            // overlap, in `x` both ways (within one rounded key `f`'s box may start right of
+            // `e`'s) and in `y`.
             let mut kept = 0;
             for j in 0..self.active.len() {
                 let f = self.active[j];
                 let bf = bbox[f as usize];
-                if bf[1] < be[0] {
+                if bf[1] < left {
                     continue;
                 }
                 self.active[kept] = f;
                 kept += 1;
-                if bf[2] > be[3] || be[2] > bf[3] {
+                if bf[2] > be[3] || be[2] > bf[3] || bf[1] < be[0] || be[1] < bf[0] {
                     continue;
                 }
                 self.pairs.push((e, f));
@@ -717,6 +734,60 @@ impl Overlay {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sweep's candidate pairs (keys with their low bits rounded off) are exactly the pairs
+    /// of edges whose boxes meet, where the boxes' ends lie a few ulps apart (many in one
+    /// rounded key), about `-1`, `+1` and the two zeros.
+    #[test]
+    fn sweep_pairs_are_the_meeting_boxes() {
+        let mut unit = crate::math::test_unit_stream(0x3c6e_f372_fe94_f82b);
+        let mut checked = 0;
+        for round in 0..300 {
+            let mut o = Overlay::with_capacity(64);
+            o.clear();
+            let base = [-1.0, 1.0, 0.0][round % 3];
+            let mut id = 0;
+            for _ in 0..1 + round % 3 {
+                let start = o.pts.len();
+                for _ in 0..3 + (unit() * 20.0) as usize {
+                    let j = (unit() * 40.0) as i64 - 20;
+                    let x = match base {
+                        0.0 if j == 0 => [0.0, -0.0][(unit() * 2.0) as usize % 2],
+                        0.0 => j as f64 * f64::from_bits(1) * 3.0,
+                        b => f64::from_bits((f64::to_bits(b) as i64 + j) as u64),
+                    };
+                    let p = DVec2::new(x, (unit() * 8.0).floor() / 8.0);
+                    o.pts.push(RingPoint {
+                        p,
+                        d: DVec3::new(p.x, p.y, 1.0),
+                        id,
+                        bridge: unit() < 0.1,
+                    });
+                    id += 1;
+                }
+                o.close(start, LIGHT);
+            }
+            let _ = o.resolve(DVec3::Z, DVec3::X, DVec3::Y);
+            let mut found: Vec<(u32, u32)> =
+                o.pairs.iter().map(|&(e, f)| (e.min(f), e.max(f))).collect();
+            found.sort_unstable();
+            let n = o.pts.len();
+            let mut meet = Vec::new();
+            for e in 0..n {
+                for f in e + 1..n {
+                    let (be, bf) = (o.bbox[e], o.bbox[f]);
+                    let x = be[0] <= bf[1] && bf[0] <= be[1];
+                    let y = be[2] <= bf[3] && bf[2] <= be[3];
+                    if x && y && !o.pts[e].bridge && !o.pts[f].bridge {
+                        meet.push((e as u32, f as u32));
+                    }
+                }
+            }
+            assert_eq!(found, meet, "round {round}");
+            checked += meet.len();
+        }
+        assert!(checked > 5000, "{checked}");
+    }
 
     /// The rays of [`Overlay::resolve`] (edges met by their boxes, half-open) count the same
     /// winding numbers as [`Overlay::winding`] (edges met by their ends' sides) along `+x`, and
