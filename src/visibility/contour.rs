@@ -872,18 +872,9 @@ fn successors_dense(
         }
         *head = k as u32;
     }
-    // Single successors.
-    for k in 0..n {
-        let head = first.get(edges[k].1 as usize).copied().unwrap_or(u32::MAX);
-        if head == u32::MAX {
-            if open {
-                continue;
-            }
-            return false;
-        }
-        if link[head as usize] == u32::MAX {
-            next[k] = head;
-        }
+    let first_out = |v: u32| first.get(v as usize).copied().unwrap_or(u32::MAX);
+    if !single_successors(edges, open, next, link, first_out) {
+        return false;
     }
     if !several {
         return true;
@@ -896,13 +887,7 @@ fn successors_dense(
             continue;
         }
         *paired = true;
-        let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
-        let mut j = head;
-        while j != u32::MAX {
-            outs.push(j as usize);
-            j = link[j as usize];
-        }
-        if !pair_at(edges, v, &outs, dir, next) {
+        if !pair_list(edges, v, head, link, dir, next) {
             return false;
         }
     }
@@ -951,7 +936,7 @@ fn successors_hashed(
             h = (h + 1) & mask;
         }
     }
-    let first_out = |table: &[u32], v: u32| {
+    let first_out = |v: u32| {
         let mut h = slot_of(v);
         loop {
             if table[2 * h] == v {
@@ -963,18 +948,8 @@ fn successors_hashed(
             h = (h + 1) & mask;
         }
     };
-    // Single successors.
-    for k in 0..n {
-        let head = first_out(table, edges[k].1);
-        if head == u32::MAX {
-            if open {
-                continue;
-            }
-            return false;
-        }
-        if link[head as usize] == u32::MAX {
-            next[k] = head;
-        }
+    if !single_successors(edges, open, next, link, first_out) {
+        return false;
     }
     // Vertices left by several edges, paired by angle: the table is scanned only if there are
     // any.
@@ -985,17 +960,55 @@ fn successors_hashed(
             continue;
         }
         *paired = true;
-        let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
-        let mut k = head;
-        while k != u32::MAX {
-            outs.push(k as usize);
-            k = link[k as usize];
-        }
-        if !pair_at(edges, v, &outs, dir, next) {
+        if !pair_list(edges, v, head, link, dir, next) {
             return false;
         }
     }
     true
+}
+
+/// The successor of every edge whose end vertex is left by one edge (`first_out(v)`: the head
+/// of `v`'s list of leaving edges, `u32::MAX` for none; `link` chains the lists): `false` where
+/// a closed contour's edge leads nowhere.
+#[inline(always)]
+fn single_successors(
+    edges: &[(u32, u32)],
+    open: bool,
+    next: &mut [u32],
+    link: &[u32],
+    first_out: impl Fn(u32) -> u32,
+) -> bool {
+    for (k, &(_, b)) in edges.iter().enumerate() {
+        let head = first_out(b);
+        if head == u32::MAX {
+            if open {
+                continue;
+            }
+            return false;
+        }
+        if link[head as usize] == u32::MAX {
+            next[k] = head;
+        }
+    }
+    true
+}
+
+/// [`pair_at`] over the edges leaving `v`: the list from `head` through `link`.
+fn pair_list(
+    edges: &[(u32, u32)],
+    v: u32,
+    head: u32,
+    link: &[u32],
+    dir: &impl Fn(u32) -> DVec3,
+    next: &mut [u32],
+) -> bool {
+    let mut outs: SmallVec<[usize; 4]> = SmallVec::new();
+    let mut k = head;
+    while k != u32::MAX {
+        outs.push(k as usize);
+        k = link[k as usize];
+    }
+    pair_at(edges, v, &outs, dir, next)
 }
 
 /// [`chain_rings`]' walk over the successors `work[..n]` (`work[n..2n]` reused as marks):
