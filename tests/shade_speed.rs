@@ -189,6 +189,33 @@ fn spherical(scene: &Scene, i: usize, f: &ShadingFrame, m: &Material) -> Option<
 /// of `1e-8` made of edge terms near 1).
 const ABS_FLOOR: f64 = 1e-3;
 
+/// Shades `x` (normal `n`, view `v`) on the fast path and compares it with the spherical path
+/// to `1e-12` of the unoccluded value: whether the fast path answered (its visible pieces, with
+/// `pieces` as scratch), and `(fast, spherical)` where they differ by more.
+fn fast_against_spherical(
+    scene: &Scene,
+    x: DVec3,
+    n: DVec3,
+    v: DVec3,
+    m: &Material,
+    pieces: &mut Pieces,
+) -> (bool, Option<(DVec3, DVec3)>) {
+    let frame = ShadingFrame::new(x, n, v).unwrap();
+    let fast = scene
+        .visibility()
+        .visible_pieces(0, &frame, true, pieces)
+        .unwrap();
+    let Some((want, unoccluded)) = spherical(scene, 0, &frame, m) else {
+        return (fast, None);
+    };
+    let got = scene.shade(x, n, v, m).unwrap();
+    let err = (got - want).abs().max_element();
+    (
+        fast,
+        (err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR)).then_some((got, want)),
+    )
+}
+
 #[test]
 fn fast_path_agrees_with_the_spherical_path() {
     let scenes: usize = std::env::var("SHADE_SPEED_SCENES")
@@ -328,20 +355,11 @@ fn points_next_to_occluder_face_planes() {
             let off = [0.0, 1e-12, -1e-12, 1e-10, 1e-9][rng.below(5)];
             x -= nf * (nf.dot(x - a) - off);
             let v = view_above(&mut rng, DVec3::Z, 0.2);
-            let frame = ShadingFrame::new(x, DVec3::Z, v).unwrap();
             pairs += 1;
-            fast += usize::from(
-                scene
-                    .visibility()
-                    .visible_pieces(0, &frame, true, &mut pieces)
-                    .unwrap(),
-            );
-            let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) else {
-                continue;
-            };
-            let got = scene.shade(x, DVec3::Z, v, &m).unwrap();
-            let err = (got - want).abs().max_element();
-            if err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR) {
+            let (answered, mismatch) =
+                fast_against_spherical(&scene, x, DVec3::Z, v, &m, &mut pieces);
+            fast += usize::from(answered);
+            if let Some((got, want)) = mismatch {
                 failures.push(format!("x {x} v {v}: fast {got} spherical {want}"));
             }
         }
@@ -428,20 +446,11 @@ fn blockers_in_exact_contact() {
         }));
         for x in points {
             let v = view_above(&mut rng, DVec3::Z, 0.2);
-            let frame = ShadingFrame::new(x, DVec3::Z, v).unwrap();
             pairs += 1;
-            fast += usize::from(
-                scene
-                    .visibility()
-                    .visible_pieces(0, &frame, true, &mut pieces)
-                    .unwrap(),
-            );
-            let Some((want, unoccluded)) = spherical(&scene, 0, &frame, &m) else {
-                continue;
-            };
-            let got = scene.shade(x, DVec3::Z, v, &m).unwrap();
-            let err = (got - want).abs().max_element();
-            if err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR) {
+            let (answered, mismatch) =
+                fast_against_spherical(&scene, x, DVec3::Z, v, &m, &mut pieces);
+            fast += usize::from(answered);
+            if let Some((got, want)) = mismatch {
                 failures.push(format!("scene {k} x {x}: fast {got} spherical {want}"));
             }
         }
@@ -512,20 +521,10 @@ fn faces_in_the_plane_of_a_light_edge() {
                 };
                 let v = view_above(&mut rng, n, 0.2);
                 let m = &materials[k % 2];
-                let frame = ShadingFrame::new(x, n, v).unwrap();
                 pairs += 1;
-                fast += usize::from(
-                    scene
-                        .visibility()
-                        .visible_pieces(0, &frame, true, &mut pieces)
-                        .unwrap(),
-                );
-                let Some((want, unoccluded)) = spherical(&scene, 0, &frame, m) else {
-                    continue;
-                };
-                let got = scene.shade(x, n, v, m).unwrap();
-                let err = (got - want).abs().max_element();
-                if err > 1e-12 * (unoccluded.max_element() + ABS_FLOOR) {
+                let (answered, mismatch) = fast_against_spherical(&scene, x, n, v, m, &mut pieces);
+                fast += usize::from(answered);
+                if let Some((got, want)) = mismatch {
                     failures.push(format!("s {s} x {x} n {n}: fast {got} spherical {want}"));
                 }
             }
