@@ -238,48 +238,24 @@ fn split(frag: &[DVec3], vals: &[(f64, Sign)]) -> (Option<Fragment>, Option<Frag
 type Range = (u32, u32);
 
 /// Appends to `pool` the parts of the fragment `pool[s..s + n]` on the negative and on the
-/// positive side of the plane whose values at its vertices are `vals`, as [`split`] does (in
-/// one pass: each cut point is computed once, for both parts), and returns their ranges, each
-/// `None` for fewer than three distinct points.
+/// positive side of the plane whose values at its vertices are `vals` ([`split`], which
+/// computes each cut point once for both parts), and returns their ranges, each `None` for
+/// fewer than three distinct points.
 fn split_parts(
     pool: &mut Vec<DVec3>,
     s: usize,
     n: usize,
     vals: &[(f64, Sign)],
 ) -> (Option<Range>, Option<Range>) {
-    let (mut minus, mut plus) = (Fragment::new(), Fragment::new());
-    for i in 0..n {
-        let j = (i + 1) % n;
-        let (a, b) = (pool[s + i], pool[s + j]);
-        let ((va, sa), (vb, sb)) = (vals[i], vals[j]);
-        if sa != Sign::Negative {
-            push_point(&mut plus, a);
-        }
-        if sa != Sign::Positive {
-            push_point(&mut minus, a);
-        }
-        if matches!(
-            (sa, sb),
-            (Sign::Positive, Sign::Negative) | (Sign::Negative, Sign::Positive)
-        ) {
-            let p = cut_point(a, b, va, vb);
-            push_point(&mut plus, p);
-            push_point(&mut minus, p);
-        }
-    }
-    let mut append = |f: &mut Fragment| {
-        while f.len() > 1 && f.first() == f.last() {
-            f.pop();
-        }
-        if f.len() < 3 {
-            return None;
-        }
+    let (plus, minus) = split(&pool[s..s + n], vals);
+    let mut append = |f: Option<Fragment>| {
+        let f = f?;
         let start = pool.len();
-        pool.extend_from_slice(f);
+        pool.extend_from_slice(&f);
         Some((start as u32, f.len() as u32))
     };
-    let minus = append(&mut minus);
-    (minus, append(&mut plus))
+    let minus = append(minus);
+    (minus, append(plus))
 }
 
 /// The point where the edge `a -> b` crosses a plane, from the plane's values `va`, `vb` at its
